@@ -185,7 +185,7 @@ class ConstraintSet:
             If two conditions prescribe different values on one dof.
         """
         n = self.scalar.ndof
-        values = {}   # dof -> (value, source)
+        pieces = []   # (dofs, values, source), merged below
         work = ng.GridFunction(self.fes)
         for cond in self.dirichlet:
             region = self.mesh.Boundaries("|".join(cond.boundaries))
@@ -194,13 +194,21 @@ class ConstraintSet:
             work.Set(cond.value, ng.BND, definedon=region)
             data = work.vec.FV().NumPy()
             scalar_dofs = np.flatnonzero(np.array(self.scalar.GetDofs(region), dtype=bool))
+            source = f"Dirichlet on {', '.join(cond.boundaries)}"
             for c in _components(cond.component):
                 dofs = c * n + scalar_dofs
-                self._merge(values, dofs, data[dofs], f"Dirichlet on {', '.join(cond.boundaries)}")
+                if not np.all(np.isfinite(data[dofs])):
+                    raise ValueError(f"{source}: the prescribed value is NaN or inf on the boundary")
+                pieces.append((dofs, data[dofs].copy(), source))
         for pc in self.points:
             for c in _components(pc.component):
-                self._merge(values, np.array([c * n + pc.vertex]), np.array([pc.value[c]]),
-                            f"point constraint at vertex {pc.vertex}")
+                pieces.append((np.array([c * n + pc.vertex]), np.array([pc.value[c]]),
+                               f"point constraint at vertex {pc.vertex}"))
+        # values that agree to rounding (NGSolve's Set() leaves ~1e-17 at corners) are one value
+        scale = max([float(np.max(np.abs(v), initial=0.0)) for _, v, _ in pieces] + [1e-300])
+        values = {}
+        for dofs, vals, source in pieces:
+            self._merge(values, dofs, vals, source, 1e-10 * scale)
         dofs = np.array(sorted(values), dtype=np.int64)
         vals = np.array([values[d][0] for d in dofs], dtype=float)
         if self.rows:
@@ -212,12 +220,11 @@ class ConstraintSet:
         return ConstraintRows(dofs, vals, C, g, [r[2] for r in self.rows])
 
     @staticmethod
-    def _merge(values, dofs, vals, source):
-        scale = max(float(np.max(np.abs(vals), initial=0.0)), 1e-300)
+    def _merge(values, dofs, vals, source, tol):
         for d, v in zip(dofs.tolist(), vals.tolist()):
             if d in values:
                 old, old_source = values[d]
-                if abs(old - v) > 1e-10 * max(scale, abs(old)):
+                if abs(old - v) > tol:
                     raise ValueError(f"conflicting constraint values on dof {d}: {old!r} from {old_source} "
                                      f"and {v!r} from {source}")
             else:

@@ -89,10 +89,10 @@ class ConstrainedSolver:
             except np.linalg.LinAlgError:
                 raise SingularSystem(f"the {self.m} general constraint rows are linearly dependent "
                                      "(remove redundant rows before the solve)") from None
-            diag = np.abs(np.diag(self._S[0]))
-            if diag.min() <= 1e-10 * diag.max():
+            pivots = np.diag(self._S[0]) ** 2
+            if pivots.min() <= 1e-12 * pivots.max():
                 raise SingularSystem(f"the {self.m} general constraint rows are (nearly) linearly dependent: "
-                                     f"Schur complement pivot ratio {diag.min() / diag.max():.2e}")
+                                     f"Schur complement pivot ratio {pivots.min() / pivots.max():.2e}")
 
     def _solve_free(self, rhs_free):
         """x_f = K_ff^-1 rhs_f, with a check that the factorisation solves its own system."""
