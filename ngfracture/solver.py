@@ -123,7 +123,8 @@ class NewtonSolver:
         status = SolveStatus()
         with _Timer(status.timings, "checks"):
             rows = prob.assemble_constraints()
-            floating = prob.floating_bodies(rows)
+            support = prob.support(rows)
+            floating = prob.floating_bodies(rows, support)
         if floating:
             return status.fail("singular", floating)
         u = prob.u.vec.FV().NumPy()
@@ -136,7 +137,7 @@ class NewtonSolver:
             target_fixed = start_fixed + t * (rows.fixed_values - start_fixed)
             target_rows = start_rows + t * (rows.g - start_rows)
             saved = u.copy()
-            self._load_step(rows, target_fixed, target_rows, status)
+            self._load_step(rows, support, target_fixed, target_rows, status)
             if not status.converged:
                 u[:] = saved  # the last converged state, never a failed iterate
                 prob.load_factor.Set(start_load + (step - 1) / load_steps * (1.0 - start_load))
@@ -145,7 +146,7 @@ class NewtonSolver:
             status.steps = step
         return status
 
-    def _load_step(self, rows, target_fixed, target_rows, status):
+    def _load_step(self, rows, support, target_fixed, target_rows, status):
         prob = self.problem
         u = prob.u.vec.FV().NumPy()
         timings = status.timings
@@ -165,7 +166,8 @@ class NewtonSolver:
                 try:
                     with _Timer(timings, "factorize"):
                         kkt = ConstrainedSolver(K, prob.freedofs(rows.fixed_dofs), rows.C,
-                                                self.linear_solver, self.inverse)
+                                                self.linear_solver, self.inverse,
+                                                modes=support.modes, pins=support.pins)
                 except SingularSystem as err:
                     status.fail("singular", str(err))
                     return
