@@ -50,8 +50,8 @@ class ConstrainedSolver:
     ----------
     K : ngsolve.SparseMatrix
         Tangent stiffness on all dofs.
-    freedofs : ngsolve.BitArray
-        Dofs not fixed by single-dof rows.
+    fixed_dofs : numpy.ndarray
+        Dofs fixed by single-dof rows (eliminated).
     C : scipy.sparse matrix, shape (m, ndof)
         General constraint rows (may have m = 0).
     linear_solver : {"direct", "gmres"}
@@ -66,20 +66,21 @@ class ConstrainedSolver:
         If K_ff or the Schur complement is singular.
     """
 
-    def __init__(self, K, freedofs, C, linear_solver="direct", inverse="sparsecholesky", gmres_tol=1e-12,
+    def __init__(self, K, fixed_dofs, C, linear_solver="direct", inverse="sparsecholesky", gmres_tol=1e-12,
                  modes=None, pins=None):
         if linear_solver not in LINEAR_SOLVERS:
             raise ValueError(f"linear_solver must be one of {LINEAR_SOLVERS}, got {linear_solver!r}")
         self.K = K
         self.ndof = K.height
-        self.free = np.array(freedofs, dtype=bool)
-        factor_dofs = freedofs
-        pins = np.zeros(0, dtype=np.int64) if pins is None else np.asarray(pins)
-        if pins.size:
-            factor_dofs = ng.BitArray(freedofs)
-            for d in pins.tolist():
-                factor_dofs.Clear(d)
-        self.factor_free = np.array(factor_dofs, dtype=bool)
+        pins = np.zeros(0, dtype=np.int64) if pins is None else np.asarray(pins, dtype=np.int64)
+        self.free = np.ones(self.ndof, dtype=bool)
+        self.free[fixed_dofs] = False
+        self.factor_free = self.free.copy()
+        self.factor_free[pins] = False
+        factor_dofs = ng.BitArray(self.ndof)
+        factor_dofs.Set()
+        for d in np.flatnonzero(~self.factor_free).tolist():
+            factor_dofs.Clear(d)
         self.linear_solver = linear_solver
         self.gmres_tol = gmres_tol
         self._tmp = K.CreateColVector()

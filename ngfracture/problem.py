@@ -161,14 +161,6 @@ class ElasticProblem:
             form.Apply(self.u.vec, self._res)
         return -self._res.FV().NumPy().copy()
 
-    def freedofs(self, fixed_dofs):
-        """BitArray of the dofs not fixed by single-dof rows."""
-        free = ng.BitArray(self.fes.ndof)
-        free.Set()
-        for d in fixed_dofs.tolist():
-            free.Clear(d)
-        return free
-
     def assemble_constraints(self):
         return self.constraints.assemble()
 

@@ -20,9 +20,10 @@ from scipy.sparse.csgraph import connected_components
 
 def pieces(elements, nv):
     """Connected components of a triangle mesh: (count, piece id per vertex)."""
-    rows = np.repeat(elements, 3, axis=1).ravel()
-    cols = np.tile(elements, (1, 3)).ravel()
-    graph = sp.csr_matrix((np.ones(rows.size), (rows, cols)), shape=(nv, nv))
+    # two edges per triangle connect its three vertices
+    rows = np.concatenate([elements[:, 0], elements[:, 1]])
+    cols = np.concatenate([elements[:, 1], elements[:, 2]])
+    graph = sp.coo_matrix((np.ones(rows.size, dtype=np.int8), (rows, cols)), shape=(nv, nv))
     return connected_components(graph, directed=False)
 
 
@@ -93,7 +94,7 @@ def analyse_support(x, elements, n, ndof, fixed_dofs):
         held = M[fixed[dofs]]
         # modes in the null space of the fixed rows: what the single-dof rows leave free
         if held.shape[0]:
-            _, s, vt = np.linalg.svd(held)
+            _, s, vt = np.linalg.svd(held, full_matrices=False)
             rank = int(np.sum(s > 1e-10 * max(s.max(), 1.0)))
             free_modes = vt[rank:].T
         else:

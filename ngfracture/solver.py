@@ -165,7 +165,7 @@ class NewtonSolver:
                     K = prob.tangent()
                 try:
                     with _Timer(timings, "factorize"):
-                        kkt = ConstrainedSolver(K, prob.freedofs(rows.fixed_dofs), rows.C,
+                        kkt = ConstrainedSolver(K, rows.fixed_dofs, rows.C,
                                                 self.linear_solver, self.inverse,
                                                 modes=support.modes, pins=support.pins)
                 except SingularSystem as err:
