@@ -94,7 +94,8 @@ def analyse_support(x, elements, n, ndof, fixed_dofs):
         held = M[fixed[dofs]]
         # modes in the null space of the fixed rows: what the single-dof rows leave free
         if held.shape[0]:
-            _, s, vt = np.linalg.svd(held, full_matrices=False)
+            # reduce to at most 3x3 first: the full V of the SVD is then cheap
+            _, s, vt = np.linalg.svd(np.linalg.qr(held, mode="r"), full_matrices=True)
             rank = int(np.sum(s > 1e-10 * max(s.max(), 1.0)))
             free_modes = vt[rank:].T
         else:
