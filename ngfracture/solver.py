@@ -44,6 +44,9 @@ class SolveStatus:
         Euclidean norm of the free out-of-balance force after every iteration.
     timings : dict
         Seconds per phase: assemble, factorize, solve, residual, checks.
+    multipliers : numpy.ndarray
+        Lagrange multipliers of the general rows at the end (the forces -C^T lam
+        they exert on the dofs); empty without general rows.
     """
     converged: bool = False
     reason: str = "max_iterations"
@@ -54,6 +57,7 @@ class SolveStatus:
     residual_history: list = field(default_factory=list)
     timings: dict = field(default_factory=lambda: dict.fromkeys(
         ("assemble", "factorize", "solve", "residual", "checks"), 0.0))
+    multipliers: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     def __bool__(self):
         return self.converged
@@ -179,7 +183,7 @@ class NewtonSolver:
             h = target_rows - rows.C @ u
             try:
                 with _Timer(timings, "solve"):
-                    du, _ = kkt.solve(r, du_fixed, h)
+                    du, status.multipliers = kkt.solve(r, du_fixed, h)
                 if k == 0:
                     # the force scale of the step: out-of-balance plus the pull of the prescribed values
                     force_scale = kkt.last_load_norm
