@@ -37,6 +37,30 @@ def element_vertices(mesh):
     return nodes[:, :3].astype(np.int64) - 1
 
 
+def region_materials(mesh, material):
+    """{region name: Material} for every material region of the mesh.
+
+    Raises
+    ------
+    ValueError
+        If a value is not a Material, a region has none, or a name is not a region.
+    """
+    regions = set(mesh.GetMaterials())
+    if isinstance(material, Material):
+        return {name: material for name in sorted(regions)}
+    if not isinstance(material, dict):
+        raise ValueError(f"material must be a ngfracture Material or a dict of them, got {type(material).__name__}")
+    for name, m in material.items():
+        if name not in regions:
+            raise ValueError(f"material region {name!r} does not exist in the mesh; its regions are {sorted(regions)}")
+        if not isinstance(m, Material):
+            raise ValueError(f"material for region {name!r} must be a ngfracture Material, got {type(m).__name__}")
+    missing = sorted(regions - set(material))
+    if missing:
+        raise ValueError(f"material region(s) {missing} have no material")
+    return dict(material)
+
+
 class ElasticProblem:
     """Geometrically nonlinear 2D elasticity on a mesh, with Lagrange-multiplier constraints.
 
@@ -44,8 +68,9 @@ class ElasticProblem:
     ----------
     mesh : ngsolve.Mesh
         A 2D mesh of triangles.
-    material : Material
-        LinearElastic, StVenantKirchhoff or NeoHookean.
+    material : Material or dict of str -> Material
+        LinearElastic, StVenantKirchhoff or NeoHookean; a dict gives one per material
+        region of the mesh (every region needs one).
     order : int
         Polynomial order of the VectorH1 displacement space (>= 1).
 
@@ -66,11 +91,12 @@ class ElasticProblem:
 
     def __init__(self, mesh, material, order=1):
         check_mesh(mesh)
-        if not isinstance(material, Material):
-            raise ValueError(f"material must be a ngfracture Material, got {type(material).__name__}")
+        self.materials = region_materials(mesh, material)
         if isinstance(order, bool) or not isinstance(order, int) or order < 1:
             raise ValueError(f"order must be an integer >= 1, got {order!r}")
-        self.mesh, self.material, self.order = mesh, material, order
+        self.mesh, self.order = mesh, order
+        #: False only when every region is linear: then the stiffness is constant
+        self.nonlinear = any(m.geometrically_nonlinear for m in self.materials.values())
         self.fes = ng.VectorH1(mesh, order=order)
         self.u = ng.GridFunction(self.fes, name="displacement")
         self.constraints = ConstraintSet(self.fes)
@@ -113,7 +139,7 @@ class ElasticProblem:
         """The energy as an NGSolve BilinearForm (Variation): Apply = residual, linearisation = tangent."""
         if self._form is None:
             u = self.fes.TrialFunction()
-            energy = self.material.energy(ng.Grad(u)) * ng.dx
+            energy = self._per_region(lambda m: m.energy(ng.Grad(u))) * ng.dx
             for kind, cf, region in self._loads:
                 if kind == "volume":
                     energy += -self.load_factor * (cf * u) * ng.dx
@@ -131,10 +157,10 @@ class ElasticProblem:
         The linear model's stiffness does not depend on u: it is assembled once and kept.
         """
         form = self.form
-        if self.material.geometrically_nonlinear or self._linear_K is None:
+        if self.nonlinear or self._linear_K is None:
             with ng.TaskManager():
                 form.AssembleLinearization(self.u.vec)
-            if not self.material.geometrically_nonlinear:
+            if not self.nonlinear:
                 self._linear_K = form.mat
                 self._load = self.u.vec.CreateVector()
                 self._load[:] = 0.0
@@ -152,7 +178,7 @@ class ElasticProblem:
     def out_of_balance(self):
         """External minus internal nodal forces at the current displacement (numpy copy)."""
         form = self.form
-        if not self.material.geometrically_nonlinear:
+        if not self.nonlinear:
             K = self._linear_K if self._linear_K is not None else self.tangent()
             # linear model: f - K u by one matrix-vector product instead of an assembly
             self._res.data = K * self.u.vec
@@ -215,16 +241,24 @@ class ElasticProblem:
 
     # -- results ------------------------------------------------------------------------------
     def strain(self):
-        """The material's strain tensor of the current displacement (CoefficientFunction)."""
-        return self.material.strain(ng.Grad(self.u))
+        """The materials' strain tensor of the current displacement (CoefficientFunction)."""
+        return self._per_region(lambda m: m.strain(ng.Grad(self.u)))
 
     def stress(self):
         """Cauchy stress of the current displacement (CoefficientFunction)."""
-        return self.material.cauchy_stress(ng.Grad(self.u))
+        return self._per_region(lambda m: m.cauchy_stress(ng.Grad(self.u)))
 
     def energy(self):
         """Total elastic energy of the current displacement."""
-        return ng.Integrate(self.material.energy(ng.Grad(self.u)), self.mesh, order=2 * self.order)
+        return ng.Integrate(self._per_region(lambda m: m.energy(ng.Grad(self.u))), self.mesh,
+                            order=2 * self.order)
+
+    def _per_region(self, make):
+        """A CoefficientFunction built per material region (one expression if all share one)."""
+        unique = {id(m): m for m in self.materials.values()}
+        if len(unique) == 1:
+            return make(next(iter(unique.values())))
+        return self.mesh.MaterialCF({name: make(m) for name, m in self.materials.items()})
 
     def solve(self, method="modified", load_steps=1, tol=1e-10, maxit=50, linear_solver="direct",
               inverse="sparsecholesky"):

@@ -205,13 +205,13 @@ class NewtonSolver:
             res_norm = float(np.linalg.norm(r[free]))
             status.residual_history.append(res_norm)
             with _Timer(timings, "checks"):
-                inverted = prob.inverted_elements() if prob.material.geometrically_nonlinear else None
+                inverted = prob.inverted_elements() if prob.nonlinear else None
             if inverted:
                 status.fail("inverted_element", inverted)
                 return
             # eq. 7; for the linear model one step is exact, and a residual at rounding level
             # proves it without a second solve
-            exact = not prob.material.geometrically_nonlinear and res_norm <= self.tol * force_scale
+            exact = not prob.nonlinear and res_norm <= self.tol * force_scale
             if ratio < self.tol or norm == 0.0 or exact:
                 status.converged, status.reason, status.message = True, "converged", ""
                 return

@@ -39,3 +39,19 @@ def two_squares_mesh(maxh=0.3):
     geo.AddRectangle((0, 0), (1, 1), bcs=["a_bottom", "a_right", "a_top", "a_left"])
     geo.AddRectangle((2, 0), (3, 1), bcs=["b_bottom", "b_right", "b_top", "b_left"])
     return ng.Mesh(geo.GenerateMesh(maxh=maxh))
+
+
+def two_region_bar_mesh(maxh=0.25):
+    """[0,2]x[0,1] with regions 'soft' (x < 1) and 'stiff' (x > 1) bonded along x = 1."""
+    geo = SplineGeometry()
+    pts = [geo.AppendPoint(*p) for p in [(0, 0), (1, 0), (2, 0), (2, 1), (1, 1), (0, 1)]]
+    geo.Append(["line", pts[0], pts[1]], leftdomain=1, rightdomain=0, bc="bottom")
+    geo.Append(["line", pts[1], pts[2]], leftdomain=2, rightdomain=0, bc="bottom")
+    geo.Append(["line", pts[2], pts[3]], leftdomain=2, rightdomain=0, bc="right")
+    geo.Append(["line", pts[3], pts[4]], leftdomain=2, rightdomain=0, bc="top")
+    geo.Append(["line", pts[4], pts[5]], leftdomain=1, rightdomain=0, bc="top")
+    geo.Append(["line", pts[5], pts[0]], leftdomain=1, rightdomain=0, bc="left")
+    geo.Append(["line", pts[1], pts[4]], leftdomain=2, rightdomain=1, bc="interface")
+    geo.SetMaterial(1, "soft")
+    geo.SetMaterial(2, "stiff")
+    return ng.Mesh(geo.GenerateMesh(maxh=maxh))

@@ -299,3 +299,31 @@ def test_max_iterations_is_reported():
     status = prob.solve(method="modified", maxit=2)
     assert status.reason == "max_iterations" and not status.converged
     assert np.all(prob.u.vec.FV().NumPy() == 0.0)
+
+
+@pytest.mark.parametrize("contrast", [1.0, 1e3, 1e6])
+def test_bonded_regions_in_series_match_the_exact_solution(contrast):
+    """Two materials in series under a prescribed stretch (nu = 0: uniaxial, exact for P1)."""
+    from conftest import two_region_bar_mesh
+    mesh = two_region_bar_mesh()
+    E1, E2, d = 1.0, contrast, 1e-3
+    mats = {"soft": nf.LinearElastic(E1, 0.0), "stiff": nf.LinearElastic(E2, 0.0)}
+    prob = nf.ElasticProblem(mesh, mats)
+    prob.add_dirichlet("left", 0.0, component="x")
+    prob.add_dirichlet("right", d, component="x")
+    prob.add_point_constraint(0, 0.0, component="y")
+    status = prob.solve()
+    assert status.converged, status.message
+    sigma = d / (1.0 / E1 + 1.0 / E2)
+    uex = ng.CF((ng.IfPos(ng.x - 1, sigma / E1 + sigma / E2 * (ng.x - 1), sigma / E1 * ng.x), 0))
+    assert l2(prob.u - uex, mesh) < 1e-8 * l2(uex, mesh)
+
+
+def test_region_materials_are_validated():
+    from conftest import two_region_bar_mesh
+    mesh = two_region_bar_mesh()
+    with pytest.raises(ValueError, match=r"\['stiff'\] have no material"):
+        nf.ElasticProblem(mesh, {"soft": nf.LinearElastic(1.0, 0.0)})
+    with pytest.raises(ValueError, match="'steel' does not exist"):
+        nf.ElasticProblem(mesh, {"soft": nf.LinearElastic(1.0, 0.0), "stiff": nf.LinearElastic(1.0, 0.0),
+                                 "steel": nf.LinearElastic(1.0, 0.0)})
