@@ -16,8 +16,8 @@ def mesh_from_arrays(points, trigs, material="solid", bcname="outer"):
     assert np.all(a != 0), "degenerate triangle"
     T[a < 0] = T[a < 0][:, [0, 2, 1]]
     half = np.concatenate([T[:, [0, 1]], T[:, [1, 2]], T[:, [2, 0]]])
-    key = np.sort(half, axis=1)
-    _, inv, cnt = np.unique(key, axis=0, return_inverse=True, return_counts=True)
+    key = np.sort(half, axis=1).astype(np.int64)
+    _, inv, cnt = np.unique(key[:, 0] * len(P) + key[:, 1], return_inverse=True, return_counts=True)
     segs = half[cnt[inv.reshape(-1)] == 1]   # boundary half-edges: domain on the left
     ng = NGMesh(dim=2)
     ng.AddPoints(np.column_stack([P, np.zeros(len(P))]))
@@ -74,7 +74,9 @@ def triangles(mesh):
 def edge_table(T):
     """Unique undirected edges and their triangle counts."""
     e = np.sort(np.concatenate([T[:, [0, 1]], T[:, [1, 2]], T[:, [2, 0]]]), axis=1)
-    return np.unique(e, axis=0, return_counts=True)
+    n = int(T.max()) + 1
+    k, cnt = np.unique(e[:, 0] * n + e[:, 1], return_counts=True)   # int64 keys: fast
+    return np.column_stack([k // n, k % n]), cnt
 
 
 def fan_defect(T, nv):
@@ -119,12 +121,15 @@ def check_invariants(old, res):
     # triangle on its left
     segs = new.ngmesh.Elements1D().NumPy()["nodes"][:, :2].astype(np.int64) - 1
     e, c = edge_table(T1)
-    bnd = {tuple(x) for x in e[c == 1]}
-    sk = [tuple(sorted(s)) for s in segs]
-    assert len(sk) == len(set(sk))
-    assert bnd <= set(sk)
+    n = new.nv
+    sk = np.sort(segs, axis=1)
+    sk = sk[:, 0] * n + sk[:, 1]
+    assert len(np.unique(sk)) == len(sk)
+    assert np.all(np.isin(e[c == 1][:, 0] * n + e[c == 1][:, 1], sk))
     if len(res.crack_segments):
         assert "crack" in new.GetBoundaries()
         cs = res.crack_segments
-        half = {(T1[t, k], T1[t, (k + 1) % 3]) for t in range(len(T1)) for k in range(3)}
-        assert all((int(a), int(b)) in half for a, b in cs)
+        n = new.nv
+        half = np.concatenate([T1[:, [0, 1]], T1[:, [1, 2]], T1[:, [2, 0]]])
+        assert np.all(np.isin(cs[:, 0].astype(np.int64) * n + cs[:, 1],
+                              half[:, 0] * n + half[:, 1]))
