@@ -143,10 +143,12 @@ def vertex_strain(mesh, u, measure="green"):
     if measure not in ("green", "linear"):
         raise ValueError(f"ngfracture.crack: measure must be 'green' or 'linear', got {measure!r}")
     if isinstance(u, ngsolve.GridFunction) and _field_order(u) > 1:
-        if u.space.mesh is not mesh and u.space.mesh.nv != mesh.nv:
+        if u.space.mesh.nv != mesh.nv or u.space.mesh.ne != mesh.ne:
             raise ValueError("ngfracture.crack: the displacement lives on another mesh")
         H = ngsolve.Grad(u)
-        E = 0.5 * (H + H.trans) + (0.5 * H.trans * H if measure == "green" else 0)
+        E = 0.5 * (H + H.trans)
+        if measure == "green":
+            E = E + 0.5 * H.trans * H
         area = ngsolve.Integrate(ngsolve.CF(1), mesh, element_wise=True).NumPy()
         comps = [E[0, 0], E[1, 1], E[0, 1]]
         em = np.column_stack([ngsolve.Integrate(c, mesh, element_wise=True).NumPy() / area
