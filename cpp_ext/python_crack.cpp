@@ -37,6 +37,12 @@ namespace
 
 void ExportCrack (py::module & m)
 {
+  py::dict rules;
+  rules["1"] = int(RULE_1); rules["1a"] = int(RULE_1A); rules["1b"] = int(RULE_1B);
+  rules["2"] = int(RULE_2); rules["2a"] = int(RULE_2A); rules["2b"] = int(RULE_2B);
+  rules["tip"] = int(RULE_TIP); rules["none"] = int(RULE_NONE);
+  m.attr("CRACK_RULES") = rules;   // bit flags of the split record's "rule" entries
+
   m.def("CrackElementStrain",
         [] (shared_ptr<ngcomp::MeshAccess> mesh, darray u, std::string measure)
         {

@@ -8,6 +8,7 @@ kkt          the constrained linear solve (elimination + Schur complement)
 solver       modified and full Newton-Raphson with a status that says why it stopped
 lshape       the L-shape manufactured solution of the paper (section 4.1)
 verify       convergence studies against exact solutions
+crack        nodal strain criterion and node splitting with a netgen rebuild (C++ engine)
 """
 import ngsolve  # load NGSolve's shared libraries before the compiled add-on
 

@@ -150,6 +150,31 @@ def test_t_junction_and_crossing_cracks():
     assert np.allclose(areas, n * n / 4, rtol=1e-14)
 
 
+def test_rule_flags_match_the_engine():
+    from ngfracture import _ngfracture
+    assert _ngfracture.CRACK_RULES == {name: bit for bit, name in crack._RULE_NAMES}
+
+
+def test_copies_split_again():
+    # a vertex created by a split is a vertex like any other: split the copy of a
+    # crack-face vertex across the crack (rule 2 on the crack surface)
+    n = 6
+    m = grid_mesh(n, n)
+    col = [vid(n, 3, j) for j in range(n + 1)]
+    res = crack.split_vertices(m, col, X * len(col))
+    mid = vid(n, 3, 3)
+    copies = res.record["new_vertices"]
+    copy = int(copies[np.flatnonzero(res.parent[copies] == mid)[0]])
+    assert copy >= m.nv
+    res2 = split1(res.mesh, copy, Y)
+    assert res2.record["rule"][0] & crack.RULE_2
+    assert len(res2.record["edges"]) == 1
+    assert res2.nfragments == 2
+    e = tuple(res2.record["edges"][0])
+    P = coords(res2.mesh)
+    assert P[e[1], 1] == P[e[0], 1]                  # the new cut runs along x
+
+
 def test_boundary_names_and_materials_survive():
     m = grid_mesh(4, 4)
     res = split1(m, vid(4, 2, 2), X)
