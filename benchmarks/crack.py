@@ -92,10 +92,11 @@ def main(argv=None):
             best = t if best is None else {k: min(best[k], t[k]) for k in t}
         work = sum(best.values())
         case = {"ntri": mesh.ne, **{k: round(v, 6) for k, v in best.items()},
-                "t_solve": round(t_solve, 6), "ratio": round(work / t_solve, 5),
-                "nsplit_vertices": int(len(res.record["vertex"])), "nv_new": int(res.mesh.nv - mesh.nv)}
+                "t_solve": round(t_solve, 6), "ratio": round(work / t_solve, 5)}
         cases.append(case)
-        print(json.dumps(case), file=sys.stderr, flush=True)
+        # progress and the size of the pass on stderr; stdout is the JSON of the schema
+        print(json.dumps({**case, "processed_vertices": int(len(res.record["vertex"])),
+                          "new_vertices": int(res.mesh.nv - mesh.nv)}), file=sys.stderr, flush=True)
     nt = np.array([c["ntri"] for c in cases], dtype=float)
     work = np.array([c["t_strain"] + c["t_select"] + c["t_rebuild"] + c["t_transfer"] for c in cases])
     exponent = float(np.polyfit(np.log(nt), np.log(work), 1)[0]) if len(cases) > 1 else None

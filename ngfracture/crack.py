@@ -25,6 +25,32 @@ Conventions
   number. The directions are those of the strain before the pass; vertices created during
   the pass are not processed again in that pass.
 * Tensors are stored as rows (xx, yy, xy), xy the tensor (not engineering) shear.
+
+Rules as implemented (paper section 3; decisions where the paper is silent)
+-------------------------------------------------------------------------
+* Angle of an edge: the angle between the edge (as a line) and the line orthogonal to the
+  maximum strain direction, in the reference configuration. Ties: smaller far-end vertex
+  number. An isotropic tensor has direction (1, 0).
+* Interior vertex (rule 1): the first edge is the best one; the second is the best edge on
+  the other side of the line through the vertex along the maximum strain direction (a
+  crack runs through the vertex; two edges on one side would cut out a wedge). Rule 1a:
+  if these two edges bound one triangle, the second is replaced by the next best edge on
+  that side that does not; if the other side has none, the best edge not sharing a
+  triangle with the first; if there is none either, nothing is split (flag ``none``).
+* Crack tip: a vertex whose fan is open only along one crack (its two boundary edges end
+  in copies of one vertex, bitwise equal points) is treated as interior with the crack as
+  one already-cut edge; usually the crack is the first edge and one new edge is cut
+  (propagation), otherwise two new edges are cut (branching).
+* Boundary vertex (rule 2, also on crack faces): the best edge among all its edges; if it
+  is a boundary edge nothing is split (rule 2a), else it is cut.
+* Rules 1b/2b and "never two pieces joined by a single vertex": after the cut, the far end
+  of every cut edge is split if its fan fell apart (it was on the boundary, on a crack face
+  or a crack tip). Only the processed vertex and those far ends change their fans.
+* Which piece keeps the old vertex number: the fan holding the smallest triangle number.
+  New vertices are numbered from nv on, in creation order.
+* Fragments: connected components of triangles through shared vertices (the same as
+  through shared edges, since no two pieces touch at a single vertex), numbered by their
+  smallest triangle.
 """
 from dataclasses import dataclass, field
 import math

@@ -23,3 +23,8 @@ def test_crack_plate_example(tmp_path):
     assert L > 0.1
     # reference area is conserved: no material removed
     assert abs(ngsolve.Integrate(1, mesh) - (1 - np.pi * 0.01)) < 2e-3   # polygonal hole
+
+
+if __name__ == "__main__":
+    import pytest as _pytest
+    raise SystemExit(_pytest.main([__file__, "-q"]))

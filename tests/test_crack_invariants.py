@@ -121,3 +121,8 @@ def test_thousands_of_random_splits_10k_triangles():
     mesh1 = run_single_splits(mesh, 1500, rng)
     mesh2 = run_passes(mesh1, 10, 300, rng)
     assert mesh2.nv >= mesh.nv + 2000
+
+
+if __name__ == "__main__":
+    import pytest as _pytest
+    raise SystemExit(_pytest.main([__file__, "-q"]))

@@ -206,3 +206,8 @@ def test_crack_normals_point_out_of_the_material():
         flux = ngsolve.Integrate(ind * ngsolve.x * n[0], mesh, ngsolve.BND)
         assert area == pytest.approx(8.0, rel=1e-12)
         assert flux == pytest.approx(area, rel=1e-12)
+
+
+if __name__ == "__main__":
+    import pytest as _pytest
+    raise SystemExit(_pytest.main([__file__, "-q"]))

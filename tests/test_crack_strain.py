@@ -214,3 +214,8 @@ def test_bad_input_raises_before_work(square):
     u3 = ngsolve.GridFunction(ngsolve.VectorH1(square, order=3))
     with pytest.raises(NotImplementedError):
         crack.crack_step(square, u3, 1e-3)
+
+
+if __name__ == "__main__":
+    import pytest as _pytest
+    raise SystemExit(_pytest.main([__file__, "-q"]))
