@@ -54,6 +54,7 @@ Rules as implemented (paper section 3; decisions where the paper is silent)
 """
 from dataclasses import dataclass, field
 import math
+import time
 
 import numpy as np
 import ngsolve
@@ -311,8 +312,9 @@ def split_vertices(mesh, vertices, directions, crack_name="crack"):
     Returns
     -------
     SplitResult
-        ``record`` holds numpy arrays: ``vertex`` (processed vertices), ``rule`` (bit flags,
-        :func:`rule_names`), ``position`` (their coordinates), ``direction``,
+        ``mesh`` is the input mesh itself when no vertex was split.
+        ``record`` holds numpy arrays: ``vertex`` (processed vertices), ``rule`` (bit
+        flags, :func:`rule_names`), ``position`` (their coordinates), ``direction``,
         ``edges`` (k, 2) cut edges (processed vertex, far end) in the numbering at cut time,
         ``edge_offsets`` (edges of entry i are ``edges[edge_offsets[i]:edge_offsets[i+1]]``),
         ``new_vertices`` with ``new_offsets`` likewise, ``nv_old``.
@@ -322,7 +324,6 @@ def split_vertices(mesh, vertices, directions, crack_name="crack"):
     ValueError
         Bad shapes, vertex numbers out of range, zero or non-finite directions, non-2D mesh.
     """
-    import time
     _check_mesh(mesh)
     v = np.ascontiguousarray(vertices, dtype=np.int32).reshape(-1)
     d = np.ascontiguousarray(directions, dtype=float)
@@ -336,7 +337,8 @@ def split_vertices(mesh, vertices, directions, crack_name="crack"):
         raise ValueError("ngfracture.crack: directions must be finite and nonzero")
     r = _C.CrackSplit(mesh.ngmesh, v, d, crack_name)
     t0 = time.perf_counter()
-    newmesh = ngsolve.Mesh(r["ngmesh"])
+    # nothing split: keep the very same mesh, so callers keep their spaces and factorisations
+    newmesh = mesh if len(r["parent"]) == mesh.nv else ngsolve.Mesh(r["ngmesh"])
     t_mesh = time.perf_counter() - t0
     rec = dict(r["record"])
     coords = mesh.ngmesh.Coordinates()
@@ -385,7 +387,8 @@ def transfer(u, result):
     Returns
     -------
     ngsolve.GridFunction
-        On ``VectorH1(result.mesh, order=p)`` (no Dirichlet flags: the caller's
+        u itself if nothing was split, else a new GridFunction
+        on ``VectorH1(result.mesh, order=p)`` (no Dirichlet flags: the caller's
         constraints are rebuilt for the new mesh anyway).
 
     Raises
@@ -394,6 +397,8 @@ def transfer(u, result):
         For order >= 3.
     """
     p = _field_order(u)
+    if result.mesh is u.space.mesh:
+        return u                      # nothing was split: the field is already there
     if p > 2:
         raise NotImplementedError("ngfracture.crack.transfer: order >= 3 is not supported "
                                   "(edge dof orientation changes with the vertex numbers)")
