@@ -7,6 +7,9 @@ constraints  Dirichlet, gliding and point constraints (Lagrange multiplier rows)
 kkt          the constrained linear solve (elimination + Schur complement)
 solver       modified and full Newton-Raphson with a status that says why it stopped
 problem      ElasticProblem: mesh, material, constraints, solve
+rigid        rigid-body modes of the pieces and how the constraints hold them
+checkpoint   atomic, verified checkpoints
+crack        nodal strain criterion and node splitting with a netgen rebuild (C++ engine)
 """
 import ngsolve  # load NGSolve's shared libraries before the compiled add-on
 

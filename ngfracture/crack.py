@@ -1,0 +1,495 @@
+"""Crack formation by node splitting (paper section 3), on top of the C++ engine.
+
+One crack pass reads top to bottom::
+
+    tensors = criterion.vertex_tensor(mesh, u)          # nodal strain (or stress)
+    values, directions = principal(tensors)             # largest principal value + direction
+    order = select(values, criterion.critical)          # overstrained, deterministic order
+    result = split_vertices(mesh, order, directions[order])   # split + netgen rebuild
+    u_new = transfer(u, result)                         # exact copy through the vertex map
+
+``crack_step`` does all of it; ``split_by_tensor`` starts from a user-supplied vertex
+tensor field (hand-made cases, other criteria).
+
+Conventions
+-----------
+* Splitting happens in the reference configuration. A new vertex is a copy of its parent
+  (same coordinates, same field values); triangles keep their number, order, orientation
+  and region; only their vertex numbers change. New boundary edges get the boundary name
+  ``crack``; existing boundary names and materials survive.
+* Nodal strain: the strain of the P1 interpolant of the vertex displacements on every
+  triangle, averaged at each vertex with the triangle areas as weights
+  (sum |T| E_T / sum |T| over the triangles T around the vertex). For order >= 2 fields the
+  element value is the element mean of E(u) (computed by NGSolve), averaged the same way.
+* Order of processing in one pass: by decreasing principal value, ties by increasing vertex
+  number. The directions are those of the strain before the pass; vertices created during
+  the pass are not processed again in that pass.
+* Tensors are stored as rows (xx, yy, xy), xy the tensor (not engineering) shear.
+
+Rules as implemented (paper section 3; decisions where the paper is silent)
+-------------------------------------------------------------------------
+* Angle of an edge: the angle between the edge (as a line) and the line orthogonal to the
+  maximum strain direction, in the reference configuration. Ties: smaller far-end vertex
+  number. An isotropic tensor has direction (1, 0).
+* Interior vertex (rule 1): the first edge is the best one; the second is the best edge on
+  the other side of the line through the vertex along the maximum strain direction (a
+  crack runs through the vertex; two edges on one side would cut out a wedge). Rule 1a:
+  if these two edges bound one triangle, the second is replaced by the next best edge on
+  that side that does not; if the other side has none, the best edge not sharing a
+  triangle with the first; if there is none either, nothing is split (flag ``none``).
+* Crack tip: a vertex whose fan is open only along one crack (its two boundary edges end
+  in copies of one vertex, bitwise equal points) is treated as interior with the crack as
+  one already-cut edge; usually the crack is the first edge and one new edge is cut
+  (propagation), otherwise two new edges are cut (branching).
+* Boundary vertex (rule 2, also on crack faces): the best edge among all its edges; if it
+  is a boundary edge nothing is split (rule 2a), else it is cut.
+* Rules 1b/2b and "never two pieces joined by a single vertex": after the cut, the far end
+  of every cut edge is split if its fan fell apart (it was on the boundary, on a crack face
+  or a crack tip). Only the processed vertex and those far ends change their fans.
+* Which piece keeps the old vertex number: the fan holding the smallest triangle number.
+  New vertices are numbered from nv on, in creation order.
+* Fragments: connected components of triangles through shared vertices (the same as
+  through shared edges, since no two pieces touch at a single vertex), numbered by their
+  smallest triangle.
+"""
+from dataclasses import dataclass, field
+import math
+import time
+
+import numpy as np
+import ngsolve
+
+from . import _ngfracture as _C
+
+__all__ = [
+    "RULE_1", "RULE_1A", "RULE_1B", "RULE_2", "RULE_2A", "RULE_2B", "RULE_TIP", "RULE_NONE",
+    "StrainCriterion", "SplitResult", "vertex_displacement", "vertex_strain", "principal",
+    "select", "split_vertices", "transfer", "transfer_vertex_field", "split_by_tensor",
+    "crack_step", "rule_names",
+]
+
+# Bit flags of the record's "rule" entry (cpp_ext/crack_split.hpp).
+RULE_1 = 1       # interior vertex: two edges cut
+RULE_1A = 2      # the two best edges bounded one triangle: the second one was replaced
+RULE_1B = 4      # a far end on the boundary or a crack surface was split as well
+RULE_2 = 8       # boundary vertex: one interior edge cut
+RULE_2A = 16     # boundary vertex whose best edge is a boundary edge: nothing split
+RULE_2B = 32     # the far end of the rule-2 edge was split as well
+RULE_TIP = 64    # crack tip (fan open only along a crack): treated by rule 1
+RULE_NONE = 128  # nothing split (no admissible edge pair, isolated or pinched vertex)
+
+_RULE_NAMES = [(RULE_1, "1"), (RULE_1A, "1a"), (RULE_1B, "1b"), (RULE_2, "2"),
+               (RULE_2A, "2a"), (RULE_2B, "2b"), (RULE_TIP, "tip"), (RULE_NONE, "none")]
+
+
+def rule_names(flags):
+    """Names of the rules set in one record flag, e.g. ``['1', '1b']``."""
+    return [name for bit, name in _RULE_NAMES if int(flags) & bit]
+
+
+def _check_critical(critical, what="critical strain"):
+    try:
+        c = float(critical)
+    except (TypeError, ValueError):
+        raise ValueError(f"ngfracture.crack: {what} must be a number, got {critical!r}")
+    if not math.isfinite(c) or c <= 0:
+        raise ValueError(f"ngfracture.crack: {what} must be finite and > 0, got {critical!r}")
+    return c
+
+
+def _check_mesh(mesh):
+    if not isinstance(mesh, ngsolve.Mesh):
+        raise TypeError(f"ngfracture.crack: expected an ngsolve.Mesh, got {type(mesh).__name__}")
+    if mesh.dim != 2:
+        raise ValueError(f"ngfracture.crack: the mesh must be 2D, it has dimension {mesh.dim}")
+
+
+def _field_order(gf):
+    fes = gf.space
+    if not isinstance(fes, ngsolve.VectorH1) or fes.mesh.dim != 2:
+        raise TypeError("ngfracture.crack: the displacement must be a GridFunction on a 2D "
+                        f"ngsolve.VectorH1 space, got {type(fes).__name__}")
+    return fes.globalorder
+
+
+def vertex_displacement(u):
+    """Vertex values of a displacement field.
+
+    Parameters
+    ----------
+    u : ngsolve.GridFunction or numpy.ndarray
+        A GridFunction on ``VectorH1`` (vertex dofs are nodal values for every order), or an
+        array of shape (nv, 2) that is returned as a float copy.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (nv, 2).
+
+    Raises
+    ------
+    TypeError
+        If u is neither.
+    """
+    if isinstance(u, ngsolve.GridFunction):
+        _field_order(u)
+        nv = u.space.mesh.nv
+        v = u.vec.FV().NumPy()
+        return v.reshape(2, -1)[:, :nv].T.copy()   # component-blocked dofs, vertices first
+    a = np.array(u, dtype=float)
+    if a.ndim != 2 or a.shape[1] != 2:
+        raise TypeError(f"ngfracture.crack: vertex displacement must have shape (nv, 2), got {a.shape}")
+    return a
+
+
+def vertex_strain(mesh, u, measure="green"):
+    """Nodal strain tensor: area-weighted average of the element strains around each vertex.
+
+    Parameters
+    ----------
+    mesh : ngsolve.Mesh
+        2D triangle mesh (reference configuration).
+    u : ngsolve.GridFunction or numpy.ndarray
+        Displacement: a ``VectorH1`` GridFunction of any order, or vertex values (nv, 2).
+        For order 1 and for arrays the element strain is that of the P1 interpolant of
+        the vertex values (C++); for order >= 2 it is the element mean of E(u).
+    measure : {'green', 'linear'}
+        Green-Lagrange (H + H^T + H^T H)/2 or small strain (H + H^T)/2, H = grad u.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (nv, 3), rows (xx, yy, xy).
+
+    Raises
+    ------
+    ValueError
+        Non-2D mesh, unknown measure or a field that does not fit the mesh.
+    """
+    _check_mesh(mesh)
+    if measure not in ("green", "linear"):
+        raise ValueError(f"ngfracture.crack: measure must be 'green' or 'linear', got {measure!r}")
+    if isinstance(u, ngsolve.GridFunction) and _field_order(u) > 1:
+        if u.space.mesh.nv != mesh.nv or u.space.mesh.ne != mesh.ne:
+            raise ValueError("ngfracture.crack: the displacement lives on another mesh")
+        H = ngsolve.Grad(u)
+        E = 0.5 * (H + H.trans)
+        if measure == "green":
+            E = E + 0.5 * H.trans * H
+        area = ngsolve.Integrate(ngsolve.CF(1), mesh, element_wise=True).NumPy()
+        comps = [E[0, 0], E[1, 1], E[0, 1]]
+        em = np.column_stack([ngsolve.Integrate(c, mesh, element_wise=True).NumPy() / area
+                              for c in comps])
+        return _C.VertexAverage(mesh, em)
+    U = vertex_displacement(u)
+    if U.shape[0] != mesh.nv:
+        raise ValueError(f"ngfracture.crack: displacement has {U.shape[0]} vertex values, "
+                         f"the mesh has {mesh.nv} vertices")
+    if not np.all(np.isfinite(U)):
+        raise ValueError("ngfracture.crack: displacement has NaN or inf values")
+    return _C.CrackVertexStrain(mesh, U, measure)
+
+
+def principal(tensors):
+    """Largest principal value and its unit direction of symmetric 2x2 tensors.
+
+    Parameters
+    ----------
+    tensors : numpy.ndarray
+        Shape (n, 3), rows (xx, yy, xy).
+
+    Returns
+    -------
+    values : numpy.ndarray
+        Shape (n,).
+    directions : numpy.ndarray
+        Shape (n, 2), angle in (-pi/2, pi/2]; an isotropic tensor gets (1, 0).
+    """
+    t = np.asarray(tensors, dtype=float)
+    if t.ndim != 2 or t.shape[1] != 3:
+        raise ValueError(f"ngfracture.crack: tensors must have shape (n, 3), got {t.shape}")
+    if not np.all(np.isfinite(t)):
+        raise ValueError("ngfracture.crack: tensor field has NaN or inf values")
+    return _C.CrackPrincipal(t)
+
+
+def select(values, critical):
+    """Overstrained vertices in processing order.
+
+    Parameters
+    ----------
+    values : numpy.ndarray
+        Principal value per vertex.
+    critical : float
+        Threshold (> 0): a vertex is overstrained when its value is strictly larger.
+
+    Returns
+    -------
+    numpy.ndarray
+        Vertex numbers by decreasing value, ties by increasing vertex number.
+    """
+    c = _check_critical(critical)
+    return _C.CrackSelect(np.asarray(values, dtype=float), c)
+
+
+class StrainCriterion:
+    """Principal nodal strain above a critical strain (the paper's criterion).
+
+    A criterion is any object with ``critical`` and ``vertex_tensor(mesh, u)`` returning a
+    symmetric tensor per vertex (rows xx, yy, xy); a stress criterion fits the same slot by
+    returning the nodal stress and a critical stress.
+
+    Parameters
+    ----------
+    critical : float
+        Critical principal strain, finite and > 0.
+    measure : {'green', 'linear'}
+        Green-Lagrange for the nonlinear models, small strain for the linear one.
+    """
+
+    def __init__(self, critical, measure="green"):
+        self.critical = _check_critical(critical)
+        if measure not in ("green", "linear"):
+            raise ValueError(f"ngfracture.crack: measure must be 'green' or 'linear', got {measure!r}")
+        self.measure = measure
+
+    def vertex_tensor(self, mesh, u):
+        """Nodal strain (nv, 3) of displacement u on mesh, see :func:`vertex_strain`."""
+        return vertex_strain(mesh, u, self.measure)
+
+    def __repr__(self):
+        return f"StrainCriterion(critical={self.critical!r}, measure={self.measure!r})"
+
+
+@dataclass
+class SplitResult:
+    """Outcome of one splitting pass.
+
+    Attributes
+    ----------
+    mesh : ngsolve.Mesh
+        The new mesh (same triangles in the same order, more vertices).
+    parent : numpy.ndarray
+        For every new vertex, the vertex of the old mesh it copies (identity for old ones).
+    record : dict
+        Plain arrays describing the pass, see :func:`split_vertices`.
+    fragment : numpy.ndarray
+        Fragment (connected component) number of every triangle, numbered by first triangle.
+    nfragments : int
+    crack_segments : numpy.ndarray
+        (m, 2) vertex pairs of the boundary segments added in region ``crack``.
+    timings : dict
+        Seconds spent in the C++ split, the netgen rebuild and ``ngsolve.Mesh``.
+    """
+    mesh: object
+    parent: np.ndarray
+    record: dict
+    fragment: np.ndarray
+    nfragments: int
+    crack_segments: np.ndarray
+    timings: dict = field(default_factory=dict)
+
+    @property
+    def nsplit(self):
+        """Number of vertices created."""
+        return len(self.parent) - int(self.record["nv_old"])
+
+
+def split_vertices(mesh, vertices, directions, crack_name="crack"):
+    """Split vertices along the edges most orthogonal to given directions (rules 1-2b).
+
+    Parameters
+    ----------
+    mesh : ngsolve.Mesh
+        2D mesh of linear triangles, reference configuration.
+    vertices : array_like of int
+        Vertices to process, in this order (see :func:`select`).
+    directions : array_like
+        Shape (len(vertices), 2): maximum strain direction of each vertex (any length > 0).
+    crack_name : str
+        Boundary name of the new crack faces.
+
+    Returns
+    -------
+    SplitResult
+        ``mesh`` is the input mesh itself when no vertex was split.
+        ``record`` holds numpy arrays: ``vertex`` (processed vertices), ``rule`` (bit
+        flags, :func:`rule_names`), ``position`` (their coordinates), ``direction``,
+        ``edges`` (k, 2) cut edges (processed vertex, far end) in the numbering at cut time,
+        ``edge_offsets`` (edges of entry i are ``edges[edge_offsets[i]:edge_offsets[i+1]]``),
+        ``new_vertices`` with ``new_offsets`` likewise, ``nv_old``.
+
+    Raises
+    ------
+    ValueError
+        Bad shapes, vertex numbers out of range, zero or non-finite directions, non-2D mesh.
+    """
+    _check_mesh(mesh)
+    v = np.ascontiguousarray(vertices, dtype=np.int32).reshape(-1)
+    d = np.ascontiguousarray(directions, dtype=float)
+    if d.ndim != 2 or d.shape != (len(v), 2):
+        raise ValueError(f"ngfracture.crack: directions must have shape ({len(v)}, 2), got {d.shape}")
+    if len(v) and (v.min() < 0 or v.max() >= mesh.nv):
+        raise ValueError(f"ngfracture.crack: vertex numbers must be in [0, {mesh.nv})")
+    if len(np.unique(v)) != len(v):
+        raise ValueError("ngfracture.crack: a vertex appears twice in the processing order")
+    if not np.all(np.isfinite(d)) or np.any(np.all(d == 0, axis=1)):
+        raise ValueError("ngfracture.crack: directions must be finite and nonzero")
+    r = _C.CrackSplit(mesh.ngmesh, v, d, crack_name)
+    t0 = time.perf_counter()
+    # nothing split: keep the very same mesh, so callers keep their spaces and factorisations
+    newmesh = mesh if len(r["parent"]) == mesh.nv else ngsolve.Mesh(r["ngmesh"])
+    t_mesh = time.perf_counter() - t0
+    rec = dict(r["record"])
+    coords = mesh.ngmesh.Coordinates()
+    rec["position"] = coords[rec["vertex"], :2].copy() if len(rec["vertex"]) else np.zeros((0, 2))
+    rec["direction"] = d.copy()
+    rec["nv_old"] = mesh.nv
+    return SplitResult(mesh=newmesh, parent=r["parent"], record=rec, fragment=r["fragment"],
+                       nfragments=r["nfragments"], crack_segments=r["crack_segments"],
+                       timings={"split": r["t_split"], "netgen": r["t_netgen"], "ngsolve_mesh": t_mesh})
+
+
+def transfer_vertex_field(values, result):
+    """Carry a vertex field to the split mesh: ``values[parent]`` (exact, no interpolation).
+
+    Parameters
+    ----------
+    values : numpy.ndarray
+        Shape (nv_old, ...).
+    result : SplitResult
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (nv_new, ...).
+    """
+    a = np.asarray(values)
+    if a.shape[0] != result.record["nv_old"]:
+        raise ValueError(f"ngfracture.crack: field has {a.shape[0]} rows, the old mesh has "
+                         f"{result.record['nv_old']} vertices")
+    return a[result.parent]
+
+
+def transfer(u, result):
+    """Carry a displacement GridFunction to the split mesh, exactly.
+
+    Order 1: vertex values copied through the vertex map. Order 2: every element's dofs are
+    copied (triangles keep number and vertex order, quadratic edge dofs have no
+    orientation). Order >= 3 is refused: edge dofs change sign when a split renumbers an edge.
+
+    Parameters
+    ----------
+    u : ngsolve.GridFunction
+        On ``VectorH1(old_mesh, order=p)``, p <= 2.
+    result : SplitResult
+
+    Returns
+    -------
+    ngsolve.GridFunction
+        u itself if nothing was split, else a new GridFunction
+        on ``VectorH1(result.mesh, order=p)`` (no Dirichlet flags: the caller's
+        constraints are rebuilt for the new mesh anyway).
+
+    Raises
+    ------
+    NotImplementedError
+        For order >= 3.
+    """
+    p = _field_order(u)
+    if result.mesh is u.space.mesh:
+        return u                      # nothing was split: the field is already there
+    if p > 2:
+        raise NotImplementedError("ngfracture.crack.transfer: order >= 3 is not supported "
+                                  "(edge dof orientation changes with the vertex numbers)")
+    if u.space.mesh.nv != result.record["nv_old"]:
+        raise ValueError("ngfracture.crack.transfer: the field is not on the split mesh")
+    fes = ngsolve.VectorH1(result.mesh, order=p)
+    gf = ngsolve.GridFunction(fes)
+    if p == 1:
+        old = u.vec.FV().NumPy().reshape(2, -1)
+        gf.vec.FV().NumPy()[:] = old[:, result.parent].reshape(-1)
+    else:
+        gf.vec.FV().NumPy()[:] = _C.CrackTransferElementDofs(u.space, fes, u.vec.FV().NumPy())
+    return gf
+
+
+def split_by_tensor(mesh, tensors, critical, crack_name="crack"):
+    """One splitting pass from a vertex tensor field supplied by the caller.
+
+    Parameters
+    ----------
+    mesh : ngsolve.Mesh
+    tensors : numpy.ndarray
+        Shape (nv, 3), rows (xx, yy, xy), e.g. a nodal strain or stress.
+    critical : float
+        Finite, > 0; vertices whose largest principal value exceeds it are split.
+    crack_name : str
+
+    Returns
+    -------
+    SplitResult
+        The record also holds ``principal`` (values of the processed vertices).
+
+    Raises
+    ------
+    ValueError
+        Wrong tensor shape, NaN values, critical <= 0 or NaN, non-2D mesh.
+    """
+    _check_mesh(mesh)
+    c = _check_critical(critical)
+    t = np.asarray(tensors, dtype=float)
+    if t.shape != (mesh.nv, 3):
+        raise ValueError(f"ngfracture.crack: tensor field must have shape ({mesh.nv}, 3), got {t.shape}")
+    values, dirs = principal(t)
+    order = _C.CrackSelect(values, c)
+    res = split_vertices(mesh, order, dirs[order], crack_name)
+    res.record["principal"] = values[order]
+    return res
+
+
+def crack_step(mesh, u, critical=None, measure="green", criterion=None, crack_name="crack"):
+    """One crack pass: nodal strain, overstrained vertices, splitting, field transfer.
+
+    Parameters
+    ----------
+    mesh : ngsolve.Mesh
+        The reference mesh u lives on.
+    u : ngsolve.GridFunction
+        Displacement on ``VectorH1(mesh, order<=2)``.
+    critical : float, optional
+        Critical principal strain (> 0); ignored when ``criterion`` is given.
+    measure : {'green', 'linear'}
+        Strain measure for the default :class:`StrainCriterion`.
+    criterion : object, optional
+        Anything with ``critical`` and ``vertex_tensor(mesh, u)``.
+    crack_name : str
+
+    Returns
+    -------
+    new_mesh : ngsolve.Mesh
+    new_u : ngsolve.GridFunction
+        u carried exactly through the vertex map.
+    result : SplitResult
+        Record of the pass (``result.record``), fragments, timings.
+
+    Raises
+    ------
+    ValueError, TypeError
+        Bad mesh, field or threshold, before any work.
+    """
+    _check_mesh(mesh)
+    if criterion is None:
+        if critical is None:
+            raise ValueError("ngfracture.crack: give a critical strain or a criterion")
+        criterion = StrainCriterion(critical, measure)
+    if isinstance(u, ngsolve.GridFunction):
+        if _field_order(u) > 2:
+            raise NotImplementedError("ngfracture.crack: displacement order >= 3 is not supported")
+        if u.space.mesh.nv != mesh.nv or u.space.mesh.ne != mesh.ne:
+            raise ValueError("ngfracture.crack: the displacement does not live on this mesh")
+    else:
+        raise TypeError("ngfracture.crack.crack_step: u must be an ngsolve.GridFunction; "
+                        "use split_by_tensor for plain arrays")
+    res = split_by_tensor(mesh, criterion.vertex_tensor(mesh, u), criterion.critical, crack_name)
+    return res.mesh, transfer(u, res), res

@@ -1,0 +1,213 @@
+"""Splitting rules of the paper (section 3) on hand-made meshes, one per rule, and
+cracks that split again: tips, branching, T-junctions, crossings, reaching the boundary."""
+import numpy as np
+import pytest
+import ngsolve
+
+from ngfracture import crack, ElementAreas
+from crack_util import grid_mesh, vid, fan_mesh, check_invariants, coords
+
+X = [[1.0, 0.0]]   # maximum strain along x: cracks want to run along y
+Y = [[0.0, 1.0]]
+
+
+def split1(mesh, v, d):
+    res = crack.split_vertices(mesh, [v], d)
+    check_invariants(mesh, res)
+    return res
+
+
+def edge_set(res, i=0):
+    r = res.record
+    e = r["edges"][r["edge_offsets"][i]:r["edge_offsets"][i + 1]]
+    return {tuple(int(x) for x in row) for row in e}
+
+
+def crack_length(mesh):
+    return ngsolve.Integrate(1, mesh, ngsolve.BND, definedon=mesh.Boundaries("crack"))
+
+
+def test_rule_1_interior_vertex_two_edges():
+    m = grid_mesh(4, 4)
+    c = vid(4, 2, 2)
+    res = split1(m, c, X)
+    assert res.record["rule"][0] == crack.RULE_1
+    assert edge_set(res) == {(c, vid(4, 2, 1)), (c, vid(4, 2, 3))}
+    assert res.mesh.nv == m.nv + 1
+    assert res.nfragments == 1
+    # two crack faces per split edge, each of length 1
+    assert crack_length(res.mesh) == pytest.approx(4.0, rel=1e-14)
+
+
+def test_rule_1_regular_fan():
+    m = fan_mesh([30, 90, 150, 210, 270, 330])
+    res = split1(m, 0, X)
+    assert res.record["rule"][0] == crack.RULE_1
+    assert edge_set(res) == {(0, 2), (0, 5)}          # the ring vertices at 90 and 270 degrees
+
+
+def test_rule_1a_edges_of_one_triangle_replaced():
+    # best edge at 95 deg; the best one on the other side (255 deg) bounds the same
+    # obtuse triangle, so rule 1a takes the next one (290 deg)
+    m = fan_mesh([95, 255, 290, 340, 30, 60])
+    res = split1(m, 0, X)
+    assert res.record["rule"][0] == crack.RULE_1 | crack.RULE_1A
+    assert edge_set(res) == {(0, 1), (0, 3)}
+    assert res.mesh.nv == m.nv + 1
+
+
+def test_rule_1b_far_ends_on_boundary_split_too():
+    m = fan_mesh([30, 90, 150, 210, 270, 330], outer=False)
+    res = split1(m, 0, X)
+    assert res.record["rule"][0] == crack.RULE_1 | crack.RULE_1B
+    assert edge_set(res) == {(0, 2), (0, 5)}
+    assert res.mesh.nv == m.nv + 3                    # the centre and both far ends
+    assert res.nfragments == 2                        # cut through: no single-vertex joint
+    assert crack_length(res.mesh) == pytest.approx(4.0, rel=1e-14)
+
+
+def test_rule_2_boundary_vertex_interior_edge():
+    m = grid_mesh(4, 4)
+    v = vid(4, 2, 0)
+    res = split1(m, v, X)
+    assert res.record["rule"][0] == crack.RULE_2
+    assert edge_set(res) == {(v, vid(4, 2, 1))}
+    assert res.mesh.nv == m.nv + 1
+    assert crack_length(res.mesh) == pytest.approx(2.0, rel=1e-14)
+
+
+def test_rule_2a_best_edge_on_boundary_no_split():
+    m = grid_mesh(4, 4)
+    v = vid(4, 2, 0)
+    res = split1(m, v, Y)                             # crack would run along the boundary
+    assert res.record["rule"][0] == crack.RULE_2 | crack.RULE_2A
+    assert len(res.record["edges"]) == 0
+    assert res.mesh.nv == m.nv
+    assert "crack" not in res.mesh.GetBoundaries()
+
+
+def test_rule_2b_far_end_on_boundary():
+    m = grid_mesh(4, 1)
+    v = vid(4, 2, 0)
+    res = split1(m, v, X)
+    assert res.record["rule"][0] == crack.RULE_2 | crack.RULE_2B
+    assert edge_set(res) == {(v, vid(4, 2, 1))}
+    assert res.mesh.nv == m.nv + 2
+    assert res.nfragments == 2
+    assert crack_length(res.mesh) == pytest.approx(2.0, rel=1e-14)
+
+
+def test_tip_propagates_to_boundary():
+    m = grid_mesh(4, 4)
+    res = split1(m, vid(4, 2, 2), X)
+    tip = vid(4, 2, 3)
+    res2 = split1(res.mesh, tip, X)
+    # the tip's fan is open only along the crack: rule 1 with the crack as one edge;
+    # the far end is on the boundary, so the crack reaches it
+    assert res2.record["rule"][0] == crack.RULE_1 | crack.RULE_TIP | crack.RULE_1B
+    assert edge_set(res2) == {(tip, vid(4, 2, 4))}
+    assert res2.nfragments == 1
+    res3 = split1(res2.mesh, vid(4, 2, 1), X)
+    assert res3.record["rule"][0] == crack.RULE_1 | crack.RULE_TIP | crack.RULE_1B
+    assert res3.nfragments == 2
+    assert crack_length(res3.mesh) == pytest.approx(8.0, rel=1e-14)
+
+
+def test_branching_at_tip():
+    # a tip loaded at 45 degrees: both chosen edges are new, the fan falls in three
+    m = grid_mesh(6, 6)
+    res = split1(m, vid(6, 3, 3), X)
+    tip = vid(6, 3, 4)
+    d = np.array([[1.0, -1.0]]) / np.sqrt(2)         # crack direction along the diagonal
+    res2 = split1(res.mesh, tip, d)
+    assert res2.record["rule"][0] & crack.RULE_TIP
+    assert edge_set(res2) == {(tip, vid(6, 4, 5)), (tip, vid(6, 2, 3))}
+    assert res2.mesh.nv == res.mesh.nv + 2
+    assert res2.nfragments == 1
+
+
+def test_t_junction_and_crossing_cracks():
+    n = 6
+    m = grid_mesh(n, n)
+    col = [vid(n, 3, j) for j in range(n + 1)]
+    res = crack.split_vertices(m, col, X * len(col))
+    check_invariants(m, res)
+    assert res.nfragments == 2
+    assert crack_length(res.mesh) == pytest.approx(2 * n, rel=1e-14)
+    # a horizontal crack from the left boundary meets the vertical one: T-junction
+    left = [vid(n, i, 3) for i in range(0, 4)]
+    res2 = crack.split_vertices(res.mesh, left, Y * len(left))
+    check_invariants(res.mesh, res2)
+    assert res2.nfragments == 3
+    # continue on the right: the cracks cross
+    right = [vid(n, i, 3) for i in range(3, n + 1)]
+    res3 = crack.split_vertices(res2.mesh, right, Y * len(right))
+    check_invariants(res2.mesh, res3)
+    assert res3.nfragments == 4
+    assert crack_length(res3.mesh) == pytest.approx(4 * n, rel=1e-14)
+    # each quarter has the area n^2 / 4
+    areas = np.bincount(res3.fragment, weights=np.abs(ElementAreas(res3.mesh)))
+    assert np.allclose(areas, n * n / 4, rtol=1e-14)
+
+
+def test_rule_flags_match_the_engine():
+    from ngfracture import _ngfracture
+    assert _ngfracture.CRACK_RULES == {name: bit for bit, name in crack._RULE_NAMES}
+
+
+def test_copies_split_again():
+    # a vertex created by a split is a vertex like any other: split the copy of a
+    # crack-face vertex across the crack (rule 2 on the crack surface)
+    n = 6
+    m = grid_mesh(n, n)
+    col = [vid(n, 3, j) for j in range(n + 1)]
+    res = crack.split_vertices(m, col, X * len(col))
+    mid = vid(n, 3, 3)
+    copies = res.record["new_vertices"]
+    copy = int(copies[np.flatnonzero(res.parent[copies] == mid)[0]])
+    assert copy >= m.nv
+    res2 = split1(res.mesh, copy, Y)
+    assert res2.record["rule"][0] & crack.RULE_2
+    assert len(res2.record["edges"]) == 1
+    assert res2.nfragments == 2
+    e = tuple(res2.record["edges"][0])
+    P = coords(res2.mesh)
+    assert P[e[1], 1] == P[e[0], 1]                  # the new cut runs along x
+
+
+def test_boundary_names_and_materials_survive():
+    m = grid_mesh(4, 4)
+    res = split1(m, vid(4, 2, 2), X)
+    assert res.mesh.GetBoundaries() == ("outer", "crack")
+    assert res.mesh.GetMaterials() == ("solid",)
+    assert ngsolve.Integrate(1, res.mesh, ngsolve.BND, definedon=res.mesh.Boundaries("outer")) \
+        == pytest.approx(16.0, rel=1e-14)
+    # a second pass reuses the crack region instead of adding another
+    res2 = split1(res.mesh, vid(4, 1, 2), Y)
+    assert res2.mesh.GetBoundaries() == ("outer", "crack")
+
+
+def test_crack_normals_point_out_of_the_material():
+    # divergence theorem on each side of the crack: int_Omega div F = int_bnd F.n with
+    # F = (x, 0) gives the area if the crack normals are outward
+    m = grid_mesh(4, 4)
+    res = crack.split_vertices(m, [vid(4, 2, j) for j in range(5)], X * 5)
+    mesh = res.mesh
+    n = ngsolve.specialcf.normal(2)
+    # fragment number as a P1 field: every vertex lies in exactly one fragment
+    T = mesh.ngmesh.Elements2D().NumPy()["nodes"][:, :3] - 1
+    vf = np.zeros(mesh.nv)
+    vf[T.ravel()] = np.repeat(res.fragment, 3)
+    frag = ngsolve.GridFunction(ngsolve.H1(mesh, order=1))
+    frag.vec.FV().NumPy()[:] = vf
+    for f in range(res.nfragments):
+        ind = ngsolve.IfPos(frag - f + 0.5, 1, 0) * ngsolve.IfPos(f + 0.5 - frag, 1, 0)
+        area = ngsolve.Integrate(ind, mesh)
+        flux = ngsolve.Integrate(ind * ngsolve.x * n[0], mesh, ngsolve.BND)
+        assert area == pytest.approx(8.0, rel=1e-12)
+        assert flux == pytest.approx(area, rel=1e-12)
+
+
+if __name__ == "__main__":
+    import pytest as _pytest
+    raise SystemExit(_pytest.main([__file__, "-q"]))
