@@ -51,7 +51,7 @@ def two_region_bar_mesh(maxh=0.25):
     geo.Append(["line", pts[3], pts[4]], leftdomain=2, rightdomain=0, bc="top")
     geo.Append(["line", pts[4], pts[5]], leftdomain=1, rightdomain=0, bc="top")
     geo.Append(["line", pts[5], pts[0]], leftdomain=1, rightdomain=0, bc="left")
-    geo.Append(["line", pts[1], pts[4]], leftdomain=2, rightdomain=1, bc="interface")
+    geo.Append(["line", pts[1], pts[4]], leftdomain=1, rightdomain=2, bc="interface")
     geo.SetMaterial(1, "soft")
     geo.SetMaterial(2, "stiff")
     return ng.Mesh(geo.GenerateMesh(maxh=maxh))
