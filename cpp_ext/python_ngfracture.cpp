@@ -5,6 +5,8 @@
 namespace py = pybind11;
 using namespace ngfracture;
 
+void ExportCollision (py::module & m);  // python_collision.cpp
+
 static void ExportVertexAverage (py::module & m)
 {
   m.def("ElementAreas",
@@ -70,4 +72,5 @@ PYBIND11_MODULE(_ngfracture, m)
 {
   m.doc() = "ngfracture's C++ kernels (vertex averaging, crack splitting).";
   ExportVertexAverage(m);
+  ExportCollision(m);
 }

@@ -1,0 +1,276 @@
+// Collision detection (paper section 3.1) and contact selection (section 3.2, rules 1-4).
+#include "collision.hpp"
+#include "predicates.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <unordered_map>
+
+namespace ngfracture
+{
+  namespace
+  {
+    // Strictly inside a counter-clockwise triangle.
+    inline bool StrictlyInside (const double * t[3], const double * v)
+    {
+      return Orient2dSign(t[0], t[1], v) > 0 && Orient2dSign(t[1], t[2], v) > 0
+        && Orient2dSign(t[2], t[0], v) > 0;
+    }
+
+    // Segments (p0,p1) and (q0,q1) cross at a single point interior to both.
+    inline bool ProperCrossing (const double * p0, const double * p1,
+                                const double * q0, const double * q1)
+    {
+      int s1 = Orient2dSign(p0, p1, q0), s2 = Orient2dSign(p0, p1, q1);
+      if (s1 * s2 >= 0) return false;
+      int s3 = Orient2dSign(q0, q1, p0), s4 = Orient2dSign(q0, q1, p1);
+      return s3 * s4 < 0;
+    }
+
+    // The edge line (e0,e1) of a CCW triangle weakly separates it from triangle o:
+    // no vertex of o lies strictly on the inner side.
+    inline bool Separates (const double * e0, const double * e1, const double * o[3])
+    {
+      return Orient2dSign(e0, e1, o[0]) <= 0 && Orient2dSign(e0, e1, o[1]) <= 0
+        && Orient2dSign(e0, e1, o[2]) <= 0;
+    }
+
+    inline double PointSegmentDistance (const double * p, const double * a, const double * b)
+    {
+      double dx = b[0]-a[0], dy = b[1]-a[1];
+      double px = p[0]-a[0], py = p[1]-a[1];
+      double l2 = dx*dx + dy*dy;
+      double t = l2 > 0 ? std::clamp((px*dx + py*dy) / l2, 0.0, 1.0) : 0.0;
+      double rx = px - t*dx, ry = py - t*dy;
+      return std::sqrt(rx*rx + ry*ry);
+    }
+  }
+
+  bool InteriorsOverlap (const double * p_in[3], const double * q_in[3])
+  {
+    int op = Orient2dSign(p_in[0], p_in[1], p_in[2]);
+    int oq = Orient2dSign(q_in[0], q_in[1], q_in[2]);
+    if (op == 0 || oq == 0) return false;          // no interior
+    // Work on counter-clockwise copies: elements may be inverted in the current state.
+    const double * p[3] = { p_in[0], op > 0 ? p_in[1] : p_in[2], op > 0 ? p_in[2] : p_in[1] };
+    const double * q[3] = { q_in[0], oq > 0 ? q_in[1] : q_in[2], oq > 0 ? q_in[2] : q_in[1] };
+
+    // The paper's 6 vertex-in-triangle tests decide most overlaps at once.
+    for (int i = 0; i < 3; i++)
+      if (StrictlyInside(p, q[i]) || StrictlyInside(q, p[i])) return true;
+    // The 9 edge-edge tests catch crossings without a vertex inside.
+    for (int i = 0; i < 3; i++)
+      for (int j = 0; j < 3; j++)
+        if (ProperCrossing(p[i], p[(i+1)%3], q[j], q[(j+1)%3])) return true;
+    // Left: degenerate contacts (vertices on edges, collinear edges, identical
+    // triangles) that strict tests cannot classify. Two convex polygons have disjoint
+    // interiors iff one of their edge lines weakly separates them (separating axis
+    // theorem); with exact signs this decides every remaining case.
+    for (int i = 0; i < 3; i++)
+      if (Separates(p[i], p[(i+1)%3], q) || Separates(q[i], q[(i+1)%3], p)) return false;
+    return true;
+  }
+
+  bool TrianglesCollide (const double * p[3], const double * q[3], double tol)
+  {
+    if (InteriorsOverlap(p, q)) return true;
+    if (!(tol > 0)) return false;
+    // Disjoint interiors: the distance is attained between a vertex and an edge.
+    for (int i = 0; i < 3; i++)
+      for (int j = 0; j < 3; j++)
+        if (PointSegmentDistance(p[i], q[j], q[(j+1)%3]) <= tol
+            || PointSegmentDistance(q[i], p[j], p[(j+1)%3]) <= tol)
+          return true;
+    return false;
+  }
+
+  std::vector<std::array<int32_t,2>>
+  CollisionPairs (const TriangleSoup & soup, const uint8_t * candidate,
+                  const int32_t * fragment, double tol, bool narrow, double * bin_size_out)
+  {
+    std::vector<std::array<int32_t,2>> pairs;
+    if (bin_size_out) *bin_size_out = 0;
+    std::vector<int32_t> cand;
+    for (int64_t i = 0; i < soup.nt; i++)
+      if (candidate[i]) cand.push_back(int32_t(i));
+    size_t n = cand.size();
+    if (n < 2) return pairs;                        // no work without candidates
+
+    const double * x = soup.x;
+    const int32_t * T = soup.tris;
+    double half = 0.5 * std::max(tol, 0.0);
+    std::vector<double> box(4*n), cen(2*n);
+    double extent = 0;
+    double cmin[2] = { std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity() };
+    double cmax[2] = { -cmin[0], -cmin[1] };
+    for (size_t k = 0; k < n; k++)
+      {
+        const int32_t * t = T + 3*cand[k];
+        for (int d = 0; d < 2; d++)
+          {
+            double v0 = x[2*t[0]+d], v1 = x[2*t[1]+d], v2 = x[2*t[2]+d];
+            double lo = std::min({v0, v1, v2}) - half, hi = std::max({v0, v1, v2}) + half;
+            box[4*k+d] = lo; box[4*k+2+d] = hi;
+            extent = std::max(extent, hi - lo);
+            double c = (v0 + v1 + v2) / 3.0;
+            cen[2*k+d] = c;
+            cmin[d] = std::min(cmin[d], c); cmax[d] = std::max(cmax[d], c);
+          }
+      }
+    // Bin size: if two (inflated) boxes of extent <= W overlap, their centroids differ
+    // by at most 2W per axis, so with h >= 2W the centroid bins differ by at most one
+    // in each direction and the 3x3 neighbourhood is complete. The factor 1 + 1e-9
+    // absorbs rounding of centroids and of (c - cmin) / h.
+    double h = 2.0 * extent * (1.0 + 1e-9);
+    double range = std::max(cmax[0] - cmin[0], cmax[1] - cmin[1]);
+    if (!(h > 0)) h = 1.0;
+    // Keep bin indices in 31 bits; coarser bins stay correct, only slower.
+    h = std::max(h, range / double(1 << 30));
+    if (bin_size_out) *bin_size_out = h;
+
+    // Bins by hashing (ix, iy): memory and time linear in the number of candidates,
+    // whatever the extent of the domain.
+    auto key = [] (int64_t ix, int64_t iy) { return (uint64_t(ix) << 32) | uint64_t(uint32_t(iy)); };
+    std::unordered_map<uint64_t, int32_t> bin_of;
+    bin_of.reserve(2*n);
+    std::vector<int32_t> bin(n), bix, biy;
+    for (size_t k = 0; k < n; k++)
+      {
+        int64_t ix = int64_t(std::floor((cen[2*k] - cmin[0]) / h));
+        int64_t iy = int64_t(std::floor((cen[2*k+1] - cmin[1]) / h));
+        auto [it, fresh] = bin_of.try_emplace(key(ix, iy), int32_t(bix.size()));
+        if (fresh) { bix.push_back(int32_t(ix)); biy.push_back(int32_t(iy)); }
+        bin[k] = it->second;
+      }
+    size_t nb = bix.size();
+    std::vector<int32_t> start(nb+1, 0), members(n);
+    for (size_t k = 0; k < n; k++) start[bin[k]+1]++;
+    for (size_t b = 0; b < nb; b++) start[b+1] += start[b];
+    {
+      std::vector<int32_t> fill(start.begin(), start.end()-1);
+      for (size_t k = 0; k < n; k++) members[fill[bin[k]]++] = int32_t(k);
+    }
+
+    auto test = [&] (int32_t k, int32_t l)
+    {
+      if (box[4*k] > box[4*l+2] || box[4*l] > box[4*k+2]
+          || box[4*k+1] > box[4*l+3] || box[4*l+1] > box[4*k+3]) return;
+      int32_t i = cand[k], j = cand[l];
+      const int32_t * ti = T + 3*i, * tj = T + 3*j;
+      // Mesh neighbours touch by construction: adjacency is not overlap.
+      if (!fragment || fragment[i] == fragment[j])
+        for (int a = 0; a < 3; a++)
+          for (int b = 0; b < 3; b++)
+            if (ti[a] == tj[b]) return;
+      if (narrow)
+        {
+          const double * p[3] = { x + 2*ti[0], x + 2*ti[1], x + 2*ti[2] };
+          const double * q[3] = { x + 2*tj[0], x + 2*tj[1], x + 2*tj[2] };
+          if (!TrianglesCollide(p, q, tol)) return;
+        }
+      pairs.push_back({ std::min(i, j), std::max(i, j) });
+    };
+
+    // Sweep: each bin against itself and the half-stencil right, lower, lower-right
+    // and upper-right. The paper's three neighbours miss the anti-diagonal pairs
+    // (centroids in bins (ix, iy) and (ix+1, iy-1)); with the fourth, every unordered
+    // pair of neighbouring bins is visited exactly once.
+    static const int off[4][2] = { {1, 0}, {0, 1}, {1, 1}, {1, -1} };
+    for (size_t b = 0; b < nb; b++)
+      {
+        for (int32_t s = start[b]; s < start[b+1]; s++)
+          for (int32_t t = s+1; t < start[b+1]; t++)
+            test(members[s], members[t]);
+        for (auto & o : off)
+          {
+            auto it = bin_of.find(key(int64_t(bix[b]) + o[0], int64_t(biy[b]) + o[1]));
+            if (it == bin_of.end()) continue;
+            int32_t nb2 = it->second;
+            for (int32_t s = start[b]; s < start[b+1]; s++)
+              for (int32_t t = start[nb2]; t < start[nb2+1]; t++)
+                test(members[s], members[t]);
+          }
+      }
+    std::sort(pairs.begin(), pairs.end());
+    return pairs;
+  }
+
+  std::vector<ContactCandidate>
+  SelectContacts (const TriangleSoup & soup, const uint8_t * bmask,
+                  const int32_t * pairs, int64_t npairs, double tol, double angle_tol)
+  {
+    std::vector<ContactCandidate> out;
+    const double * x = soup.x;
+    const int32_t * T = soup.tris;
+    for (int64_t pi = 0; pi < npairs; pi++)
+      for (int dir = 0; dir < 2; dir++)
+        {
+          // Rule 1: per overlapping pair at most one constraint with each element as
+          // master, hence at most two per pair.
+          int32_t M = pairs[2*pi + dir], S = pairs[2*pi + 1 - dir];
+          const int32_t * tm = T + 3*M, * ts = T + 3*S;
+          bool found = false;
+          ContactCandidate best{};
+          for (int k = 0; k < 3; k++)
+            {
+              // Rule 2: the master segment is a boundary (or crack) edge.
+              if (!bmask[3*M + k]) continue;
+              int32_t a = tm[k], c = tm[(k+1)%3], o = tm[(k+2)%3];
+              const double * xa = x + 2*a, * xc = x + 2*c, * xo = x + 2*o;
+              double d[2] = { xc[0]-xa[0], xc[1]-xa[1] };
+              double l2 = d[0]*d[0] + d[1]*d[1];
+              if (!(l2 > 0)) continue;
+              double l = std::sqrt(l2);
+              double n[2] = { d[1]/l, -d[0]/l };           // outward: master on the left of a -> c
+              // A node further inside than the master's height over this edge has gone
+              // past the element: it is not this edge's contact.
+              double depth = std::abs((xo[0]-xa[0])*n[0] + (xo[1]-xa[1])*n[1]);
+              int mbest = -1; double dbest = 0, xibest = 0;
+              for (int m = 0; m < 3; m++)
+                {
+                  int32_t b = ts[m];
+                  if (b == a || b == c) continue;
+                  const double * xb = x + 2*b;
+                  // eq. 13: x'_b = xi x_a + (1 - xi) x_c, (x'_b - x_b) . (x_a - x_c) = 0
+                  double xi = ((xb[0]-xc[0])*(xa[0]-xc[0]) + (xb[1]-xc[1])*(xa[1]-xc[1])) / l2;
+                  double slack = std::max(tol, 0.0) / l;
+                  if (xi < -slack || xi > 1.0 + slack) continue;
+                  double dist = (xb[0]-xa[0])*n[0] + (xb[1]-xa[1])*n[1];
+                  // Rule 2: within the precision threshold (negative = penetration),
+                  // the nearest (deepest) node wins.
+                  if (dist > tol || dist < -depth) continue;
+                  if (mbest < 0 || dist < dbest)
+                    { mbest = m; dbest = dist; xibest = std::clamp(xi, 0.0, 1.0); }
+                }
+              if (mbest < 0) continue;
+              // Rule 3: angle between the master segment and the slave's two edges.
+              const double * xb = x + 2*ts[mbest];
+              double angle = M_PI;
+              for (int e = 1; e <= 2; e++)
+                {
+                  const double * xe = x + 2*ts[(mbest+e)%3];
+                  double v[2] = { xe[0]-xb[0], xe[1]-xb[1] };
+                  double lv = std::sqrt(v[0]*v[0] + v[1]*v[1]);
+                  if (!(lv > 0)) continue;
+                  double cs = std::min(1.0, std::abs(v[0]*d[0] + v[1]*d[1]) / (lv*l));
+                  angle = std::min(angle, std::acos(cs));
+                }
+              if (angle > angle_tol) continue;
+              bool better = !found || angle < best.angle
+                || (angle == best.angle && dbest < best.dist);
+              if (better)
+                {
+                  found = true;
+                  best.slave = ts[mbest]; best.a = a; best.c = c;
+                  best.master_tri = M; best.slave_tri = S; best.pair = int32_t(pi);
+                  best.xi = xibest; best.n[0] = n[0]; best.n[1] = n[1];
+                  best.dist = dbest; best.angle = angle;
+                }
+            }
+          // Rule 4: otherwise no constraint for this direction.
+          if (found) out.push_back(best);
+        }
+    return out;
+  }
+}
