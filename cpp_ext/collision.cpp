@@ -76,7 +76,19 @@ namespace ngfracture
   {
     if (InteriorsOverlap(p, q)) return true;
     if (!(tol > 0)) return false;
-    // Disjoint interiors: the distance is attained between a vertex and an edge.
+    // A flat triangle may lie inside the other one: distance zero.
+    for (int swap = 0; swap < 2; swap++)
+      {
+        const double ** t = swap ? q : p, ** o = swap ? p : q;
+        int ot = Orient2dSign(t[0], t[1], t[2]);
+        if (ot != 0)
+          for (int i = 0; i < 3; i++)
+            if (ot * Orient2dSign(t[0], t[1], o[i]) >= 0 && ot * Orient2dSign(t[1], t[2], o[i]) >= 0
+                && ot * Orient2dSign(t[2], t[0], o[i]) >= 0)
+              return true;
+      }
+    // Disjoint interiors, neither inside the other: the distance is attained between a
+    // vertex and an edge.
     for (int i = 0; i < 3; i++)
       for (int j = 0; j < 3; j++)
         if (PointSegmentDistance(p[i], q[j], q[(j+1)%3]) <= tol
@@ -210,66 +222,86 @@ namespace ngfracture
           // master, hence at most two per pair.
           int32_t M = pairs[2*pi + dir], S = pairs[2*pi + 1 - dir];
           const int32_t * tm = T + 3*M, * ts = T + 3*S;
-          bool found = false;
-          ContactCandidate best{};
+          // Outward unit normals of the master's edges (reference orientation: the
+          // master is on the left of t[k] -> t[k+1]).
+          double nrm[3][2], len[3];
           for (int k = 0; k < 3; k++)
             {
-              // Rule 2: the master segment is a boundary (or crack) edge.
-              if (!bmask[3*M + k]) continue;
-              int32_t a = tm[k], c = tm[(k+1)%3], o = tm[(k+2)%3];
-              const double * xa = x + 2*a, * xc = x + 2*c, * xo = x + 2*o;
-              double d[2] = { xc[0]-xa[0], xc[1]-xa[1] };
-              double l2 = d[0]*d[0] + d[1]*d[1];
-              if (!(l2 > 0)) continue;
-              double l = std::sqrt(l2);
-              double n[2] = { d[1]/l, -d[0]/l };           // outward: master on the left of a -> c
-              // A node further inside than the master's height over this edge has gone
-              // past the element: it is not this edge's contact.
-              double depth = std::abs((xo[0]-xa[0])*n[0] + (xo[1]-xa[1])*n[1]);
-              int mbest = -1; double dbest = 0, xibest = 0;
-              for (int m = 0; m < 3; m++)
+              const double * xa = x + 2*tm[k], * xc = x + 2*tm[(k+1)%3];
+              double d0 = xc[0]-xa[0], d1 = xc[1]-xa[1];
+              len[k] = std::sqrt(d0*d0 + d1*d1);
+              nrm[k][0] = len[k] > 0 ? d1/len[k] : 0.0;
+              nrm[k][1] = len[k] > 0 ? -d0/len[k] : 0.0;
+            }
+          double scale = std::max({len[0], len[1], len[2]});
+          ContactCandidate cand[3];
+          int ncand = 0;
+          for (int m = 0; m < 3; m++)
+            {
+              int32_t b = ts[m];
+              const double * xb = x + 2*b;
+              // Only nodes inside the master, or within tol of it, are feasible.
+              bool near = true;
+              for (int k = 0; k < 3; k++)
+                if ((xb[0]-x[2*tm[k]])*nrm[k][0] + (xb[1]-x[2*tm[k]+1])*nrm[k][1] > tol)
+                  near = false;
+              if (!near) continue;
+              // Rule 2: master segments are boundary (or crack) edges; the node's
+              // distance to the master is that of its nearest way out through one of
+              // them (largest signed distance among edges it projects onto).
+              int kbest = -1; double dbest = 0, xibest = 0;
+              for (int k = 0; k < 3; k++)
                 {
-                  int32_t b = ts[m];
+                  if (!bmask[3*M + k] || !(len[k] > 0)) continue;
+                  int32_t a = tm[k], c = tm[(k+1)%3];
                   if (b == a || b == c) continue;
-                  const double * xb = x + 2*b;
+                  const double * xa = x + 2*a, * xc = x + 2*c;
                   // eq. 13: x'_b = xi x_a + (1 - xi) x_c, (x'_b - x_b) . (x_a - x_c) = 0
-                  double xi = ((xb[0]-xc[0])*(xa[0]-xc[0]) + (xb[1]-xc[1])*(xa[1]-xc[1])) / l2;
-                  double slack = std::max(tol, 0.0) / l;
+                  double xi = ((xb[0]-xc[0])*(xa[0]-xc[0]) + (xb[1]-xc[1])*(xa[1]-xc[1]))
+                    / (len[k]*len[k]);
+                  double slack = tol / len[k];
                   if (xi < -slack || xi > 1.0 + slack) continue;
-                  double dist = (xb[0]-xa[0])*n[0] + (xb[1]-xa[1])*n[1];
-                  // Rule 2: within the precision threshold (negative = penetration),
-                  // the nearest (deepest) node wins.
-                  if (dist > tol || dist < -depth) continue;
-                  if (mbest < 0 || dist < dbest)
-                    { mbest = m; dbest = dist; xibest = std::clamp(xi, 0.0, 1.0); }
+                  double dist = (xb[0]-xa[0])*nrm[k][0] + (xb[1]-xa[1])*nrm[k][1];
+                  if (kbest < 0 || dist > dbest)
+                    { kbest = k; dbest = dist; xibest = std::clamp(xi, 0.0, 1.0); }
                 }
-              if (mbest < 0) continue;
-              // Rule 3: angle between the master segment and the slave's two edges.
-              const double * xb = x + 2*ts[mbest];
+              if (kbest < 0 || dbest > tol) continue;   // threshold: negative = penetration
+              auto & cc = cand[ncand++];
+              cc.slave = b; cc.a = tm[kbest]; cc.c = tm[(kbest+1)%3];
+              cc.master_tri = M; cc.slave_tri = S; cc.pair = int32_t(pi);
+              cc.xi = xibest; cc.n[0] = nrm[kbest][0]; cc.n[1] = nrm[kbest][1];
+              cc.dist = dbest;
+              // Rule 3 angle: between the master segment and the slave's two edges at b.
               double angle = M_PI;
               for (int e = 1; e <= 2; e++)
                 {
-                  const double * xe = x + 2*ts[(mbest+e)%3];
+                  const double * xe = x + 2*ts[(m+e)%3];
                   double v[2] = { xe[0]-xb[0], xe[1]-xb[1] };
                   double lv = std::sqrt(v[0]*v[0] + v[1]*v[1]);
                   if (!(lv > 0)) continue;
-                  double cs = std::min(1.0, std::abs(v[0]*d[0] + v[1]*d[1]) / (lv*l));
+                  // |v . t| with t the unit tangent (n rotated back)
+                  double cs = std::min(1.0, std::abs(-v[0]*cc.n[1] + v[1]*cc.n[0]) / lv);
                   angle = std::min(angle, std::acos(cs));
                 }
-              if (angle > angle_tol) continue;
-              bool better = !found || angle < best.angle
-                || (angle == best.angle && dbest < best.dist);
-              if (better)
-                {
-                  found = true;
-                  best.slave = ts[mbest]; best.a = a; best.c = c;
-                  best.master_tri = M; best.slave_tri = S; best.pair = int32_t(pi);
-                  best.xi = xibest; best.n[0] = n[0]; best.n[1] = n[1];
-                  best.dist = dbest; best.angle = angle;
-                }
+              cc.angle = angle;
             }
-          // Rule 4: otherwise no constraint for this direction.
-          if (found) out.push_back(best);
+          if (ncand == 0) continue;                     // rule 4
+          // Rule 2: the nearest (most penetrating) node. Rule 3: nodes equally near,
+          // within the precision threshold (at least 1e-12 of the element size), are
+          // ranked by angle; the chosen angle must not exceed angle_tol.
+          double dmin = cand[0].dist;
+          for (int i = 1; i < ncand; i++) dmin = std::min(dmin, cand[i].dist);
+          double window = std::max(tol, 1e-12 * scale);
+          int best = -1;
+          for (int i = 0; i < ncand; i++)
+            {
+              if (cand[i].dist > dmin + window) continue;
+              if (best < 0 || cand[i].angle < cand[best].angle
+                  || (cand[i].angle == cand[best].angle && cand[i].dist < cand[best].dist))
+                best = i;
+            }
+          if (cand[best].angle > angle_tol) continue;   // rule 3 threshold, then rule 4
+          out.push_back(cand[best]);
         }
     return out;
   }
