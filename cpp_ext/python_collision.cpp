@@ -4,6 +4,7 @@
 #include <python_comp.hpp>
 #include "collision.hpp"
 #include "predicates.hpp"
+#include "independent_rows.hpp"
 
 namespace py = pybind11;
 using namespace ngfracture;
@@ -148,4 +149,22 @@ void ExportCollision (py::module & m)
         py::arg("tol") = 0.0, py::arg("angle_tol") = 1.5707963267948966,
         "Node-to-segment constraints by rules 1-4: ids (slave, a, c, master_tri, slave_tri, pair)"
         " and geometry (xi, nx, ny, dist, angle) per constraint.");
+
+  m.def("IndependentRows",
+        [] (DArr A, DArr G, double rtol)
+        {
+          if (A.ndim() != 2 || G.ndim() != 2 || (G.shape(0) > 0 && G.shape(1) != A.shape(1)))
+            throw py::value_error("ngfracture.IndependentRows: A (k, n) and G (p, n) expected");
+          std::vector<int32_t> picked;
+          {
+            py::gil_scoped_release release;
+            picked = IndependentRows(A.data(), A.shape(0), A.shape(1),
+                                     G.data(), G.shape(0), rtol);
+          }
+          py::array_t<int32_t> out(picked.size());
+          std::copy(picked.begin(), picked.end(), out.mutable_data());
+          return out;
+        },
+        py::arg("A"), py::arg("G"), py::arg("rtol") = 1e-10,
+        "Rows of dense A independent of each other and of the rows of G (pivot order).");
 }
