@@ -1,5 +1,6 @@
 // Rank-revealing selection of independent constraint rows (small dense blocks).
 #include "independent_rows.hpp"
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -83,5 +84,64 @@ namespace ngfracture
             Axpy(-Dot(qq, &R[i*n], n), qq, &R[i*n], n);
       }
     return picked;
+  }
+
+  std::vector<int32_t> IndependentColumnsBanded (const int64_t * indptr, const int32_t * indices,
+                                                 const double * data, int64_t n, int64_t k,
+                                                 double rtol)
+  {
+    // Band width W: with rows spanning at most W columns, R keeps upper bandwidth W.
+    int64_t W = 1;
+    for (int64_t i = 0; i < n; i++)
+      if (indptr[i+1] > indptr[i])
+        {
+          int32_t lo = indices[indptr[i]], hi = lo;
+          for (int64_t t = indptr[i]; t < indptr[i+1]; t++)
+            { lo = std::min(lo, indices[t]); hi = std::max(hi, indices[t]); }
+          W = std::max<int64_t>(W, hi - lo + 1);
+        }
+    std::vector<double> R(k * W, 0.0);          // R(j, j + d) at R[j*W + d]
+    std::vector<char> filled(k, 0);
+    std::vector<double> x(k + W, 0.0);          // work row, dense over a moving window
+    for (int64_t i = 0; i < n; i++)
+      {
+        if (indptr[i+1] == indptr[i]) continue;
+        int64_t lo = k, hi = -1;
+        for (int64_t t = indptr[i]; t < indptr[i+1]; t++)
+          {
+            x[indices[t]] += data[t];
+            lo = std::min<int64_t>(lo, indices[t]); hi = std::max<int64_t>(hi, indices[t]);
+          }
+        for (int64_t j = lo; j <= hi && j < k; j++)
+          {
+            double xj = x[j];
+            if (xj == 0.0) continue;
+            double * r = &R[j*W];
+            if (!filled[j])
+              {
+                if (std::abs(xj) <= rtol) { x[j] = 0.0; continue; }   // below threshold
+                for (int64_t d = 0; d < W && j + d <= hi; d++) { r[d] = x[j+d]; x[j+d] = 0.0; }
+                filled[j] = 1;
+                break;
+              }
+            // Givens rotation zeroing x_j against R_jj.
+            double rjj = r[0], h = std::hypot(rjj, xj);
+            double c = rjj / h, sn = xj / h;
+            r[0] = h; x[j] = 0.0;
+            int64_t end = std::min<int64_t>(W, k - j);
+            for (int64_t d = 1; d < end; d++)
+              {
+                double a = r[d], b = x[j+d];
+                r[d] = c*a + sn*b;
+                x[j+d] = -sn*a + c*b;
+              }
+            hi = std::max<int64_t>(hi, j + end - 1);
+          }
+        for (int64_t j = lo; j <= hi && j < k; j++) x[j] = 0.0;   // clear remainders
+      }
+    std::vector<int32_t> kept;
+    for (int64_t j = 0; j < k; j++)
+      if (filled[j] && std::abs(R[j*W]) > rtol) kept.push_back(int32_t(j));
+    return kept;
   }
 }

@@ -14,5 +14,16 @@ namespace ngfracture
   // Returns the picked rows of A in pivot order.
   std::vector<int32_t> IndependentRows (const double * A, int64_t k, int64_t n,
                                         const double * G, int64_t p, double rtol);
+
+  // Sparse alternative for large components: greedy sequential selection in the given
+  // column order by a banded Givens QR of the n x k matrix A^T (CSR: one row per dof,
+  // column indices in the chosen order, entries of unit-norm constraint rows). Column j
+  // is kept iff its distance from the span of the kept columns before it exceeds rtol
+  // (|R_jj| > rtol); intermediate pivots below rtol are dropped (treated as zero), which
+  // keeps rank decisions consistent with the threshold. Cost O(n W^2) with W the largest
+  // column span of a row (small after a reverse Cuthill-McKee ordering).
+  std::vector<int32_t> IndependentColumnsBanded (const int64_t * indptr, const int32_t * indices,
+                                                 const double * data, int64_t n, int64_t k,
+                                                 double rtol);
 }
 #endif

@@ -167,4 +167,28 @@ void ExportCollision (py::module & m)
         },
         py::arg("A"), py::arg("G"), py::arg("rtol") = 1e-10,
         "Rows of dense A independent of each other and of the rows of G (pivot order).");
+
+  m.def("IndependentColumnsBanded",
+        [] (py::array_t<int64_t, py::array::c_style | py::array::forcecast> indptr,
+            IArr indices, DArr data, int64_t k, double rtol)
+        {
+          int64_t n = indptr.shape(0) - 1;
+          if (n < 0 || indices.shape(0) != data.shape(0)
+              || indptr.data()[n] != indices.shape(0))
+            throw py::value_error("ngfracture.IndependentColumnsBanded: inconsistent CSR arrays");
+          for (int64_t t = 0; t < indices.shape(0); t++)
+            if (indices.data()[t] < 0 || indices.data()[t] >= k)
+              throw py::value_error("ngfracture.IndependentColumnsBanded: column out of range");
+          std::vector<int32_t> kept;
+          {
+            py::gil_scoped_release release;
+            kept = IndependentColumnsBanded(indptr.data(), indices.data(), data.data(), n, k, rtol);
+          }
+          py::array_t<int32_t> out(kept.size());
+          std::copy(kept.begin(), kept.end(), out.mutable_data());
+          return out;
+        },
+        py::arg("indptr"), py::arg("indices"), py::arg("data"), py::arg("k"),
+        py::arg("rtol") = 1e-10,
+        "Greedy independent columns of the CSR matrix A^T (n x k) by banded Givens QR.");
 }

@@ -48,7 +48,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.sparse.csgraph import connected_components
+from scipy.sparse.csgraph import connected_components, reverse_cuthill_mckee
 
 from . import _ngfracture as _ext
 from .collision import (_as_array, _check_tol, _check_tris, boundary_edge_mask,
@@ -213,7 +213,19 @@ def select_contacts(coords, displacement, tris, boundary_edges, pairs, tol=0.0,
         dist=geo[:, 3], angle=geo[:, 4], C=C, g=g)
 
 
-def independent_rows(C, fixed_dofs=None, G=None, rtol=1e-10):
+def _banded_selection(Csub, rtol):
+    """Greedy independent rows of one large component, in reverse Cuthill-McKee order."""
+    pattern = Csub.copy()
+    pattern.data = np.ones_like(pattern.data)
+    order = reverse_cuthill_mckee(sp.csr_matrix(pattern @ pattern.T), symmetric_mode=True)
+    At = sp.csr_matrix(Csub[order].T)                   # dofs x constraints (ordered)
+    At.sort_indices()
+    kept = _ext.IndependentColumnsBanded(At.indptr.astype(np.int64), At.indices, At.data,
+                                         Csub.shape[0], rtol)
+    return order[kept]
+
+
+def independent_rows(C, fixed_dofs=None, G=None, rtol=1e-10, method="auto", dense_limit=64):
     """A maximal set of rows of C, linearly independent and independent of the Dirichlet rows.
 
     Rows are scaled to unit norm, columns fixed by Dirichlet conditions are eliminated
@@ -237,6 +249,16 @@ def independent_rows(C, fixed_dofs=None, G=None, rtol=1e-10):
         General Dirichlet / multi-point rows that are kept in any case.
     rtol : float
         Rank threshold on |R_kk| for unit-norm rows.
+    method : {"auto", "pivoted", "banded"}
+        "pivoted": the column-pivoted QR on every component. "banded": for components
+        without G rows, a sparse alternative: greedy selection in reverse Cuthill-McKee
+        order by a banded Givens QR of C^T (|R_jj| > rtol keeps row j; not pivoted, so
+        rank-revealing only for well-separated singular values, which exact duplicates
+        and the Fig. 5 cycles are). "auto": pivoted for components of at most
+        dense_limit rows, banded above (the pivoted QR costs O(k r n) per component, far
+        too much for the long chains of rows along a whole crack).
+    dense_limit : int
+        Component size up to which "auto" uses the pivoted QR.
 
     Returns
     -------
@@ -267,6 +289,8 @@ def independent_rows(C, fixed_dofs=None, G=None, rtol=1e-10):
         fixed = np.asarray(fixed_dofs, dtype=np.int64).ravel()
         if fixed.size and (fixed.min() < 0 or fixed.max() >= ndof):
             raise ValueError(f"fixed_dofs holds dofs outside [0, {ndof})")
+    if method not in ("auto", "pivoted", "banded"):
+        raise ValueError(f"method must be 'auto', 'pivoted' or 'banded', got {method!r}")
     if m == 0:
         return np.zeros(0, dtype=np.int64)
 
@@ -321,6 +345,10 @@ def independent_rows(C, fixed_dofs=None, G=None, rtol=1e-10):
             grows = g_order[np.searchsorted(g_sorted, lab, "left"):
                             np.searchsorted(g_sorted, lab, "right")]
             Csub = Cn[grp]
+            banded = method == "banded" or (method == "auto" and len(grp) > dense_limit)
+            if banded and len(grows) == 0:
+                kept.append(grp[_banded_selection(Csub, rtol)])
+                continue
             Gsub = Gn[grows] if len(grows) else Gn[:0]
             cols = np.unique(np.concatenate([Csub.indices, Gsub.indices]))
             picked = _ext.IndependentRows(Csub[:, cols].toarray(), Gsub[:, cols].toarray(), rtol)

@@ -126,10 +126,31 @@ def test_pressed_blocks_rows():
     A = cs.C.toarray()
     assert np.linalg.matrix_rank(A[keep]) == len(keep) == np.linalg.matrix_rank(A)
     assert len(keep) < len(cs)
+    keep_b = contact.independent_rows(cs.C, method="banded")
+    assert len(keep_b) == len(keep) == np.linalg.matrix_rank(A[keep_b])
+
+
+def test_banded_and_pivoted_agree_on_long_chains():
+    # 3-node rows along a chain of vertices, with duplicates and Fig. 5 style cycles
+    rng = np.random.default_rng(9)
+    nv, m = 160, 200
+    b = rng.integers(0, nv - 2, m)
+    a, c = b + 1, b + 2
+    n = rng.normal(size=(m, 2))
+    n /= np.linalg.norm(n, axis=1, keepdims=True)
+    C, _ = contact.gap_rows(np.zeros((nv, 2)), b, a, c, rng.uniform(0, 1, m), n)
+    dup = rng.integers(0, m, 40)
+    C = sp.vstack([C, C[dup] * 2.0]).tocsr()
+    rank = np.linalg.matrix_rank(C.toarray())
+    for method in ("pivoted", "banded", "auto"):
+        keep = contact.independent_rows(C, method=method)
+        assert len(keep) == rank
+        assert np.linalg.matrix_rank(C[keep].toarray()) == rank
 
 
 # ------------------------------------------------------------------ redundancy
-def test_2000_coincident_rows_rank_r_and_kkt():
+@pytest.mark.parametrize("method", ["pivoted", "banded", "auto"])
+def test_2000_coincident_rows_rank_r_and_kkt(method):
     rng = np.random.default_rng(5)
     ndof, r, m = 300, 40, 2000
     # r independent node-to-segment-like rows on a cluster of 80 dofs
@@ -146,7 +167,7 @@ def test_2000_coincident_rows_rank_r_and_kkt():
     rows[:r] = base                                    # every base row occurs
     C = sp.csr_matrix(rows)
     # rank r by construction: combinations of the base rows, which all occur
-    keep = contact.independent_rows(C)
+    keep = contact.independent_rows(C, method=method)
     assert len(keep) == r
     assert np.linalg.matrix_rank(rows[keep]) == r
     # consistent gaps: g = -C u* for some u*, so the full system is solvable
@@ -182,6 +203,7 @@ def test_three_body_redundancy_fig5_and_duplicates():
     C = sp.vstack([r01, r12, r02, r01, r12]).tocsr()   # plus two exact duplicates
     keep = contact.independent_rows(C)
     assert keep.tolist() == [0, 1]
+    assert len(contact.independent_rows(C, method="banded")) == 2
     assert np.linalg.matrix_rank(C.toarray()[keep]) == 2
     # different normals: the three node-to-node rows are independent in 2D
     r02b = node_to_node(nv, 2, 0, np.array([1.0, 0.0]))
