@@ -240,12 +240,6 @@ namespace ngfracture
             {
               int32_t b = ts[m];
               const double * xb = x + 2*b;
-              // Only nodes inside the master, or within tol of it, are feasible.
-              bool near = true;
-              for (int k = 0; k < 3; k++)
-                if ((xb[0]-x[2*tm[k]])*nrm[k][0] + (xb[1]-x[2*tm[k]+1])*nrm[k][1] > tol)
-                  near = false;
-              if (!near) continue;
               // Rule 2: master segments are boundary (or crack) edges; the node's
               // distance to the master is that of its nearest way out through one of
               // them (largest signed distance among edges it projects onto).
@@ -262,6 +256,13 @@ namespace ngfracture
                   double slack = tol / len[k];
                   if (xi < -slack || xi > 1.0 + slack) continue;
                   double dist = (xb[0]-xa[0])*nrm[k][0] + (xb[1]-xa[1])*nrm[k][1];
+                  // Deeper than the master's height over this edge: the node has gone
+                  // past the element, this edge is not its way out. (A node may sit in
+                  // a neighbour of the master that touches the boundary only at a vertex:
+                  // no need to lie inside the master itself.)
+                  const double * xo = x + 2*tm[(k+2)%3];
+                  double height = -((xo[0]-xa[0])*nrm[k][0] + (xo[1]-xa[1])*nrm[k][1]);
+                  if (dist <= -std::abs(height) * (1.0 - 1e-9)) continue;
                   if (kbest < 0 || dist > dbest)
                     { kbest = k; dbest = dist; xibest = std::clamp(xi, 0.0, 1.0); }
                 }

@@ -31,18 +31,26 @@ Selection rules (per colliding pair, see ``SelectContacts`` in cpp_ext/collision
 
 1. per pair and direction (master, slave) at most one constraint, hence at most two per
    pair and each element at most once as master and once as slave;
-2. the master segment is a boundary/crack edge of the master triangle; the slave node is
-   a vertex of the other triangle (not a vertex of the segment) whose projection lies on
-   the segment (up to tol / |segment|, then clamped: node-to-node for xi = 0 or 1), whose
-   signed distance is <= tol and not below minus the master's height over that edge (a
-   node past the master element belongs to another edge); among those, the smallest
-   signed distance (deepest penetration) wins;
-3. among the master's boundary edges that have such a node, the smallest angle between
-   the master segment and the slave node's two triangle edges wins; it must be <=
-   angle_tol (the default pi/2 only ranks, it rejects nothing);
+2. the master segment is a boundary/crack edge of the master triangle; a slave
+   candidate is a vertex of the other triangle (not an end of the segment) whose
+   projection lies on the segment (up to tol / |segment|, then clamped: node-to-node for
+   xi = 0 or 1) and whose signed distance d satisfies -height < d <= tol, height being
+   the master's height over that edge (deeper nodes have gone past the element; the node
+   need not lie inside the master itself: it may sit in a neighbour that touches the
+   boundary only at a vertex, which is not a candidate element). A node's distance to
+   the master is that of its nearest way out, the largest d over the master's boundary
+   edges; the node with the smallest distance (deepest penetration) wins;
+3. nodes equally deep within the precision threshold (at least 1e-12 of the element
+   size) are ranked by the angle between the master segment and the node's two edges
+   in the slave triangle, smallest first; the chosen angle must be <= angle_tol (the
+   default pi/2 only ranks, it rejects nothing);
 4. otherwise no constraint.
 
 Identical constraints (same slave, a, c) found through different pairs are merged.
+Known weakness: where a slave node lies on the extension of an outer boundary edge of the
+other body (the corners of an overlap), the nearest exit may be that edge, giving a row
+with gap 0 and a tangential normal; as an inequality it is harmless (an active-set solve
+releases it if adhesive) but it is not the physically intended interface constraint.
 """
 from dataclasses import dataclass
 
