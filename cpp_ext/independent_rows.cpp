@@ -144,4 +144,101 @@ namespace ngfracture
       if (filled[j] && std::abs(R[j*W]) > rtol) kept.push_back(int32_t(j));
     return kept;
   }
+
+  std::vector<int32_t> IndependentRowsSparse (int64_t m, int64_t ndof,
+                                              const int64_t * indptr, const int32_t * indices,
+                                              const double * data, const int32_t * label,
+                                              const int64_t * position,
+                                              int64_t p, const int64_t * gindptr,
+                                              const int32_t * gindices, const double * gdata,
+                                              const int32_t * glabel,
+                                              double rtol, int method, int64_t dense_limit)
+  {
+    std::vector<int32_t> kept;
+    if (m == 0) return kept;
+    // Group the C rows by component (in processing order) and the G rows likewise.
+    std::vector<int32_t> rows(m);
+    for (int64_t i = 0; i < m; i++) rows[i] = int32_t(i);
+    std::sort(rows.begin(), rows.end(), [&] (int32_t a, int32_t b)
+              {
+                if (label[a] != label[b]) return label[a] < label[b];
+                return position[a] != position[b] ? position[a] < position[b] : a < b;
+              });
+    std::vector<int32_t> grows(p);
+    for (int64_t i = 0; i < p; i++) grows[i] = int32_t(i);
+    std::sort(grows.begin(), grows.end(), [&] (int32_t a, int32_t b)
+              { return glabel[a] != glabel[b] ? glabel[a] < glabel[b] : a < b; });
+
+    std::vector<int32_t> colmap(ndof, -1), cols;
+    size_t gpos = 0;
+    for (size_t s0 = 0; s0 < rows.size(); )
+      {
+        size_t s1 = s0;
+        int32_t lab = label[rows[s0]];
+        while (s1 < rows.size() && label[rows[s1]] == lab) s1++;
+        while (gpos < grows.size() && glabel[grows[gpos]] < lab) gpos++;
+        size_t g0 = gpos, g1 = gpos;
+        while (g1 < grows.size() && glabel[grows[g1]] == lab) g1++;
+        int64_t k = s1 - s0, pg = g1 - g0;
+
+        cols.clear();
+        auto addcols = [&] (const int64_t * ip, const int32_t * ix, int32_t r)
+        {
+          for (int64_t t = ip[r]; t < ip[r+1]; t++)
+            if (colmap[ix[t]] < 0) { colmap[ix[t]] = int32_t(cols.size()); cols.push_back(ix[t]); }
+        };
+        for (size_t s = s0; s < s1; s++) addcols(indptr, indices, rows[s]);
+        for (size_t s = g0; s < g1; s++) addcols(gindptr, gindices, grows[s]);
+        int64_t nc = cols.size();
+
+        bool banded = (method == 2 || (method == 0 && k > dense_limit)) && pg == 0;
+        if (k == 1 && pg == 0)
+          {
+            // A single row: independent iff it did not vanish.
+            double nrm = 0;
+            for (int64_t t = indptr[rows[s0]]; t < indptr[rows[s0]+1]; t++)
+              nrm += data[t] * data[t];
+            if (std::sqrt(nrm) > rtol) kept.push_back(rows[s0]);
+          }
+        else if (banded)
+          {
+            // A^T in CSR: one row per local column, entries (position in group, value).
+            std::vector<int64_t> tp(nc + 1, 0);
+            for (size_t s = s0; s < s1; s++)
+              for (int64_t t = indptr[rows[s]]; t < indptr[rows[s]+1]; t++)
+                tp[colmap[indices[t]] + 1]++;
+            for (int64_t c = 0; c < nc; c++) tp[c+1] += tp[c];
+            std::vector<int32_t> ti(tp[nc]);
+            std::vector<double> tv(tp[nc]);
+            std::vector<int64_t> fill(tp.begin(), tp.end() - 1);
+            for (size_t s = s0; s < s1; s++)
+              for (int64_t t = indptr[rows[s]]; t < indptr[rows[s]+1]; t++)
+                {
+                  int64_t at = fill[colmap[indices[t]]]++;
+                  ti[at] = int32_t(s - s0);
+                  tv[at] = data[t];
+                }
+            for (int32_t j : IndependentColumnsBanded(tp.data(), ti.data(), tv.data(), nc, k, rtol))
+              kept.push_back(rows[s0 + j]);
+          }
+        else
+          {
+            // Pivoting prefers the lowest index among equal residuals: input order.
+            std::sort(rows.begin() + s0, rows.begin() + s1);
+            std::vector<double> A(k * nc, 0.0), Gd(pg * nc, 0.0);
+            for (size_t s = s0; s < s1; s++)
+              for (int64_t t = indptr[rows[s]]; t < indptr[rows[s]+1]; t++)
+                A[(s - s0) * nc + colmap[indices[t]]] += data[t];
+            for (size_t s = g0; s < g1; s++)
+              for (int64_t t = gindptr[grows[s]]; t < gindptr[grows[s]+1]; t++)
+                Gd[(s - g0) * nc + colmap[gindices[t]]] += gdata[t];
+            for (int32_t j : IndependentRows(A.data(), k, nc, Gd.data(), pg, rtol))
+              kept.push_back(rows[s0 + j]);
+          }
+        for (int32_t c : cols) colmap[c] = -1;
+        s0 = s1;
+      }
+    std::sort(kept.begin(), kept.end());
+    return kept;
+  }
 }

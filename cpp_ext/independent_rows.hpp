@@ -25,5 +25,21 @@ namespace ngfracture
   std::vector<int32_t> IndependentColumnsBanded (const int64_t * indptr, const int32_t * indices,
                                                  const double * data, int64_t n, int64_t k,
                                                  double rtol);
+
+  // Both selections applied per connected component of the rows of a CSR matrix C
+  // (m x ndof, unit-norm rows, Dirichlet columns already eliminated) together with the
+  // rows of G (p x ndof, always kept). label[i] / glabel[i] give the component of each
+  // row, position[i] the processing order of the C rows (e.g. reverse Cuthill-McKee).
+  // method: 0 auto (pivoted up to dense_limit rows or when G rows are present, banded
+  // above), 1 pivoted, 2 banded (pivoted where G rows are present).
+  // Returns the kept rows of C, ascending.
+  std::vector<int32_t> IndependentRowsSparse (int64_t m, int64_t ndof,
+                                              const int64_t * indptr, const int32_t * indices,
+                                              const double * data, const int32_t * label,
+                                              const int64_t * position,
+                                              int64_t p, const int64_t * gindptr,
+                                              const int32_t * gindices, const double * gdata,
+                                              const int32_t * glabel,
+                                              double rtol, int method, int64_t dense_limit);
 }
 #endif

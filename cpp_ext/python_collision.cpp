@@ -191,4 +191,40 @@ void ExportCollision (py::module & m)
         py::arg("indptr"), py::arg("indices"), py::arg("data"), py::arg("k"),
         py::arg("rtol") = 1e-10,
         "Greedy independent columns of the CSR matrix A^T (n x k) by banded Givens QR.");
+
+  m.def("IndependentRowsSparse",
+        [] (int64_t ndof, py::array_t<int64_t, py::array::c_style | py::array::forcecast> indptr,
+            IArr indices, DArr data, IArr label,
+            py::array_t<int64_t, py::array::c_style | py::array::forcecast> position,
+            py::array_t<int64_t, py::array::c_style | py::array::forcecast> gindptr,
+            IArr gindices, DArr gdata, IArr glabel, double rtol, int method, int64_t dense_limit)
+        {
+          int64_t m = indptr.shape(0) - 1, p = gindptr.shape(0) - 1;
+          if (m < 0 || p < 0 || label.shape(0) != m || position.shape(0) != m
+              || glabel.shape(0) != p || indptr.data()[m] != indices.shape(0)
+              || gindptr.data()[p] != gindices.shape(0)
+              || indices.shape(0) != data.shape(0) || gindices.shape(0) != gdata.shape(0))
+            throw py::value_error("ngfracture.IndependentRowsSparse: inconsistent arrays");
+          for (int64_t t = 0; t < indices.shape(0); t++)
+            if (indices.data()[t] < 0 || indices.data()[t] >= ndof)
+              throw py::value_error("ngfracture.IndependentRowsSparse: column out of range");
+          for (int64_t t = 0; t < gindices.shape(0); t++)
+            if (gindices.data()[t] < 0 || gindices.data()[t] >= ndof)
+              throw py::value_error("ngfracture.IndependentRowsSparse: column out of range");
+          std::vector<int32_t> kept;
+          {
+            py::gil_scoped_release release;
+            kept = IndependentRowsSparse(m, ndof, indptr.data(), indices.data(), data.data(),
+                                         label.data(), position.data(), p, gindptr.data(),
+                                         gindices.data(), gdata.data(), glabel.data(),
+                                         rtol, method, dense_limit);
+          }
+          py::array_t<int64_t> out(kept.size());
+          std::copy(kept.begin(), kept.end(), out.mutable_data());
+          return out;
+        },
+        py::arg("ndof"), py::arg("indptr"), py::arg("indices"), py::arg("data"), py::arg("label"),
+        py::arg("position"), py::arg("gindptr"), py::arg("gindices"), py::arg("gdata"),
+        py::arg("glabel"), py::arg("rtol"), py::arg("method"), py::arg("dense_limit"),
+        "Independent rows per connected component (see independent_rows.hpp).");
 }

@@ -176,12 +176,17 @@ def boundary_edge_mask(tris, boundary_edges, nv=None):
     if E.shape[0] == 0 or T.shape[0] == 0:
         return np.zeros(T.shape, dtype=bool)
     local = (T * nv + np.roll(T, -1, axis=1)).ravel()        # key a * nv + b of edge a -> b
-    keys = E[:, 0] * nv + E[:, 1]
-    mask = np.isin(local, keys)
-    if np.count_nonzero(np.isin(keys, local)) != len(keys):
-        bad = E[~np.isin(keys, local)][0]
-        raise ValueError(f"boundary edge {tuple(bad)} is not a counter-clockwise edge of any "
-                         "triangle (the triangle must be on its left)")
+    keys = np.unique(E[:, 0] * nv + E[:, 1])
+    # sorted search instead of np.isin: the hash-based isin took 0.2 s at 100k triangles
+    at = np.minimum(np.searchsorted(keys, local), len(keys) - 1)
+    mask = keys[at] == local
+    if np.count_nonzero(mask) != len(keys):             # some boundary edge not found
+        found = np.zeros(len(keys), dtype=bool)
+        found[at[mask]] = True
+        bad = keys[~found][0]
+        raise ValueError(f"boundary edge {(int(bad // nv), int(bad % nv))} is not a "
+                         "counter-clockwise edge of any triangle (the triangle must be on "
+                         "its left)")
     return mask.reshape(T.shape)
 
 

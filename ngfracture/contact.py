@@ -221,18 +221,6 @@ def select_contacts(coords, displacement, tris, boundary_edges, pairs, tol=0.0,
         dist=geo[:, 3], angle=geo[:, 4], C=C, g=g)
 
 
-def _banded_selection(Csub, rtol):
-    """Greedy independent rows of one large component, in reverse Cuthill-McKee order."""
-    pattern = Csub.copy()
-    pattern.data = np.ones_like(pattern.data)
-    order = reverse_cuthill_mckee(sp.csr_matrix(pattern @ pattern.T), symmetric_mode=True)
-    At = sp.csr_matrix(Csub[order].T)                   # dofs x constraints (ordered)
-    At.sort_indices()
-    kept = _ext.IndependentColumnsBanded(At.indptr.astype(np.int64), At.indices, At.data,
-                                         Csub.shape[0], rtol)
-    return order[kept]
-
-
 def independent_rows(C, fixed_dofs=None, G=None, rtol=1e-10, method="auto", dense_limit=64):
     """A maximal set of rows of C, linearly independent and independent of the Dirichlet rows.
 
@@ -331,37 +319,25 @@ def independent_rows(C, fixed_dofs=None, G=None, rtol=1e-10, method="auto", dens
     _, labels = connected_components(A, directed=False)
     lab_c, lab_g = labels[:m], labels[m:nr]
 
-    rownnz = np.diff(Cn.indptr)
     # Rows that vanished after eliminating fixed dofs depend on the Dirichlet rows.
     rem_norm = np.sqrt(np.asarray(Cn.multiply(Cn).sum(axis=1)).ravel())
-    alive = (rownnz > 0) & (rem_norm > rtol)
-    count = np.bincount(lab_c[alive], minlength=labels.max() + 1)
-    gcount = np.bincount(lab_g, minlength=labels.max() + 1)
-    single = alive & (count[lab_c] == 1) & (gcount[lab_c] == 0)
-    kept = [np.flatnonzero(single)]
-
-    multi = alive & ~single
-    if multi.any():
-        rows_c = np.flatnonzero(multi)
-        order = np.argsort(lab_c[rows_c], kind="stable")
-        rows_c = rows_c[order]
-        bounds = np.flatnonzero(np.diff(lab_c[rows_c])) + 1
-        g_order = np.argsort(lab_g, kind="stable")
-        g_sorted = lab_g[g_order]
-        for grp in np.split(rows_c, bounds):
-            lab = lab_c[grp[0]]
-            grows = g_order[np.searchsorted(g_sorted, lab, "left"):
-                            np.searchsorted(g_sorted, lab, "right")]
-            Csub = Cn[grp]
-            banded = method == "banded" or (method == "auto" and len(grp) > dense_limit)
-            if banded and len(grows) == 0:
-                kept.append(grp[_banded_selection(Csub, rtol)])
-                continue
-            Gsub = Gn[grows] if len(grows) else Gn[:0]
-            cols = np.unique(np.concatenate([Csub.indices, Gsub.indices]))
-            picked = _ext.IndependentRows(Csub[:, cols].toarray(), Gsub[:, cols].toarray(), rtol)
-            kept.append(grp[picked])
-    return np.sort(np.concatenate(kept)).astype(np.int64)
+    alive = np.flatnonzero(rem_norm > rtol)
+    Ca = sp.csr_matrix(Cn[alive])
+    Ca.sort_indices()
+    position = np.zeros(len(alive), dtype=np.int64)
+    if method != "pivoted" and len(alive):
+        # processing order for the banded QR: reverse Cuthill-McKee of the row graph
+        pattern = Ca.copy()
+        pattern.data = np.ones_like(pattern.data)
+        order = reverse_cuthill_mckee(sp.csr_matrix(pattern @ pattern.T), symmetric_mode=True)
+        position[order] = np.arange(len(alive))
+    code = {"auto": 0, "pivoted": 1, "banded": 2}[method]
+    kept = _ext.IndependentRowsSparse(
+        ndof, Ca.indptr.astype(np.int64), Ca.indices.astype(np.int32), Ca.data,
+        lab_c[alive].astype(np.int32), position, Gn.indptr.astype(np.int64),
+        Gn.indices.astype(np.int32), Gn.data, lab_g.astype(np.int32), float(rtol), code,
+        int(dense_limit))
+    return alive[kept].astype(np.int64)
 
 
 def contact_constraints(coords, displacement, tris, boundary_edges, fragment=None,
