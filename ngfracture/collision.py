@@ -94,6 +94,19 @@ def current_coordinates(coords, displacement=None):
     return X + U
 
 
+def _check_shapes(coords, displacement, tris):
+    """O(1) shape checks for the paths that do no work (contents are not inspected)."""
+    for name, a, cols in (("coords", coords, 2), ("displacement", displacement, 2),
+                          ("tris", tris, 3)):
+        if a is None and name == "displacement":
+            continue
+        shape = np.shape(a)
+        if len(shape) != 2 or shape[1] != cols:
+            raise ValueError(f"{name} must have shape (n, {cols}), got {shape}")
+    if displacement is not None and np.shape(displacement) != np.shape(coords):
+        raise ValueError("displacement must have the shape of coords")
+
+
 def _check_tris(tris, nv):
     T = _as_array(tris, "tris", np.int32, 3)
     if T.size and (T.min() < 0 or T.max() >= nv):
@@ -208,20 +221,22 @@ def candidate_mask(tris, boundary_edges, nv=None):
 
 def _pairs(coords, displacement, tris, candidates, fragment, tol, narrow):
     tol = _check_tol(tol)
-    x = current_coordinates(coords, displacement)
-    T = _check_tris(tris, x.shape[0])
+    _check_shapes(coords, displacement, tris)
+    nt = np.shape(tris)[0]
     cand = np.asarray(candidates)
-    if cand.shape != (T.shape[0],):
-        raise ValueError(f"candidates must have shape ({T.shape[0]},), got {cand.shape}")
+    if cand.shape != (nt,):
+        raise ValueError(f"candidates must have shape ({nt},), got {cand.shape}")
     if cand.dtype != bool:
         raise TypeError("candidates must be a boolean mask")
+    if np.count_nonzero(cand) < 2:
+        return np.zeros((0, 2), dtype=np.int32)         # nothing can collide: no work
+    x = current_coordinates(coords, displacement)
+    T = _check_tris(tris, x.shape[0])
     frag = None
     if fragment is not None:
         frag = np.ascontiguousarray(fragment, dtype=np.int32)
         if frag.shape != (T.shape[0],):
             raise ValueError(f"fragment must have shape ({T.shape[0]},), got {frag.shape}")
-    if np.count_nonzero(cand) < 2:
-        return np.zeros((0, 2), dtype=np.int32)         # nothing can collide: no work
     pairs, _ = _ext.CollisionPairs(x, T, cand.view(np.uint8), frag, tol, narrow)
     return pairs
 
@@ -273,8 +288,8 @@ def detect_collisions(coords, displacement, tris, candidates=None, boundary_edge
         Triangles.
     candidates : numpy.ndarray of bool, shape (nt,), optional
         Triangles taking part. If omitted, those with an edge in ``boundary_edges``.
-        An empty mask returns at once: a scene without cracks or separate bodies does no
-        collision work.
+        An empty mask (or no boundary edges) returns at once, after O(1) shape checks
+        only: a scene without cracks or separate bodies does no collision work.
     boundary_edges : array_like, shape (ne, 2), optional
         Needed only when ``candidates`` is omitted.
     fragment : array_like of int, shape (nt,), optional
@@ -297,6 +312,9 @@ def detect_collisions(coords, displacement, tris, candidates=None, boundary_edge
     if candidates is None:
         if boundary_edges is None:
             raise ValueError("give candidates or boundary_edges")
+        if np.shape(boundary_edges)[:1] == (0,):
+            _check_shapes(coords, displacement, tris)
+            return np.zeros((0, 2), dtype=np.int32)     # no crack, no boundary: no work
         nv = np.shape(coords)[0]
         candidates = candidate_mask(_check_tris(tris, nv), boundary_edges, nv)
     return _pairs(coords, displacement, tris, candidates, fragment, tol, narrow=True)

@@ -115,6 +115,14 @@ class ContactConstraints:
             C=self.C[rows], g=self.g[rows])
 
 
+def _no_constraints(nv):
+    e = np.zeros(0, dtype=np.int32)
+    f = np.zeros(0)
+    return ContactConstraints(slave=e, a=e, c=e, master_tri=e, slave_tri=e, pair=e, xi=f,
+                              normal=np.zeros((0, 2)), dist=f, angle=f,
+                              C=sp.csr_matrix((0, 2 * nv)), g=f)
+
+
 def gap_rows(coords, slave, a, c, xi, normal):
     """Rows of the linearised gap (eq. 14): C u + g = n . (x_b - xi x_a - (1 - xi) x_c).
 
@@ -370,6 +378,8 @@ def contact_constraints(coords, displacement, tris, boundary_edges, fragment=Non
     """
     pairs = detect_collisions(coords, displacement, tris, candidates=candidates,
                               boundary_edges=boundary_edges, fragment=fragment, tol=tol)
+    if len(pairs) == 0:
+        return _no_constraints(np.shape(coords)[0])     # no work without collisions
     cs = select_contacts(coords, displacement, tris, boundary_edges, pairs, tol=tol,
                          angle_tol=angle_tol)
     if len(cs) == 0:

@@ -26,14 +26,16 @@ def ulp_grid(base, b, c, k=128):
 
 
 # --------------------------------------------------------------------- predicates
-@pytest.mark.parametrize("base,b,c", [
-    (0.5, [12.0, 12.0], [24.0, 24.0]),          # Shewchuk's classic near-collinear grid
-    ((0.5, 1.0), [12.0, 24.0], [24.0, 48.0]),
-    (1.0 / 3.0, [7.0 / 3.0, 7.0 / 3.0], [-11.0 / 3.0, -11.0 / 3.0]),
-    ((0.1, 0.3), [12.1, 36.3], [24.1, 72.3]),       # inexact differences: stage C
+@pytest.mark.parametrize("base,b,c,k", [
+    (0.5, [12.0, 12.0], [24.0, 24.0], 128),     # Shewchuk's classic near-collinear grid
+    ((0.5, 1.0), [12.0, 24.0], [24.0, 48.0], 64),
+    (1.0 / 3.0, [7.0 / 3.0, 7.0 / 3.0], [-11.0 / 3.0, -11.0 / 3.0], 64),
+    ((0.1, 0.3), [12.1, 36.3], [24.1, 72.3], 128),  # inexact differences: stage C
+    pytest.param(0.5, [12.0, 12.0], [24.0, 24.0], 256, marks=pytest.mark.slow),
+    pytest.param((0.1, 0.3), [12.1, 36.3], [24.1, 72.3], 256, marks=pytest.mark.slow),
 ])
-def test_orient2d_near_collinear_zero_sign_errors(base, b, c):
-    a, B, Cc = ulp_grid(base, np.array(b), np.array(c))
+def test_orient2d_near_collinear_zero_sign_errors(base, b, c, k):
+    a, B, Cc = ulp_grid(base, np.array(b), np.array(c), k)
     exact = np.array([exact_sign(p, b, c) for p in a])
     robust = collision.orient2d(a, B, Cc)
     expansion_only = ext.Orient2d(a, B, Cc, True)
@@ -42,7 +44,7 @@ def test_orient2d_near_collinear_zero_sign_errors(base, b, c):
     assert np.count_nonzero(robust != exact) == 0
     assert np.count_nonzero(expansion_only != exact) == 0
     # the grid is hard: the plain determinant gets many signs wrong
-    assert np.count_nonzero(naive != exact) > 100
+    assert np.count_nonzero(naive != exact) > k
     assert np.count_nonzero(exact > 0) > 0 and np.count_nonzero(exact < 0) > 0
 
 
@@ -180,7 +182,7 @@ def exact_interiors_overlap(p, q):
 def test_narrow_phase_matches_exact_reference_on_lattice_triangles():
     # Integer lattice vertices: touching, collinear and coincident cases are frequent.
     rng = np.random.default_rng(11)
-    n = 1500
+    n = 1000
     cen = rng.integers(0, 40, (n, 1, 2))
     Xi = (cen + rng.integers(-3, 4, (n, 3, 2))).reshape(-1, 2)
     T = np.arange(3 * n).reshape(n, 3).astype(np.int32)
@@ -341,6 +343,11 @@ def test_bad_input_raises_clear_errors():
         collision.boundary_edge_mask(T, [[3, 0]])      # reversed: triangle on the right
     with pytest.raises(ValueError, match="candidates or boundary_edges"):
         collision.detect_collisions(X, None, T)
+    # the no-work path still checks shapes
+    with pytest.raises(ValueError, match="tris"):
+        collision.detect_collisions(X, None, T[:, :2], boundary_edges=np.zeros((0, 2), int))
+    with pytest.raises(ValueError, match="candidates"):
+        collision.detect_collisions(X, None, T, candidates=np.zeros(3, bool))
     with pytest.raises(ValueError, match="a, b and c"):
         collision.orient2d(np.zeros((2, 2)), np.zeros((3, 2)), np.zeros((2, 2)))
 
