@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <tuple>
 #include <unordered_map>
 
 namespace ngfracture
@@ -215,6 +216,10 @@ namespace ngfracture
     std::vector<ContactCandidate> out;
     const double * x = soup.x;
     const int32_t * T = soup.tris;
+    // Slaves already constrained by an earlier pair: among equally deep nodes the others
+    // go first, so that a corner triangle with two penetrating nodes (which meets only one
+    // triangle of the other body) still gets both constrained across its pairs.
+    std::vector<char> used(soup.nv, 0);
     for (int64_t pi = 0; pi < npairs; pi++)
       for (int dir = 0; dir < 2; dir++)
         {
@@ -243,10 +248,23 @@ namespace ngfracture
               // Rule 2: master segments are boundary (or crack) edges; the node's
               // distance to the master is that of its nearest way out through one of
               // them (largest signed distance among edges it projects onto).
+              // Outward boundary normal of the slave body at b (sum over the slave's
+              // boundary edges at b): a master edge must face it. Without this a node at
+              // the corner of an overlap picks the outer edge it lies on (gap 0).
+              double ns[2] = { 0.0, 0.0 };
+              for (int e : { m, (m+2)%3 })
+                if (bmask[3*S + e])
+                  {
+                    const double * p0 = x + 2*ts[e], * p1 = x + 2*ts[(e+1)%3];
+                    double l = std::hypot(p1[0]-p0[0], p1[1]-p0[1]);
+                    if (l > 0) { ns[0] += (p1[1]-p0[1])/l; ns[1] += -(p1[0]-p0[0])/l; }
+                  }
               int kbest = -1; double dbest = 0, xibest = 0;
               for (int k = 0; k < 3; k++)
                 {
                   if (!bmask[3*M + k] || !(len[k] > 0)) continue;
+                  if (nrm[k][0]*ns[0] + nrm[k][1]*ns[1] >= 0 && (ns[0] != 0 || ns[1] != 0))
+                    continue;
                   int32_t a = tm[k], c = tm[(k+1)%3];
                   if (b == a || b == c) continue;
                   const double * xa = x + 2*a, * xc = x + 2*c;
@@ -289,19 +307,20 @@ namespace ngfracture
           if (ncand == 0) continue;                     // rule 4
           // Rule 2: the nearest (most penetrating) node. Rule 3: nodes equally near,
           // within the precision threshold (at least 1e-12 of the element size), are
-          // ranked by angle; the chosen angle must not exceed angle_tol.
+          // ranked: not yet constrained first, then by angle, then by depth; the chosen
+          // angle must not exceed angle_tol.
           double dmin = cand[0].dist;
           for (int i = 1; i < ncand; i++) dmin = std::min(dmin, cand[i].dist);
           double window = std::max(tol, 1e-12 * scale);
           int best = -1;
+          auto key = [&] (int i) { return std::make_tuple(used[cand[i].slave], cand[i].angle, cand[i].dist); };
           for (int i = 0; i < ncand; i++)
             {
               if (cand[i].dist > dmin + window) continue;
-              if (best < 0 || cand[i].angle < cand[best].angle
-                  || (cand[i].angle == cand[best].angle && cand[i].dist < cand[best].dist))
-                best = i;
+              if (best < 0 || key(i) < key(best)) best = i;
             }
           if (cand[best].angle > angle_tol) continue;   // rule 3 threshold, then rule 4
+          used[cand[best].slave] = 1;
           out.push_back(cand[best]);
         }
     return out;

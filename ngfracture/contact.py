@@ -37,20 +37,21 @@ Selection rules (per colliding pair, see ``SelectContacts`` in cpp_ext/collision
    xi = 0 or 1) and whose signed distance d satisfies -height < d <= tol, height being
    the master's height over that edge (deeper nodes have gone past the element; the node
    need not lie inside the master itself: it may sit in a neighbour that touches the
-   boundary only at a vertex, which is not a candidate element). A node's distance to
+   boundary only at a vertex, which is not a candidate element), and the master edge's
+   normal faces the slave body's boundary normal at the node (their dot product is
+   negative; the slave normal is the sum of the normals of the slave triangle's boundary
+   edges at the node, if it has any). A node's distance to
    the master is that of its nearest way out, the largest d over the master's boundary
    edges; the node with the smallest distance (deepest penetration) wins;
 3. nodes equally deep within the precision threshold (at least 1e-12 of the element
-   size) are ranked by the angle between the master segment and the node's two edges
-   in the slave triangle, smallest first; the chosen angle must be <= angle_tol (the
-   default pi/2 only ranks, it rejects nothing);
+   size) are ranked: nodes not yet a slave of an earlier pair first (our addition: a
+   corner triangle with two penetrating nodes meets only one triangle of the other body,
+   and rule 1 would otherwise leave one of them free), then by the angle between the
+   master segment and the node's two edges in the slave triangle, smallest first; the
+   chosen angle must be <= angle_tol (the default pi/2 only ranks, it rejects nothing);
 4. otherwise no constraint.
 
 Identical constraints (same slave, a, c) found through different pairs are merged.
-Known weakness: where a slave node lies on the extension of an outer boundary edge of the
-other body (the corners of an overlap), the nearest exit may be that edge, giving a row
-with gap 0 and a tangential normal; as an inequality it is harmless (an active-set solve
-releases it if adhesive) but it is not the physically intended interface constraint.
 """
 from dataclasses import dataclass
 

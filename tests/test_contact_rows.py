@@ -277,3 +277,50 @@ def test_contact_constraints_pipeline_and_no_work_without_candidates():
 if __name__ == "__main__":
     import sys
     sys.exit(pytest.main([__file__, "-q"]))
+
+
+def graph_laplacian_K(T, nv, mass=1.0):
+    """SPD stand-in for a stiffness matrix: mass + graph Laplacian per component."""
+    e = np.concatenate([T[:, [0, 1]], T[:, [1, 2]], T[:, [2, 0]]])
+    A = sp.csr_matrix((np.ones(len(e)), (e[:, 0], e[:, 1])), shape=(nv, nv))
+    A = ((A + A.T) > 0).astype(float)
+    L = sp.diags(np.asarray(A.sum(axis=1)).ravel()) - A
+    K1 = mass * sp.identity(nv) + L
+    return sp.block_diag([K1, K1]).tocsc()             # component-blocked dofs
+
+
+def test_kkt_with_contact_rows_separates_pressed_blocks():
+    import scipy.sparse.linalg as spla
+    X, U, T, frag = two_blocks(n=8, overlap=0.01)
+    E = boundary_edges_of(T)
+    nv = len(X)
+    cs = contact.contact_constraints(X, U, T, E, fragment=frag)
+    K = graph_laplacian_K(T, nv)
+    u_pred = U.T.ravel()
+    f = K @ u_pred                                     # without contact: u = u_pred
+    m = len(cs)
+    KKT = sp.bmat([[K, cs.C.T], [cs.C, None]], format="csc")
+    rhs = np.concatenate([f, -cs.g])
+    sol = spla.spsolve(KKT, rhs)
+    u, lam = sol[:2 * nv], sol[2 * nv:]
+    assert np.linalg.norm(KKT @ sol - rhs) / np.linalg.norm(rhs) < 1e-10
+    assert np.abs(cs.C @ u + cs.g).max() < 1e-12
+    # sign convention: compressive contact gives lambda <= 0 (the paper's p_N <= 0)
+    across = np.abs(cs.normal[:, 0]) == 1.0
+    assert lam[across].max() < 0
+    assert np.all(lam <= 1e-12)
+    # load balance: f = K u + C^T lambda
+    assert np.linalg.norm(f - K @ u - cs.C.T @ lam) <= 1e-10 * np.linalg.norm(f)
+    # all selected rows before redundancy removal hold as well (consistent g)
+    pairs = collision.detect_collisions(X, U, T, boundary_edges=E, fragment=frag)
+    full = contact.select_contacts(X, U, T, E, pairs)
+    assert np.abs(full.C @ u + full.g).max() < 1e-12
+    # and the blocks no longer overlap, except at one end of the interface: this mesh
+    # meets the other block in exactly one triangle pair per cell, so rule 1 (one slave
+    # per direction and pair) covers n of the n + 1 interface nodes per side
+    Uc = u.reshape(2, nv).T
+    after = collision.detect_collisions(X, Uc, T, boundary_edges=E, fragment=frag)
+    assert len(pairs) == 10 and len(after) <= 2
+    assert np.all((X + Uc)[T[after.ravel()]][:, :, 1].max(axis=1) == 1.0)   # top end
+    corner = np.flatnonzero((X[:, 0] == 1.0) & (X[:, 1] == 1.0))        # nodes 80, 89
+    assert not np.isin(corner, full.slave).any()
