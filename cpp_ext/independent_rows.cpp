@@ -100,6 +100,7 @@ namespace ngfracture
             { lo = std::min(lo, indices[t]); hi = std::max(hi, indices[t]); }
           W = std::max<int64_t>(W, hi - lo + 1);
         }
+    const double drop = 64 * 2.220446049250313e-16;   // rows have unit norm
     std::vector<double> R(k * W, 0.0);          // R(j, j + d) at R[j*W + d]
     std::vector<char> filled(k, 0);
     std::vector<double> x(k + W, 0.0);          // work row, dense over a moving window
@@ -119,7 +120,8 @@ namespace ngfracture
             double * r = &R[j*W];
             if (!filled[j])
               {
-                if (std::abs(xj) <= rtol) { x[j] = 0.0; continue; }   // below threshold
+                // Round-off, not a pivot: dropping it perturbs A far below rtol.
+                if (std::abs(xj) <= drop) { x[j] = 0.0; continue; }
                 for (int64_t d = 0; d < W && j + d <= hi; d++) { r[d] = x[j+d]; x[j+d] = 0.0; }
                 filled[j] = 1;
                 break;

@@ -19,8 +19,9 @@ namespace ngfracture
   // column order by a banded Givens QR of the n x k matrix A^T (CSR: one row per dof,
   // column indices in the chosen order, entries of unit-norm constraint rows). Column j
   // is kept iff its distance from the span of the kept columns before it exceeds rtol
-  // (|R_jj| > rtol); intermediate pivots below rtol are dropped (treated as zero), which
-  // keeps rank decisions consistent with the threshold. Cost O(n W^2) with W the largest
+  // (|R_jj| > rtol); intermediate pivots at round-off level (64 eps) are dropped rather
+  // than used as pivots. (Dropping at rtol instead perturbs A by rtol-sized entries and
+  // lets dependent columns pass the rtol test.) Cost O(n W^2) with W the largest
   // column span of a row (small after a reverse Cuthill-McKee ordering).
   std::vector<int32_t> IndependentColumnsBanded (const int64_t * indptr, const int32_t * indices,
                                                  const double * data, int64_t n, int64_t k,

@@ -324,3 +324,33 @@ def test_kkt_with_contact_rows_separates_pressed_blocks():
     assert np.all((X + Uc)[T[after.ravel()]][:, :, 1].max(axis=1) == 1.0)   # top end
     corner = np.flatnonzero((X[:, 0] == 1.0) & (X[:, 1] == 1.0))        # nodes 80, 89
     assert not np.isin(corner, full.slave).any()
+
+
+def test_xi_snap_turns_near_duplicates_into_duplicates():
+    X, U, T, frag = two_blocks(n=8, overlap=0.01)
+    U[frag_vertices(T, frag, 1), 1] += 1e-7            # tiny tangential slip of block 2
+    E = boundary_edges_of(T)
+    pairs = collision.detect_collisions(X, U, T, boundary_edges=E, fragment=frag)
+    raw = contact.select_contacts(X, U, T, E, pairs, xi_snap=0.0)
+    snapped = contact.select_contacts(X, U, T, E, pairs)
+    assert np.array_equal(raw.slave, snapped.slave)
+    near_end = np.minimum(raw.xi, 1 - raw.xi) < 1e-3
+    assert np.count_nonzero((raw.xi > 0) & (raw.xi < 1) & near_end) > 0
+    assert np.all((snapped.xi[near_end] == 0) | (snapped.xi[near_end] == 1))
+    # the gap at the predicted state does not change: C u_pred + g = dist either way
+    u = U.T.ravel()
+    assert np.allclose(raw.C @ u + raw.g, snapped.C @ u + snapped.g, atol=1e-15, rtol=0)
+    # unsnapped: opposite rows are independent only at the 1e-6 level
+    k_raw = contact.independent_rows(raw.C)
+    s_raw = np.linalg.svd(raw.C[k_raw].toarray(), compute_uv=False)
+    assert s_raw[-1] < 1e-5
+    # snapped: they are exact duplicates, removed, and the rest is well conditioned
+    k_snap = contact.independent_rows(snapped.C)
+    s_snap = np.linalg.svd(snapped.C[k_snap].toarray(), compute_uv=False)
+    assert len(k_snap) < len(k_raw) and s_snap[-1] > 1e-3
+    with pytest.raises(ValueError, match="xi_snap"):
+        contact.select_contacts(X, U, T, E, pairs, xi_snap=0.5)
+
+
+def frag_vertices(T, frag, f):
+    return np.unique(T[frag == f])
