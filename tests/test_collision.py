@@ -199,11 +199,6 @@ def test_narrow_phase_matches_exact_reference_on_lattice_triangles():
     assert np.array_equal(found2, found)
 
 
-def tri_pair(p, q):
-    X = np.array(list(p) + list(q), float)
-    return X, np.array([[0, 1, 2]], np.int32), np.array([[3, 4, 5]], np.int32)
-
-
 def collide(p, q, tol=0.0):
     X = np.array(list(p) + list(q), float)
     T = np.array([[0, 1, 2], [3, 4, 5]], np.int32)

@@ -274,10 +274,6 @@ def test_contact_constraints_pipeline_and_no_work_without_candidates():
     assert len(empty) == 0 and empty.C.shape == (0, 2 * len(X))
 
 
-if __name__ == "__main__":
-    import sys
-    sys.exit(pytest.main([__file__, "-q"]))
-
 
 def graph_laplacian_K(T, nv, mass=1.0):
     """SPD stand-in for a stiffness matrix: mass + graph Laplacian per component."""
@@ -354,3 +350,8 @@ def test_xi_snap_turns_near_duplicates_into_duplicates():
 
 def frag_vertices(T, frag, f):
     return np.unique(T[frag == f])
+
+
+if __name__ == "__main__":
+    import sys
+    sys.exit(pytest.main([__file__, "-q"]))
