@@ -228,7 +228,9 @@ namespace ngfracture
           int32_t M = pairs[2*pi + dir], S = pairs[2*pi + 1 - dir];
           const int32_t * tm = T + 3*M, * ts = T + 3*S;
           // Outward unit normals of the master's edges (reference orientation: the
-          // master is on the left of t[k] -> t[k+1]).
+          // master is on the left of t[k] -> t[k+1]; an element inverted in the current
+          // state would get inward normals, but inversion is the elasticity's failure,
+          // not a contact configuration).
           double nrm[3][2], len[3];
           for (int k = 0; k < 3; k++)
             {

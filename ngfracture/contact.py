@@ -23,7 +23,10 @@ negative = penetration (the paper's "distance is negative in case of penetration
 is eq. 14 with the paper's n taken as the master's *inward* normal. C is (m, 2 nv), u the
 total displacement in the layout above, g = C-row applied to the reference coordinates.
 The non-penetration condition is g_N >= 0; an active constraint imposes C u + g = 0. For a
-Newton increment du from u_k use C du = -(C u_k + g). For any rigid translation of the
+Newton increment du from u_k use C du = -(C u_k + g). With eq. 12 written as
+[[K, G^T, C^T], [G, 0, 0], [C, 0, 0]] [u; lambda_D; lambda_c] = [f; b; -g], compressive
+contact gives lambda_c <= 0 (the paper's p_N <= 0, tested); lambda_c > 0 is adhesive and
+the row is to be released by the active-set loop. For any rigid translation of the
 whole configuration C u is unchanged, and for translations of the slave relative to the
 master C u + g is the exact signed distance.
 
@@ -158,6 +161,8 @@ def gap_rows(coords, slave, a, c, xi, normal):
     m = len(slave)
     if not (len(a) == len(c) == len(xi) == n.shape[0] == m):
         raise ValueError("slave, a, c, xi and normal must have the same length")
+    if not (np.isfinite(xi).all() and np.isfinite(n).all()):
+        raise ValueError("xi and normal must be finite")
     for name, v in (("slave", slave), ("a", a), ("c", c)):
         if m and (v.min() < 0 or v.max() >= nv):
             raise ValueError(f"{name} holds vertex indices outside [0, {nv})")
@@ -223,6 +228,8 @@ def select_contacts(coords, displacement, tris, boundary_edges, pairs, tol=0.0,
     P = _as_array(pairs, "pairs", np.int32, 2)
     if P.size and (P.min() < 0 or P.max() >= T.shape[0]):
         raise ValueError(f"pairs holds triangle indices outside [0, {T.shape[0]})")
+    if np.any(P[:, 0] == P[:, 1]):
+        raise ValueError("pairs must pair two different triangles")
     if P.shape[0] == 0:
         ids, geo = np.zeros((0, 6), np.int32), np.zeros((0, 5))
     else:

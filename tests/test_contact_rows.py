@@ -94,6 +94,14 @@ def test_threshold_and_angle_rules():
         contact.select_contacts(X2, None, T2, E2, pairs, angle_tol=2.0)
     with pytest.raises(ValueError, match="tol"):
         contact.select_contacts(X2, None, T2, E2, pairs, tol=-1.0)
+    with pytest.raises(ValueError, match="different triangles"):
+        contact.select_contacts(X2, None, T2, E2, [[1, 1]])
+    with pytest.raises(ValueError, match="pairs"):
+        contact.select_contacts(X2, None, T2, E2, [[0, 2]])
+    with pytest.raises(ValueError, match="displacement"):
+        contact.select_contacts(X2, np.full((6, 2), np.nan), T2, E2, pairs)
+    with pytest.raises(ValueError, match="finite"):
+        contact.gap_rows(X2, [3], [0], [1], [np.nan], [[0.0, 1.0]])
 
 
 def test_pressed_blocks_rows():
