@@ -211,7 +211,8 @@ namespace ngfracture
 
   std::vector<ContactCandidate>
   SelectContacts (const TriangleSoup & soup, const uint8_t * bmask,
-                  const int32_t * pairs, int64_t npairs, double tol, double angle_tol)
+                  const int32_t * pairs, int64_t npairs, double tol, double angle_tol,
+                  double xi_snap)
   {
     std::vector<ContactCandidate> out;
     const double * x = soup.x;
@@ -322,8 +323,13 @@ namespace ngfracture
               if (best < 0 || key(i) < key(best)) best = i;
             }
           if (cand[best].angle > angle_tol) continue;   // rule 3 threshold, then rule 4
-          used[cand[best].slave] = 1;
-          out.push_back(cand[best]);
+          auto & cb = cand[best];
+          used[cb.slave] = 1;
+          // A (near) node-to-node constraint also covers the partner node: the other
+          // direction of the pair then prefers a node not yet in contact.
+          if (cb.xi <= xi_snap) used[cb.c] = 1;
+          if (cb.xi >= 1.0 - xi_snap) used[cb.a] = 1;
+          out.push_back(cb);
         }
     return out;
   }

@@ -52,7 +52,8 @@ namespace ngfracture
 
   std::vector<ContactCandidate>
   SelectContacts (const TriangleSoup & soup, const uint8_t * boundary_edge_mask,
-                  const int32_t * pairs, int64_t npairs, double tol, double angle_tol);
+                  const int32_t * pairs, int64_t npairs, double tol, double angle_tol,
+                  double xi_snap);
 }
 
 #endif

@@ -115,7 +115,8 @@ void ExportCollision (py::module & m)
         "Narrow phase for each pair: interiors overlap or distance <= tol (tol > 0).");
 
   m.def("SelectContacts",
-        [] (DArr x, IArr tris, BArr bmask, IArr pairs, double tol, double angle_tol)
+        [] (DArr x, IArr tris, BArr bmask, IArr pairs, double tol, double angle_tol,
+            double xi_snap)
         {
           auto soup = MakeSoup(x, tris);
           CheckShape(bmask, 3, "boundary_edge_mask");
@@ -129,7 +130,7 @@ void ExportCollision (py::module & m)
           std::vector<ContactCandidate> cc;
           {
             py::gil_scoped_release release;
-            cc = SelectContacts(soup, bmask.data(), pairs.data(), np, tol, angle_tol);
+            cc = SelectContacts(soup, bmask.data(), pairs.data(), np, tol, angle_tol, xi_snap);
           }
           py::ssize_t k = cc.size();
           py::array_t<int32_t> ids({ k, py::ssize_t(6) });
@@ -146,7 +147,7 @@ void ExportCollision (py::module & m)
           return py::make_tuple(ids, geo);
         },
         py::arg("x"), py::arg("tris"), py::arg("boundary_edge_mask"), py::arg("pairs"),
-        py::arg("tol") = 0.0, py::arg("angle_tol") = 1.5707963267948966,
+        py::arg("tol") = 0.0, py::arg("angle_tol") = 1.5707963267948966, py::arg("xi_snap") = 0.0,
         "Node-to-segment constraints by rules 1-4: ids (slave, a, c, master_tri, slave_tri, pair)"
         " and geometry (xi, nx, ny, dist, angle) per constraint.");
 

@@ -47,9 +47,11 @@ Selection rules (per colliding pair, see ``SelectContacts`` in cpp_ext/collision
    the master is that of its nearest way out, the largest d over the master's boundary
    edges; the node with the smallest distance (deepest penetration) wins;
 3. nodes equally deep within the precision threshold (at least 1e-12 of the element
-   size) are ranked: nodes not yet a slave of an earlier pair first (our addition: a
-   corner triangle with two penetrating nodes meets only one triangle of the other body,
-   and rule 1 would otherwise leave one of them free), then by the angle between the
+   size) are ranked: nodes not yet in contact first (our addition: a node is in contact
+   once it is the slave of an earlier constraint, or the partner end of an earlier
+   (near, within xi_snap) node-to-node constraint; where a mesh meets the other body in
+   one triangle pair per cell, rule 1 would otherwise always pick the same end of each
+   cell and leave the last node of the interface free), then by the angle between the
    master segment and the node's two edges in the slave triangle, smallest first; the
    chosen angle must be <= angle_tol (the default pi/2 only ranks, it rejects nothing);
 4. otherwise no constraint.
@@ -234,7 +236,8 @@ def select_contacts(coords, displacement, tris, boundary_edges, pairs, tol=0.0,
         ids, geo = np.zeros((0, 6), np.int32), np.zeros((0, 5))
     else:
         mask = boundary_edge_mask(T, boundary_edges, x.shape[0])
-        ids, geo = _ext.SelectContacts(x, T, mask.view(np.uint8), P, tol, float(angle_tol))
+        ids, geo = _ext.SelectContacts(x, T, mask.view(np.uint8), P, tol, float(angle_tol),
+                                       float(xi_snap))
     # The same node-segment constraint can come from several pairs: keep the first.
     key = ids[:, :3].astype(np.int64)
     _, first = np.unique(key, axis=0, return_index=True)
