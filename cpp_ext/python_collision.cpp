@@ -166,7 +166,7 @@ void ExportCollision (py::module & m)
           std::copy(picked.begin(), picked.end(), out.mutable_data());
           return out;
         },
-        py::arg("A"), py::arg("G"), py::arg("rtol") = 1e-10,
+        py::arg("A"), py::arg("G"), py::arg("rtol") = 1e-8,
         "Rows of dense A independent of each other and of the rows of G (pivot order).");
 
   m.def("IndependentColumnsBanded",
@@ -190,7 +190,7 @@ void ExportCollision (py::module & m)
           return out;
         },
         py::arg("indptr"), py::arg("indices"), py::arg("data"), py::arg("k"),
-        py::arg("rtol") = 1e-10,
+        py::arg("rtol") = 1e-8,
         "Greedy independent columns of the CSR matrix A^T (n x k) by banded Givens QR.");
 
   m.def("IndependentRowsSparse",

@@ -359,6 +359,60 @@ def frag_vertices(T, frag, f):
     return np.unique(T[frag == f])
 
 
+def netgen_pieces(ntri, k):
+    """Unit square meshed by netgen as k x k glued pieces, cut apart (vertices per piece)."""
+    from netgen.occ import Glue, MoveTo, OCCGeometry
+    faces = []
+    for i in range(k):
+        for j in range(k):
+            f = MoveTo(i / k, j / k).Rectangle(1 / k, 1 / k).Face()
+            f.mat(f"p{i}{j}")
+            faces.append(f)
+    h = np.sqrt(2.3 / ntri)
+    ngmesh = OCCGeometry(Glue(faces), dim=2).GenerateMesh(maxh=h)
+    X = np.array(ngmesh.Coordinates())
+    el = ngmesh.Elements2D().NumPy()
+    T = np.array(el["nodes"][:, :3], dtype=np.int64) - 1
+    frag = np.array(el["index"], dtype=np.int32) - 1
+    P = X[T]
+    neg = ((P[:, 1, 0] - P[:, 0, 0]) * (P[:, 2, 1] - P[:, 0, 1])
+           - (P[:, 1, 1] - P[:, 0, 1]) * (P[:, 2, 0] - P[:, 0, 0])) < 0
+    T[neg] = T[neg][:, [0, 2, 1]]
+    key = T * k * k + frag[:, None]
+    uniq, inv = np.unique(key.ravel(), return_inverse=True)
+    return X[uniq // (k * k)], inv.reshape(T.shape).astype(np.int32), frag, h
+
+
+def test_repeated_linearised_solves_converge_on_netgen_pieces():
+    # Four netgen pieces, each expanded about its centroid: overlap 0.2 h on both cuts,
+    # a four-piece junction in the middle. Detect, select, reduce and solve the KKT
+    # system (SPD stand-in K) repeatedly, re-linearising at the last solution, with the
+    # precision threshold 0.1 h so that closed contacts stay detected.
+    import scipy.sparse.linalg as spla
+    X, T, frag, h = netgen_pieces(2000, 2)
+    E = boundary_edges_of(T)
+    nv = len(X)
+    cen = np.stack([np.bincount(frag, weights=X[T][:, :, d].mean(axis=1))
+                    / np.bincount(frag) for d in range(2)], axis=1)
+    vf = np.zeros(nv, dtype=np.int64)
+    vf[T.ravel()] = np.repeat(frag, 3)
+    U = 0.4 * h * (X - cen[vf])
+    K = graph_laplacian_K(T, nv)
+    f = K @ U.T.ravel()
+    Uk, depth = U.copy(), []
+    for _ in range(4):
+        cs = contact.contact_constraints(X, Uk, T, E, fragment=frag, tol=0.1 * h)
+        depth.append(-cs.dist.min() / h)
+        assert np.linalg.svd(cs.C.toarray(), compute_uv=False)[-1] > 1e-8
+        KKT = sp.bmat([[K, cs.C.T], [cs.C, None]], format="csc")
+        rhs = np.concatenate([f, -cs.g])
+        sol = spla.spsolve(KKT, rhs)
+        assert np.linalg.norm(KKT @ sol - rhs) <= 1e-10 * np.linalg.norm(rhs)
+        Uk = sol[:2 * nv].reshape(2, nv).T
+    assert depth[0] == pytest.approx(0.2, rel=0.05)
+    assert depth[1] < 1e-3 and max(depth[2:]) < 1e-10
+
+
 if __name__ == "__main__":
     import sys
     sys.exit(pytest.main([__file__, "-q"]))
