@@ -57,6 +57,11 @@ Selection rules (per colliding pair, see ``SelectContacts`` in cpp_ext/collision
 4. otherwise no constraint.
 
 Identical constraints (same slave, a, c) found through different pairs are merged.
+
+Threshold: with tol = 0 only pairs whose interiors overlap produce rows, so a contact
+closed by a solve (gap 0) is no longer detected at the next linearisation. For repeated
+detect-and-solve loops use tol > 0 (0.1 h worked in the tests); the rows with a positive
+gap it adds are what the active set must release when their multiplier is adhesive.
 """
 from dataclasses import dataclass
 
