@@ -6,6 +6,7 @@ namespace py = pybind11;
 using namespace ngfracture;
 
 void ExportCrack (py::module & m);   // python_crack.cpp
+void ExportCollision (py::module & m);  // python_collision.cpp
 
 static void ExportVertexAverage (py::module & m)
 {
@@ -70,7 +71,8 @@ RuntimeError
 
 PYBIND11_MODULE(_ngfracture, m)
 {
-  m.doc() = "ngfracture's C++ kernels (vertex averaging, crack splitting).";
+  m.doc() = "ngfracture's C++ kernels (vertex averaging, crack splitting, collision detection).";
   ExportVertexAverage(m);
   ExportCrack(m);
+  ExportCollision(m);
 }

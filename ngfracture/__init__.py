@@ -10,6 +10,9 @@ problem      ElasticProblem: mesh, material, constraints, solve
 rigid        rigid-body modes of the pieces and how the constraints hold them
 checkpoint   atomic, verified checkpoints
 crack        nodal strain criterion and node splitting with a netgen rebuild (C++ engine)
+collision    exact orient2d, grid broad phase and exact narrow phase on numpy arrays
+contact      node-to-segment contact rows (selection rules, gap linearisation) and
+             redundancy removal by rank-revealing QR
 """
 import ngsolve  # load NGSolve's shared libraries before the compiled add-on
 
