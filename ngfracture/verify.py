@@ -1,0 +1,240 @@
+"""Convergence studies against exact solutions (the L-shape of the paper, section 4.1).
+
+``lshape_study`` solves the L-shape problem on a sequence of uniform or graded
+meshes, measures relative L2 and energy-norm errors against eq. 15 and fits
+the rates.  Two boundary-value problems share the exact solution:
+
+``"dirichlet"``
+    exact displacement on the whole boundary;
+``"traction-free"``
+    exact displacement on the outer edges, zero traction (natural) on the two
+    reentrant edges, where the exact solution is traction-free.
+
+Dirichlet data are put on the boundary dofs with NGSolve's ``Set(uex, BND)``,
+a local L2 projection on the boundary edges whose vertex values are averaged
+between neighbouring edges: it is *not* nodal interpolation.  The L2 errors
+with Dirichlet data everywhere depend on this choice (nodal interpolation,
+``Set(..., dual=True)`` for order 1, gave L2 errors 1.2 to 2 times different
+in earlier measurements, see NGSOLVE_NOTES.md); energy errors and rates do
+not.  The exact-solution energy is the same for both.
+
+The solvers: ``"plain"`` is a textbook NGSolve linear-elasticity solve (the
+baseline of the benchmark), ``"ngfracture"`` goes through
+``ngfracture.ElasticProblem``.
+"""
+import math
+import time
+
+import ngsolve as ng
+import numpy as np
+
+from . import lshape
+
+VARIANTS = ("dirichlet", "traction-free")
+MESHES = ("uniform", "graded")
+MODELS = ("linear",)
+SOLVERS = ("plain", "ngfracture")
+
+
+def dirichlet_boundaries(variant):
+    """Names of the boundaries carrying Dirichlet data in a variant, as a regex for NGSolve.
+
+    Parameters
+    ----------
+    variant : {"dirichlet", "traction-free"}
+
+    Returns
+    -------
+    str
+
+    Raises
+    ------
+    ValueError
+        On an unknown variant.
+    """
+    if variant == "dirichlet":
+        return "outer|reentrant"
+    if variant == "traction-free":
+        return "outer"
+    raise ValueError(f"variant must be one of {VARIANTS}, got {variant!r}")
+
+
+def solve_plain(mesh, order, sol, variant="dirichlet", dual=False):
+    """Plain NGSolve linear-elasticity solve of the L-shape problem (the baseline).
+
+    ``BilinearForm`` of linear elasticity, ``gfu.Set(uex, BND)`` on the
+    Dirichlet boundaries, sparse Cholesky on the free dofs, all inside
+    ``TaskManager``.
+
+    Parameters
+    ----------
+    mesh : ngsolve.Mesh
+        An L-shape mesh.
+    order : int
+        Polynomial order of the VectorH1 space.
+    sol : lshape.LShapeSolution
+        Exact solution (Dirichlet data and Lame parameters).
+    variant : {"dirichlet", "traction-free"}
+        Boundary-value problem.
+    dual : bool
+        Use ``Set(..., dual=True)`` (vertex values exact: nodal interpolation
+        for order 1) instead of the default local L2 projection.
+
+    Returns
+    -------
+    ngsolve.GridFunction
+        The discrete displacement.
+    """
+    bnd = dirichlet_boundaries(variant)
+    with ng.TaskManager():
+        fes = ng.VectorH1(mesh, order=order, dirichlet=bnd)
+        u, v = fes.TnT()
+        a = ng.BilinearForm(fes, symmetric=True)
+        a += ng.InnerProduct(sol.stress_of(u), ng.Sym(ng.Grad(v))) * ng.dx
+        a.Assemble()
+        gfu = ng.GridFunction(fes)
+        gfu.Set(sol.u, ng.BND, definedon=mesh.Boundaries(bnd), dual=dual)
+        inv = a.mat.Inverse(fes.FreeDofs(), inverse="sparsecholesky")
+        res = (-a.mat * gfu.vec).Evaluate()
+        gfu.vec.data += inv * res
+    return gfu
+
+
+def solve_ngfracture(mesh, order, sol, variant="dirichlet", model="linear"):
+    """The L-shape problem solved through ``ngfracture.ElasticProblem``.
+
+    Parameters
+    ----------
+    mesh : ngsolve.Mesh
+    order : int
+    sol : lshape.LShapeSolution
+    variant : {"dirichlet", "traction-free"}
+    model : {"linear"}
+        Material model; only the linear one has eq. 15 as exact solution.
+
+    Returns
+    -------
+    ngsolve.GridFunction
+        ``prob.u``.
+
+    Raises
+    ------
+    RuntimeError
+        If the elasticity core is not available or the solve did not converge.
+    """
+    try:
+        from .problem import ElasticProblem
+        from .materials import LinearElastic
+    except ImportError as exc:  # the core lives on branch main until merged
+        raise RuntimeError("ngfracture.ElasticProblem is not available in this build; "
+                           "use solver='plain'") from exc
+    bnd = dirichlet_boundaries(variant)
+    mat = LinearElastic(E=sol.E, nu=sol.nu, plane=sol.plane)
+    prob = ElasticProblem(mesh, mat, order=order)
+    prob.add_dirichlet(bnd.split("|"), value=sol.u)
+    status = prob.solve(method="full", load_steps=1, tol=1e-10, maxit=5)
+    if not status.converged:
+        raise RuntimeError(f"ngfracture solve did not converge: {status.reason}")
+    return prob.u
+
+
+def fit_rate(h, err, last=3):
+    """Rate ``k`` of ``err ~ h^k`` fitted by least squares in log-log over the last points.
+
+    Parameters
+    ----------
+    h, err : sequence of float
+        Mesh sizes and errors, coarse to fine.
+    last : int
+        Number of finest points used (all if fewer are given).
+
+    Returns
+    -------
+    float or None
+        The slope of ``np.polyfit(log h, log err, 1)``; None with fewer than two
+        points or a non-positive error.
+    """
+    h, err = np.asarray(h, float)[-last:], np.asarray(err, float)[-last:]
+    if len(h) < 2 or np.any(err <= 0) or np.any(h <= 0):
+        return None
+    return float(np.polyfit(np.log(h), np.log(err), 1)[0])
+
+
+def lshape_study(order, levels, variant="dirichlet", model="linear", mesh="uniform",
+                 E=1e5, nu=0.3, h0=0.5, gamma=None, solver="plain", plane="strain"):
+    """Convergence study of the L-shape problem (paper section 4.1, eq. 15).
+
+    Parameters
+    ----------
+    order : int
+        Polynomial order, >= 1.
+    levels : int
+        Number of meshes, >= 2: the coarse mesh and ``levels - 1`` uniform refinements.
+    variant : {"dirichlet", "traction-free"}
+        Dirichlet data on the whole boundary, or traction-free reentrant edges.
+    model : {"linear"}
+        Material model (eq. 15 is a linear-elastic solution).
+    mesh : {"uniform", "graded"}
+        Uniform refinements, or the same meshes graded toward the corner.
+    E, nu : float
+        Young's modulus and Poisson's ratio.
+    h0 : float
+        Maximal edge length of the coarse mesh.
+    gamma : float, optional
+        Grading exponent for ``mesh="graded"``; default ``lshape.default_grading(order)``.
+    solver : {"plain", "ngfracture"}
+        Plain NGSolve solve, or ``ngfracture.ElasticProblem``.
+    plane : {"strain", "stress"}
+        2D reduction.
+
+    Returns
+    -------
+    dict
+        ``{"problem": "lshape", "variant", "order", "model", "mesh", "gamma", "solver",
+        "E", "nu", "alpha", "levels": [{"level", "ndof", "nverts", "h", "rel_l2",
+        "rel_energy", "time_s"}, ...], "rates": {"l2", "energy"}}``.  ``h`` is the
+        largest edge length, ``time_s`` the wall time of the solve (space, assembly,
+        boundary data, factorisation), rates are fitted over the finest three levels.
+
+    Raises
+    ------
+    ValueError
+        On an unknown option or an out-of-range number.
+    RuntimeError
+        If ``solver="ngfracture"`` and the elasticity core is unavailable or fails.
+    """
+    lshape._check_int("order", order, 1)
+    lshape._check_int("levels", levels, 2)
+    dirichlet_boundaries(variant)
+    if model not in MODELS:
+        raise ValueError(f"model must be one of {MODELS} (eq. 15 is a linear-elastic solution), "
+                         f"got {model!r}")
+    if mesh not in MESHES:
+        raise ValueError(f"mesh must be one of {MESHES}, got {mesh!r}")
+    if solver not in SOLVERS:
+        raise ValueError(f"solver must be one of {SOLVERS}, got {solver!r}")
+    if mesh == "uniform":
+        if gamma is not None and gamma != 1.0:
+            raise ValueError("gamma is only used with mesh='graded'")
+        gamma = 1.0
+    elif gamma is None:
+        gamma = lshape.default_grading(order)
+    sol = lshape.LShapeSolution(E, nu, plane)
+    rows = []
+    for level, m in enumerate(lshape.mesh_hierarchy(levels, h0, gamma)):
+        t0 = time.perf_counter()
+        if solver == "plain":
+            uh = solve_plain(m, order, sol, variant)
+        else:
+            uh = solve_ngfracture(m, order, sol, variant, model)
+        elapsed = time.perf_counter() - t0
+        rel_l2, rel_energy = lshape.energy_errors(m, uh, sol, order)
+        rows.append({"level": level, "ndof": uh.space.ndof, "nverts": m.nv,
+                     "h": lshape.max_edge_length(m), "rel_l2": rel_l2,
+                     "rel_energy": rel_energy, "time_s": elapsed})
+    h = [r["h"] for r in rows]
+    return {"problem": "lshape", "variant": variant, "order": order, "model": model,
+            "mesh": mesh, "gamma": gamma, "solver": solver, "E": E, "nu": nu,
+            "alpha": sol.alpha, "levels": rows,
+            "rates": {"l2": fit_rate(h, [r["rel_l2"] for r in rows]),
+                      "energy": fit_rate(h, [r["rel_energy"] for r in rows])}}
