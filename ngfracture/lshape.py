@@ -169,7 +169,9 @@ class LShapeSolution:
         # Angle from the bisector: the branch cut of atan2 then points into the
         # removed quadrant (phi = -pi/4), never through the domain.
         th = ng.atan2(-sb * x + cb * y, cb * x + sb * y)
-        cp, sp = x / r, y / r  # cos and sin of the ordinary polar angle phi
+        # cos and sin of the ordinary polar angle phi = theta + beta; not x/r, so that
+        # u is finite (zero) at the corner itself (Set(..., dual=True) evaluates there).
+        cp, sp = ng.cos(th + beta), ng.sin(th + beta)
         ap, am = a + 1.0, a - 1.0
         kp, km = (c2 - ap) * c1, (c2 + am) * c1
         f = -ap * ng.cos(ap * th) + kp * ng.cos(am * th)
