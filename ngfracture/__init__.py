@@ -3,14 +3,16 @@
 Submodules
 ----------
 materials    hyperelastic energies (linear, St Venant-Kirchhoff, neo-Hookean)
-constraints  Dirichlet, gliding and point constraints (Lagrange multipliers)
+constraints  Dirichlet, gliding and point constraints (Lagrange multiplier rows)
 kkt          the constrained linear solve (elimination + Schur complement)
 solver       modified and full Newton-Raphson with a status that says why it stopped
-lshape       the L-shape manufactured solution of the paper (section 4.1)
-verify       convergence studies against exact solutions
+problem      ElasticProblem: mesh, material, constraints, solve
 """
 import ngsolve  # load NGSolve's shared libraries before the compiled add-on
 
 from ._ngfracture import ElementAreas, VertexAverage
+from .materials import LinearElastic, NeoHookean, StVenantKirchhoff, lame_parameters, make_material
+from .problem import ElasticProblem
+from .solver import SolveStatus
 
 __version__ = "0.1.0"

@@ -1,0 +1,231 @@
+"""Linear constraints on the displacement: the rows G u = b of the paper's eq. 3.
+
+Two kinds of rows are kept apart because they are solved differently (see kkt.py):
+
+* single-dof rows ``u[dof] = value``: Dirichlet and gliding conditions on named
+  boundaries and point constraints on single vertices.  They are eliminated
+  exactly from the KKT system; their multipliers are the reaction forces.
+* general rows ``C u = g``: anything that couples several dofs (contact,
+  rigid-body modes of free fragments, inclined gliding).  They stay Lagrange
+  multipliers, solved through a Schur complement on the small multiplier block.
+
+Dof layout (NGSolve's VectorH1): component c of scalar dof i is ``c * n + i`` with
+n the number of scalar dofs; scalar dof i < number of vertices is vertex i.
+"""
+from dataclasses import dataclass, field
+
+import numpy as np
+import ngsolve as ng
+import scipy.sparse as sp
+
+COMPONENTS = {None: (0, 1), 0: (0,), 1: (1,), "x": (0,), "y": (1,)}
+
+
+def _components(component):
+    try:
+        return COMPONENTS[component]
+    except (KeyError, TypeError):
+        raise ValueError(f"component must be None (both), 0/'x' or 1/'y', got {component!r}") from None
+
+
+def _as_vector_cf(value, comps):
+    """A 2-vector CoefficientFunction from a number, a pair or a CF (gliding: one component)."""
+    if isinstance(value, ng.CoefficientFunction):
+        cf = value
+        if cf.dim == 1:
+            if len(comps) != 1:
+                raise ValueError("a scalar value needs component=0 or 1 (gliding); give a pair for both")
+            return ng.CF((cf, 0)) if comps == (0,) else ng.CF((0, cf))
+        if cf.dim != 2:
+            raise ValueError(f"a Dirichlet value must have 1 or 2 components, this CoefficientFunction has {cf.dim}")
+        return cf
+    arr = np.asarray(value, dtype=float)
+    if not np.all(np.isfinite(arr)):
+        raise ValueError(f"a Dirichlet value must be finite, got {value!r}")
+    if arr.ndim == 0:
+        if len(comps) != 1:
+            return ng.CF((float(arr), float(arr)))
+        return ng.CF((float(arr), 0.0)) if comps == (0,) else ng.CF((0.0, float(arr)))
+    if arr.shape != (2,):
+        raise ValueError(f"a Dirichlet value must be a number or a pair, got {value!r}")
+    return ng.CF((float(arr[0]), float(arr[1])))
+
+
+@dataclass
+class Dirichlet:
+    """Prescribed displacement on named boundaries (component=None: both; 0 or 1: gliding)."""
+    boundaries: tuple
+    value: object
+    component: object = None
+
+
+@dataclass
+class PointConstraint:
+    """Prescribed displacement of one vertex."""
+    vertex: int
+    value: tuple
+    component: object = None
+
+
+@dataclass
+class ConstraintRows:
+    """The assembled constraints: fixed dofs with target values, plus general rows C u = g."""
+    fixed_dofs: np.ndarray
+    fixed_values: np.ndarray
+    C: sp.csr_matrix
+    g: np.ndarray
+    labels: list = field(default_factory=list)
+
+    @property
+    def n_rows(self):
+        return len(self.fixed_dofs) + self.C.shape[0]
+
+
+class ConstraintSet:
+    """The constraints of one elasticity problem on a VectorH1 space.
+
+    Parameters
+    ----------
+    fes : ngsolve.VectorH1
+        The displacement space.
+    """
+
+    def __init__(self, fes):
+        self.fes = fes
+        self.mesh = fes.mesh
+        self.scalar = ng.H1(self.mesh, order=fes.globalorder)
+        self.dirichlet = []
+        self.points = []
+        self.rows = []  # (C, g, label)
+
+    # -- adding constraints (validated at once, before any assembly) ----------------
+    def add_dirichlet(self, boundaries, value=(0.0, 0.0), component=None):
+        """Prescribe the displacement on one or more named boundaries.
+
+        Parameters
+        ----------
+        boundaries : str or sequence of str
+            Boundary names of the mesh; every name must exist.
+        value : float, pair, or ngsolve.CoefficientFunction
+            Prescribed displacement (a 2-vector, or a scalar with ``component``).
+        component : None, 0/'x' or 1/'y'
+            None prescribes both components; 0 or 1 only that one (gliding).
+
+        Raises
+        ------
+        ValueError
+            If a boundary name matches nothing, or the value or component is invalid.
+        """
+        names = (boundaries,) if isinstance(boundaries, str) else tuple(boundaries)
+        if not names:
+            raise ValueError("add_dirichlet needs at least one boundary name")
+        known = set(self.mesh.GetBoundaries())
+        for name in names:
+            if not isinstance(name, str) or name not in known:
+                raise ValueError(f"boundary {name!r} does not exist in the mesh; its boundaries are {sorted(known)}")
+        comps = _components(component)
+        cf = _as_vector_cf(value, comps)
+        self.dirichlet.append(Dirichlet(names, cf, component))
+
+    def add_point(self, vertex, value=(0.0, 0.0), component=None):
+        """Prescribe the displacement of a single vertex.
+
+        Parameters
+        ----------
+        vertex : int
+            Vertex number (NGSolve numbering, 0-based).
+        value : float or pair
+            Prescribed displacement.
+        component : None, 0/'x' or 1/'y'
+
+        Raises
+        ------
+        ValueError
+            If the vertex does not exist or the value is invalid.
+        """
+        if isinstance(vertex, bool) or not isinstance(vertex, (int, np.integer)) or not 0 <= vertex < self.mesh.nv:
+            raise ValueError(f"vertex {vertex!r} does not exist; the mesh has {self.mesh.nv} vertices")
+        comps = _components(component)
+        arr = np.broadcast_to(np.asarray(value, dtype=float), (2,)) if np.ndim(value) == 0 else np.asarray(value, float)
+        if arr.shape != (2,) or not np.all(np.isfinite(arr)):
+            raise ValueError(f"point constraint value must be a finite number or pair, got {value!r}")
+        self.points.append(PointConstraint(int(vertex), tuple(arr), component))
+
+    def add_rows(self, C, g, label="rows"):
+        """Add general constraint rows C u = g (kept as Lagrange multipliers).
+
+        Raises
+        ------
+        ValueError
+            If the shapes do not match the space or values are not finite.
+        """
+        C = sp.csr_matrix(C, dtype=float)
+        g = np.asarray(g, dtype=float).reshape(-1)
+        if C.shape[1] != self.fes.ndof or C.shape[0] != g.size:
+            raise ValueError(f"constraint rows {label!r}: C is {C.shape}, g has {g.size} entries, the space has {self.fes.ndof} dofs")
+        if not (np.all(np.isfinite(C.data)) and np.all(np.isfinite(g))):
+            raise ValueError(f"constraint rows {label!r} contain NaN or inf")
+        self.rows.append((C, g, label))
+
+    def clear_rows(self, label=None):
+        """Remove general rows (all, or those with the given label)."""
+        self.rows = [r for r in self.rows if label is not None and r[2] != label]
+
+    # -- assembly -------------------------------------------------------------------
+    def assemble(self):
+        """The constraint rows for the current mesh.
+
+        Returns
+        -------
+        ConstraintRows
+
+        Raises
+        ------
+        ValueError
+            If two conditions prescribe different values on one dof.
+        """
+        n = self.scalar.ndof
+        pieces = []   # (dofs, values, source), merged below
+        work = ng.GridFunction(self.fes)
+        for cond in self.dirichlet:
+            region = self.mesh.Boundaries("|".join(cond.boundaries))
+            work.vec[:] = 0.0
+            # NGSolve's Set() on the boundary: nodal at vertices, projection for edge dofs
+            work.Set(cond.value, ng.BND, definedon=region)
+            data = work.vec.FV().NumPy()
+            scalar_dofs = np.flatnonzero(np.array(self.scalar.GetDofs(region), dtype=bool))
+            source = f"Dirichlet on {', '.join(cond.boundaries)}"
+            for c in _components(cond.component):
+                dofs = c * n + scalar_dofs
+                if not np.all(np.isfinite(data[dofs])):
+                    raise ValueError(f"{source}: the prescribed value is NaN or inf on the boundary")
+                pieces.append((dofs, data[dofs].copy(), source))
+        for pc in self.points:
+            for c in _components(pc.component):
+                pieces.append((np.array([c * n + pc.vertex]), np.array([pc.value[c]]),
+                               f"point constraint at vertex {pc.vertex}"))
+        # values that agree to rounding (NGSolve's Set() leaves ~1e-17 at corners) are one value
+        scale = max([float(np.max(np.abs(v), initial=0.0)) for _, v, _ in pieces] + [1e-300])
+        values = {}
+        for dofs, vals, source in pieces:
+            self._merge(values, dofs, vals, source, 1e-10 * scale)
+        dofs = np.array(sorted(values), dtype=np.int64)
+        vals = np.array([values[d][0] for d in dofs], dtype=float)
+        if self.rows:
+            C = sp.vstack([r[0] for r in self.rows]).tocsr()
+            g = np.concatenate([r[1] for r in self.rows])
+        else:
+            C = sp.csr_matrix((0, self.fes.ndof))
+            g = np.zeros(0)
+        return ConstraintRows(dofs, vals, C, g, [r[2] for r in self.rows])
+
+    @staticmethod
+    def _merge(values, dofs, vals, source, tol):
+        for d, v in zip(dofs.tolist(), vals.tolist()):
+            if d in values:
+                old, old_source = values[d]
+                if abs(old - v) > tol:
+                    raise ValueError(f"conflicting constraint values on dof {d}: {old!r} from {old_source} "
+                                     f"and {v!r} from {source}")
+            else:
+                values[d] = (v, source)

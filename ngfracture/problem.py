@@ -1,0 +1,321 @@
+"""A quasi-static, geometrically nonlinear elasticity problem with constraints.
+
+    prob = ElasticProblem(mesh, StVenantKirchhoff(E=5e9, nu=0.18), order=1)
+    prob.add_dirichlet("left", 0.0, component="x")      # gliding: ux = 0, uy free
+    prob.add_dirichlet("right", 1e-4, component="x")
+    status = prob.solve(load_steps=2)
+    assert status.converged, status.message
+
+NGSolve assembles the residual and the consistent tangent from the strain-energy
+density of the material (``Variation``, i.e. SymbolicEnergy); constraints are
+Lagrange-multiplier rows (constraints.py) solved as described in kkt.py.
+"""
+import numpy as np
+import ngsolve as ng
+import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components
+
+from .constraints import ConstraintSet
+from .materials import Material
+from .solver import NewtonSolver
+
+
+def check_mesh(mesh):
+    """Raise ValueError unless mesh is a non-empty 2D NGSolve mesh of triangles."""
+    if not isinstance(mesh, ng.Mesh):
+        raise ValueError(f"mesh must be an ngsolve.Mesh, got {type(mesh).__name__}")
+    if mesh.dim != 2:
+        raise ValueError(f"ngfracture works on 2D meshes; this mesh has dimension {mesh.dim}")
+    if mesh.ne == 0:
+        raise ValueError("the mesh has no elements")
+
+
+def element_vertices(mesh):
+    """Vertex numbers of every triangle, shape (ne, 3), 0-based."""
+    nodes = mesh.ngmesh.Elements2D().NumPy()["nodes"]
+    if nodes.shape[1] > 3 and np.any(nodes[:, 3] != 0):
+        raise ValueError("only triangular meshes are supported (the mesh has quadrilaterals)")
+    return nodes[:, :3].astype(np.int64) - 1
+
+
+class ElasticProblem:
+    """Geometrically nonlinear 2D elasticity on a mesh, with Lagrange-multiplier constraints.
+
+    Parameters
+    ----------
+    mesh : ngsolve.Mesh
+        A 2D mesh of triangles.
+    material : Material
+        LinearElastic, StVenantKirchhoff or NeoHookean.
+    order : int
+        Polynomial order of the VectorH1 displacement space (>= 1).
+
+    Attributes
+    ----------
+    fes : ngsolve.VectorH1
+    u : ngsolve.GridFunction
+        The displacement; after a failed solve, the last converged state.
+    constraints : ConstraintSet
+    load_factor : ngsolve.Parameter
+        Scales body forces and tractions (0 before the first solve, 1 after).
+
+    Raises
+    ------
+    ValueError
+        On an invalid mesh, material or order.
+    """
+
+    def __init__(self, mesh, material, order=1):
+        check_mesh(mesh)
+        if not isinstance(material, Material):
+            raise ValueError(f"material must be a ngfracture Material, got {type(material).__name__}")
+        if isinstance(order, bool) or not isinstance(order, int) or order < 1:
+            raise ValueError(f"order must be an integer >= 1, got {order!r}")
+        self.mesh, self.material, self.order = mesh, material, order
+        self.fes = ng.VectorH1(mesh, order=order)
+        self.u = ng.GridFunction(self.fes, name="displacement")
+        self.constraints = ConstraintSet(self.fes)
+        self.load_factor = ng.Parameter(0.0)
+        self._loads = []      # (kind, CF, region)
+        self._form = None
+        self._elements = element_vertices(mesh)
+        self._points = mesh.ngmesh.Coordinates()[:, :2].copy()
+
+    # -- set-up ---------------------------------------------------------------------
+    def add_dirichlet(self, boundaries, value=(0.0, 0.0), component=None):
+        """Prescribe the displacement on named boundaries; see ConstraintSet.add_dirichlet."""
+        self.constraints.add_dirichlet(boundaries, value, component)
+
+    def add_point_constraint(self, vertex, value=(0.0, 0.0), component=None):
+        """Prescribe the displacement of one vertex; see ConstraintSet.add_point."""
+        self.constraints.add_point(vertex, value, component)
+
+    def add_body_force(self, f):
+        """Add a body force per unit reference area (a 2-vector CoefficientFunction or pair)."""
+        self._loads.append(("volume", ng.CF(tuple(f)) if not isinstance(f, ng.CoefficientFunction) else f, None))
+        self._form = None
+
+    def add_traction(self, boundary, t):
+        """Add a dead traction per unit reference length on a named boundary.
+
+        Raises
+        ------
+        ValueError
+            If the boundary does not exist.
+        """
+        if boundary not in self.mesh.GetBoundaries():
+            raise ValueError(f"boundary {boundary!r} does not exist in the mesh; its boundaries are {sorted(set(self.mesh.GetBoundaries()))}")
+        self._loads.append(("boundary", ng.CF(tuple(t)) if not isinstance(t, ng.CoefficientFunction) else t, boundary))
+        self._form = None
+
+    # -- the discrete operators ----------------------------------------------------------
+    @property
+    def form(self):
+        """The energy as an NGSolve BilinearForm (Variation): Apply = residual, linearisation = tangent."""
+        if self._form is None:
+            u = self.fes.TrialFunction()
+            energy = self.material.energy(ng.Grad(u)) * ng.dx
+            for kind, cf, region in self._loads:
+                if kind == "volume":
+                    energy += -self.load_factor * (cf * u) * ng.dx
+                else:
+                    energy += -self.load_factor * (cf * u) * ng.ds(region)
+            self._form = ng.BilinearForm(self.fes, symmetric=True)
+            self._form += ng.Variation(energy.Compile())
+            self._res = self.u.vec.CreateVector()
+            self._linear_K = None
+        return self._form
+
+    def tangent(self):
+        """Assemble and return the tangent stiffness at the current displacement.
+
+        The linear model's stiffness does not depend on u: it is assembled once and kept.
+        """
+        form = self.form
+        if self.material.geometrically_nonlinear or self._linear_K is None:
+            with ng.TaskManager():
+                form.AssembleLinearization(self.u.vec)
+            if not self.material.geometrically_nonlinear:
+                self._linear_K = form.mat
+                self._load = self.u.vec.CreateVector()
+                self._load[:] = 0.0
+                if self._loads:
+                    zero = self.u.vec.CreateVector()
+                    zero[:] = 0.0
+                    # the energy is quadratic: its gradient at u = 0 is minus the full load vector
+                    factor = self.load_factor.Get()
+                    self.load_factor.Set(1.0)
+                    with ng.TaskManager():
+                        form.Apply(zero, self._load)
+                    self.load_factor.Set(factor)
+        return form.mat
+
+    def out_of_balance(self):
+        """External minus internal nodal forces at the current displacement (numpy copy)."""
+        form = self.form
+        if not self.material.geometrically_nonlinear:
+            K = self._linear_K if self._linear_K is not None else self.tangent()
+            # linear model: f - K u by one matrix-vector product instead of an assembly
+            self._res.data = K * self.u.vec
+            return -(self._res.FV().NumPy() + self.load_factor.Get() * self._load.FV().NumPy())
+        with ng.TaskManager():
+            form.Apply(self.u.vec, self._res)
+        return -self._res.FV().NumPy().copy()
+
+    def freedofs(self, fixed_dofs):
+        """BitArray of the dofs not fixed by single-dof rows."""
+        free = ng.BitArray(self.fes.ndof)
+        free.Set()
+        for d in fixed_dofs.tolist():
+            free.Clear(d)
+        return free
+
+    def assemble_constraints(self):
+        return self.constraints.assemble()
+
+    # -- checks that turn silent garbage into reasons -------------------------------------
+    def fragments(self):
+        """Connected components of the mesh: (count, component id per vertex)."""
+        els = self._elements
+        nv = self.mesh.nv
+        rows = np.repeat(els, 3, axis=1).ravel()
+        cols = np.tile(els, (1, 3)).ravel()
+        graph = sp.csr_matrix((np.ones(rows.size), (rows, cols)), shape=(nv, nv))
+        return connected_components(graph, directed=False)
+
+    def floating_bodies(self, rows):
+        """A message naming the pieces whose rigid-body modes no constraint fixes ('' if none).
+
+        The tangent is singular exactly when some combination of rigid-body modes of the
+        pieces passes all constraint rows; this checks that per group of pieces coupled by
+        general rows, with the rigid modes taken at the current configuration.
+        """
+        ncomp, comp = self.fragments()
+        nv, n = self.mesh.nv, self.fes.ndof // 2
+        x = self._points + self.u.vec.FV().NumPy().reshape(2, n)[:, :nv].T
+        # group pieces that general rows couple together (union-find over rows)
+        parent = np.arange(ncomp)
+
+        def find(a):
+            while parent[a] != a:
+                parent[a] = parent[parent[a]]
+                a = parent[a]
+            return a
+
+        dof_vertex = lambda d: d % n
+        C = rows.C.tocsr()
+        for i in range(C.shape[0]):
+            cols = C.indices[C.indptr[i]:C.indptr[i + 1]]
+            pieces = {comp[dof_vertex(d)] for d in cols if dof_vertex(d) < nv}
+            pieces = [find(p) for p in pieces]
+            for p in pieces[1:]:
+                parent[find(p)] = pieces[0]
+        group = np.array([find(p) for p in range(ncomp)])
+        fixed_v = rows.fixed_dofs % n
+        problems = []
+        for g in np.unique(group):
+            pieces = np.flatnonzero(group == g)
+            # rigid modes of each piece at current positions, centred for conditioning
+            blocks = []
+            for p in pieces:
+                verts = np.flatnonzero(comp == p)
+                c = x[verts].mean(axis=0)
+                scale = max(np.ptp(x[verts], axis=0).max(), 1e-300)
+                blocks.append((verts, c, scale))
+
+            def mode(dofs):
+                """Rigid-mode matrix rows (len(dofs) x 3*len(pieces)) at the given dofs."""
+                out = np.zeros((len(dofs), 3 * len(pieces)))
+                v, cpt = dofs % n, dofs // n
+                for j, p in enumerate(pieces):
+                    verts, c, scale = blocks[j]
+                    m = (comp[np.minimum(v, nv - 1)] == p) & (v < nv)
+                    out[m, 3 * j + cpt[m]] = 1.0
+                    rel = (x[v[m]] - c) / scale
+                    out[m, 3 * j + 2] = np.where(cpt[m] == 0, -rel[:, 1], rel[:, 0])
+                return out
+
+            in_group = (fixed_v < nv) & np.isin(comp[np.minimum(fixed_v, nv - 1)], pieces)
+            rmat = [mode(rows.fixed_dofs[in_group])]
+            if C.shape[0]:
+                touched = np.unique(C.indices)
+                touched = touched[(touched % n < nv)]
+                touched = touched[np.isin(comp[touched % n], pieces)]
+                if touched.size:
+                    sub = C[:, touched]
+                    keep = np.flatnonzero(np.diff(sub.indptr))
+                    rmat.append(sub[keep].toarray() @ mode(touched))
+            R = np.vstack(rmat)
+            need = 3 * len(pieces)
+            sv = np.linalg.svd(R, compute_uv=False) if R.shape[0] else np.zeros(0)
+            rank = int(np.sum(sv > 1e-10 * max(sv.max(initial=0.0), 1.0)))
+            if rank < need:
+                sizes = [int(np.sum(comp == p)) for p in pieces]
+                problems.append(f"piece(s) {pieces.tolist()} ({sizes} vertices) keep {need - rank} "
+                                "unconstrained rigid-body mode(s)")
+        if problems:
+            return "floating body: " + "; ".join(problems)
+        return ""
+
+    def inverted_elements(self):
+        """A message naming the elements with det F <= 0 at a check point ('' if none)."""
+        detF = self.min_det_F()
+        bad = np.flatnonzero(~(detF > 0))
+        if bad.size:
+            return (f"{bad.size} inverted element(s) (det F <= 0 or NaN), first {bad[:5].tolist()}, "
+                    f"min det F = {np.nanmin(detF) if np.any(np.isfinite(detF)) else float('nan'):.3e}")
+        return ""
+
+    def min_det_F(self):
+        """Smallest det F per element over vertices, edge midpoints and centroid."""
+        pts = [(0, 0), (1, 0), (0, 1), (0.5, 0), (0.5, 0.5), (0, 0.5), (1 / 3, 1 / 3)]
+        ir = ng.IntegrationRule(pts, [0.0] * len(pts))
+        F = ng.Id(2) + ng.Grad(self.u)
+        vals = ng.Det(F)(self.mesh.MapToAllElements(ir, ng.VOL)).reshape(self.mesh.ne, len(pts))
+        return vals.min(axis=1)
+
+    # -- results ------------------------------------------------------------------------------
+    def strain(self):
+        """The material's strain tensor of the current displacement (CoefficientFunction)."""
+        return self.material.strain(ng.Grad(self.u))
+
+    def stress(self):
+        """Cauchy stress of the current displacement (CoefficientFunction)."""
+        return self.material.cauchy_stress(ng.Grad(self.u))
+
+    def energy(self):
+        """Total elastic energy of the current displacement."""
+        return ng.Integrate(self.material.energy(ng.Grad(self.u)), self.mesh, order=2 * self.order)
+
+    def solve(self, method="modified", load_steps=1, tol=1e-10, maxit=50, linear_solver="direct",
+              inverse="sparsecholesky"):
+        """Solve for equilibrium with the current constraints and loads.
+
+        Parameters
+        ----------
+        method : {"modified", "full"}
+            Modified Newton (tangent factorised once per load step) or full Newton.
+        load_steps : int
+            Number of equal increments from the current state to the prescribed values.
+        tol : float
+            Relative increment tolerance (paper eq. 7).
+        maxit : int
+            Iterations allowed per load step.
+        linear_solver : {"direct", "gmres"}
+        inverse : str
+            NGSolve direct solver for "direct".
+
+        Returns
+        -------
+        SolveStatus
+            ``status.converged`` and ``status.reason`` say how the solve ended; on failure
+            ``u`` holds the last converged state.
+
+        Raises
+        ------
+        ValueError
+            On invalid options or constraints (unknown boundary, conflicting values).
+        """
+        solver = NewtonSolver(self, method=method, tol=tol, maxit=maxit,
+                              linear_solver=linear_solver, inverse=inverse)
+        return solver.solve(load_steps)

@@ -1,0 +1,287 @@
+"""The nonlinear elasticity core against exact solutions and theory."""
+import math
+
+import ngsolve as ng
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+import ngfracture as nf
+from conftest import distorted_square_mesh, square_mesh, two_squares_mesh
+
+ALL_BOUNDARIES = ["bottom", "right", "top", "left"]
+NONLINEAR = [nf.StVenantKirchhoff, nf.NeoHookean]
+
+
+def l2(cf, mesh, order=6):
+    return math.sqrt(ng.Integrate(ng.InnerProduct(cf, cf), mesh, order=order))
+
+
+@pytest.mark.parametrize("order", [1, 2])
+@pytest.mark.parametrize("cls", NONLINEAR + [nf.LinearElastic])
+def test_patch_test_finite_stretch_and_shear(cls, order):
+    """A homogeneous deformation F = A solves every model without body force: reproduced exactly."""
+    mesh = distorted_square_mesh(maxh=0.25, amount=0.4)
+    A = ((1.2, 0.3), (-0.1, 0.9))
+    uex = ng.CF(((A[0][0] - 1) * ng.x + A[0][1] * ng.y, A[1][0] * ng.x + (A[1][1] - 1) * ng.y))
+    prob = nf.ElasticProblem(mesh, cls(E=1.0, nu=0.3), order=order)
+    prob.add_dirichlet(ALL_BOUNDARIES, uex)
+    status = prob.solve(method="full", load_steps=2)
+    assert status.converged, status.message
+    assert l2(prob.u - uex, mesh) < 1e-10 * l2(uex, mesh)
+
+
+@pytest.mark.parametrize("angle", [30, 90, 180])
+@pytest.mark.parametrize("cls", NONLINEAR)
+def test_objectivity_rigid_rotation(cls, angle):
+    """Rotation imposed as Dirichlet data: zero Green-Lagrange strain and zero energy."""
+    mesh = distorted_square_mesh(maxh=0.3, amount=0.3)
+    theta = ng.Parameter(0.0)
+    # rotation about the centre of the square
+    X, Y = ng.x - 0.5, ng.y - 0.5
+    rot = ng.CF((ng.cos(theta) * X - ng.sin(theta) * Y - X, ng.sin(theta) * X + ng.cos(theta) * Y - Y))
+    E = 1.0
+    prob = nf.ElasticProblem(mesh, cls(E=E, nu=0.3), order=1)
+    prob.add_dirichlet(ALL_BOUNDARIES, rot)
+    steps = angle // 15
+    for k in range(1, steps + 1):
+        theta.Set(math.radians(angle) * k / steps)
+        status = prob.solve(method="full")
+        assert status.converged, status.message
+    strain = l2(prob.strain(), mesh)
+    assert strain < 1e-10
+    assert abs(prob.energy()) < 1e-10 * E
+
+
+def test_linear_model_is_not_objective():
+    """Documented: the linear model strains under a large rotation, eps = (cos t - 1) I."""
+    mesh = square_mesh(0.3)
+    t = math.radians(90)
+    X, Y = ng.x - 0.5, ng.y - 0.5
+    rot = ng.CF((math.cos(t) * X - math.sin(t) * Y - X, math.sin(t) * X + math.cos(t) * Y - Y))
+    prob = nf.ElasticProblem(mesh, nf.LinearElastic(1.0, 0.3))
+    prob.add_dirichlet(ALL_BOUNDARIES, rot)
+    assert prob.solve().converged
+    expected = abs(math.cos(t) - 1) * math.sqrt(2)   # |(cos t - 1) I|_F over unit area
+    assert l2(prob.strain(), mesh) == pytest.approx(expected, rel=1e-10)
+
+
+@pytest.mark.parametrize("cls", NONLINEAR)
+def test_taylor_consistent_tangent(cls):
+    """|r(u + e v) - r(u) - e K(u) v| decays like e^2 (second-order remainder)."""
+    mesh = distorted_square_mesh(maxh=0.3)
+    prob = nf.ElasticProblem(mesh, cls(E=1.0, nu=0.3), order=2)
+    rng = np.random.default_rng(1)
+    u0 = 0.05 * rng.standard_normal(prob.fes.ndof)
+    v = rng.standard_normal(prob.fes.ndof)
+    vec = prob.u.vec
+    vec.FV().NumPy()[:] = u0
+    K = nf.kkt.to_scipy(prob.tangent())
+    r0 = prob.out_of_balance()
+    remainders = []
+    for eps in [1e-2, 5e-3, 2.5e-3, 1.25e-3]:
+        vec.FV().NumPy()[:] = u0 + eps * v
+        r = prob.out_of_balance()
+        # out_of_balance is minus the internal force: r(u+ev) = r(u) - e K v + O(e^2)
+        remainders.append(np.linalg.norm(r - r0 + eps * (K @ v)))
+    rates = np.log2(np.array(remainders[:-1]) / np.array(remainders[1:]))
+    assert np.all(np.abs(rates - 2.0) < 0.1), rates
+
+
+def stretch_problem(cls, stretch=0.25):
+    mesh = square_mesh(0.2)
+    prob = nf.ElasticProblem(mesh, cls(E=1.0, nu=0.3))
+    prob.add_dirichlet("left", (0.0, 0.0))
+    prob.add_dirichlet("right", (stretch, 0.2 * stretch))
+    return prob
+
+
+@pytest.mark.parametrize("cls", NONLINEAR)
+def test_full_newton_converges_quadratically(cls):
+    prob = stretch_problem(cls)
+    status = prob.solve(method="full", tol=1e-12)
+    assert status.converged, status.message
+    e = np.array([x for x in status.increment_history if x > 1e-13])
+    assert len(e) >= 4
+    # order estimate p = log(e_{k+1}/e_k) / log(e_k/e_{k-1}) over the last iterations
+    p = np.log(e[2:] / e[1:-1]) / np.log(e[1:-1] / e[:-2])
+    assert p[-1] > 1.8, (e, p)
+
+
+@pytest.mark.parametrize("cls", NONLINEAR)
+def test_modified_newton_contracts_each_iteration(cls):
+    prob = stretch_problem(cls, stretch=0.1)
+    status = prob.solve(method="modified", tol=1e-10)
+    assert status.converged, status.message
+    e = np.array(status.increment_history)
+    factors = e[1:] / e[:-1]
+    assert np.all(factors < 0.5), factors
+    # linear (not quadratic) convergence: the contraction factor settles to a constant
+    assert factors[-1] == pytest.approx(factors[-2], rel=0.5)
+    assert status.iterations > 4
+
+
+def test_modified_and_full_newton_agree():
+    a, b = stretch_problem(nf.StVenantKirchhoff, 0.1), stretch_problem(nf.StVenantKirchhoff, 0.1)
+    assert a.solve(method="modified", tol=1e-12).converged
+    assert b.solve(method="full", tol=1e-12).converged
+    ua, ub = a.u.vec.FV().NumPy(), b.u.vec.FV().NumPy()
+    assert np.linalg.norm(ua - ub) < 1e-10 * np.linalg.norm(ua)
+
+
+def test_small_load_limit_svk_matches_linear_to_second_order():
+    """|u_svk - u_lin| = O(load^2): the fitted exponent is 2."""
+    mesh = square_mesh(0.2)
+    diffs, loads = [], [1e-2, 1e-3, 1e-4]
+    for s in loads:
+        sols = []
+        for cls in (nf.LinearElastic, nf.StVenantKirchhoff):
+            prob = nf.ElasticProblem(mesh, cls(E=1.0, nu=0.3), order=2)
+            prob.add_dirichlet("left", (0.0, 0.0))
+            prob.add_dirichlet("right", (s, 0.5 * s))
+            assert prob.solve(method="full", tol=1e-13).converged
+            sols.append(prob.u.vec.FV().NumPy().copy())
+        diffs.append(np.linalg.norm(sols[0] - sols[1]))
+    slope = np.polyfit(np.log(loads), np.log(diffs), 1)[0]
+    assert abs(slope - 2.0) < 0.05, (diffs, slope)
+
+
+def test_load_steps_reach_the_same_state():
+    a, b = stretch_problem(nf.NeoHookean), stretch_problem(nf.NeoHookean)
+    sa, sb = a.solve(load_steps=1, tol=1e-12), b.solve(load_steps=4, tol=1e-12)
+    assert sa.converged and sb.converged and sb.steps == 4
+    ua, ub = a.u.vec.FV().NumPy(), b.u.vec.FV().NumPy()
+    assert np.linalg.norm(ua - ub) < 1e-9 * np.linalg.norm(ua)
+
+
+def test_gmres_option_agrees_with_direct():
+    a, b = stretch_problem(nf.StVenantKirchhoff, 0.1), stretch_problem(nf.StVenantKirchhoff, 0.1)
+    assert a.solve(tol=1e-11).converged
+    sb = b.solve(tol=1e-11, linear_solver="gmres")
+    assert sb.converged, sb.message
+    ua, ub = a.u.vec.FV().NumPy(), b.u.vec.FV().NumPy()
+    assert np.linalg.norm(ua - ub) < 1e-8 * np.linalg.norm(ua)
+
+
+def test_body_force_and_traction_balance():
+    """Clamped bar under a traction: the reaction equals the applied load (linear, exact in total)."""
+    mesh = square_mesh(0.25)
+    prob = nf.ElasticProblem(mesh, nf.LinearElastic(1.0, 0.3))
+    prob.add_dirichlet("left", (0.0, 0.0))
+    prob.add_traction("right", (0.01, 0.002))
+    prob.add_body_force((0.0, -0.003))
+    status = prob.solve()
+    assert status.converged, status.message
+    r = prob.out_of_balance()
+    n = prob.fes.ndof // 2
+    reaction = [-r[:n].sum(), -r[n:].sum()]   # internal forces at the clamped dofs
+    assert reaction[0] == pytest.approx(-0.01, abs=1e-12)
+    assert reaction[1] == pytest.approx(-0.002 + 0.003, abs=1e-12)
+
+
+# -- failures are reasons, never garbage ---------------------------------------------------
+
+def test_floating_body_is_reported_not_solved(square):
+    prob = nf.ElasticProblem(square, nf.StVenantKirchhoff(1.0, 0.3))
+    prob.add_point_constraint(0, (0.0, 0.0))       # translation fixed, rotation free
+    status = prob.solve()
+    assert not status.converged and status.reason == "singular"
+    assert "floating body" in status.message and "1 unconstrained rigid-body mode" in status.message
+    assert np.all(prob.u.vec.FV().NumPy() == 0.0)
+
+
+def test_second_free_body_is_named():
+    mesh = two_squares_mesh()
+    prob = nf.ElasticProblem(mesh, nf.LinearElastic(1.0, 0.3))
+    prob.add_dirichlet("a_left", (0.0, 0.0))
+    prob.add_dirichlet("a_right", (0.1, 0.0))
+    status = prob.solve()
+    assert status.reason == "singular" and "3 unconstrained rigid-body mode" in status.message
+
+
+def test_general_rows_on_a_supported_body(square):
+    """Multiplier rows through the Schur complement: tie the mean ux of the right edge to 0.01."""
+    prob = nf.ElasticProblem(square, nf.LinearElastic(1.0, 0.3, plane="stress"))
+    prob.add_dirichlet("left", 0.0, component="x")
+    prob.add_point_constraint(0, 0.0, component="y")
+    n = prob.fes.ndof // 2
+    right = np.flatnonzero(np.abs(square.ngmesh.Coordinates()[:, 0] - 1.0) < 1e-12)
+    C = np.zeros((1, prob.fes.ndof))
+    C[0, right] = 1.0 / right.size
+    prob.constraints.add_rows(sp.csr_matrix(C), [0.01], label="mean")
+    status = prob.solve()
+    assert status.converged, status.message
+    u = prob.u.vec.FV().NumPy()
+    assert abs(C @ u - 0.01)[0] < 1e-15
+    # reference: the whole saddle-point system handed to a sparse LU
+    rows = prob.assemble_constraints()
+    K = nf.kkt.to_scipy(prob.tangent())
+    G = sp.csr_matrix((np.ones(rows.fixed_dofs.size), (np.arange(rows.fixed_dofs.size), rows.fixed_dofs)),
+                      shape=(rows.fixed_dofs.size, prob.fes.ndof))
+    B = sp.vstack([G, sp.csr_matrix(C)])
+    kkt = sp.bmat([[K, B.T], [B, None]]).tocsc()
+    rhs = np.concatenate([np.zeros(prob.fes.ndof), rows.fixed_values, [0.01]])
+    ref = sp.linalg.spsolve(kkt, rhs)[:prob.fes.ndof]
+    assert np.linalg.norm(u - ref) < 1e-12 * np.linalg.norm(ref)
+
+
+def test_body_held_only_by_general_rows_is_reported(square):
+    """Known limitation (see kkt.py): pieces must be supported by single-dof rows for now."""
+    prob = nf.ElasticProblem(square, nf.LinearElastic(1.0, 0.3))
+    n, nv = prob.fes.ndof // 2, square.nv
+    x = square.ngmesh.Coordinates()[:, :2] - 0.5
+    C = np.zeros((3, prob.fes.ndof))
+    C[0, :nv] = 1.0
+    C[1, n:n + nv] = 1.0
+    C[2, :nv], C[2, n:n + nv] = -x[:, 1], x[:, 0]
+    prob.constraints.add_rows(sp.csr_matrix(C), np.zeros(3), label="rigid")
+    status = prob.solve()
+    assert status.reason == "singular" and not status.converged
+    assert np.all(prob.u.vec.FV().NumPy() == 0.0)
+
+
+def test_dependent_general_rows_are_reported(square):
+    prob = nf.ElasticProblem(square, nf.LinearElastic(1.0, 0.3))
+    prob.add_dirichlet("left", (0.0, 0.0))
+    row = np.zeros(prob.fes.ndof)
+    row[5] = 1.0
+    prob.constraints.add_rows(sp.csr_matrix(np.vstack([row, 2 * row])), np.zeros(2))
+    status = prob.solve()
+    assert status.reason == "singular" and "dependent" in status.message
+
+
+def test_nan_load_is_reported(square):
+    prob = nf.ElasticProblem(square, nf.StVenantKirchhoff(1.0, 0.3))
+    prob.add_dirichlet("left", (0.0, 0.0))
+    prob.add_body_force((ng.sqrt(ng.x - 2.0), 0.0))   # NaN everywhere in the domain
+    status = prob.solve()
+    assert status.reason == "nan" and not status.converged
+    assert np.all(np.isfinite(prob.u.vec.FV().NumPy()))
+
+
+def test_inverted_element_is_reported_and_state_restored(square):
+    prob = nf.ElasticProblem(square, nf.NeoHookean(1.0, 0.3))
+    prob.add_dirichlet("left", (0.0, 0.0))
+    prob.add_dirichlet("right", (-0.1, 0.0))
+    assert prob.solve().converged
+    before = prob.u.vec.FV().NumPy().copy()
+    prob.constraints.dirichlet.pop()
+    prob.add_dirichlet("right", (-1.5, 0.0))      # squeezes the square through itself
+    status = prob.solve(method="full")
+    assert not status.converged and status.reason in ("inverted_element", "nan")
+    assert np.array_equal(prob.u.vec.FV().NumPy(), before)
+
+
+def test_modified_newton_divergence_is_reported():
+    """A 25% stretch in one step from the linear tangent: SVK stiffens, modified Newton diverges."""
+    prob = stretch_problem(nf.StVenantKirchhoff, stretch=0.25)
+    status = prob.solve(method="modified")
+    assert status.reason == "diverged" and not status.converged
+    assert np.all(prob.u.vec.FV().NumPy() == 0.0)
+
+
+def test_max_iterations_is_reported():
+    prob = stretch_problem(nf.StVenantKirchhoff, stretch=0.1)
+    status = prob.solve(method="modified", maxit=2)
+    assert status.reason == "max_iterations" and not status.converged
+    assert np.all(prob.u.vec.FV().NumPy() == 0.0)
