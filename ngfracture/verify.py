@@ -249,3 +249,47 @@ def lshape_study(order, levels, variant="dirichlet", model="linear", mesh="unifo
             "alpha": sol.alpha, "levels": rows,
             "rates": {"l2": fit_rate(h, [r["rel_l2"] for r in rows]),
                       "energy": fit_rate(h, [r["rel_energy"] for r in rows])}}
+
+
+def time_to_error(times, errors, target):
+    """Time at which a sequence of runs reaches an error, by log-log interpolation.
+
+    Between the two consecutive runs whose errors bracket ``target``,
+    ``log t`` is interpolated linearly in ``log err``.  If no pair brackets it,
+    the line through the two finest runs (target below every error) or the two
+    coarsest runs (target above every error) is extrapolated.
+
+    Parameters
+    ----------
+    times, errors : sequence of float
+        Wall times and errors of the runs, coarse to fine (errors decreasing); > 0.
+    target : float
+        The error to reach, > 0.
+
+    Returns
+    -------
+    (float, bool)
+        The time, and whether it was extrapolated.
+
+    Raises
+    ------
+    ValueError
+        With fewer than two runs, non-positive values, or errors that do not decrease.
+    """
+    t = np.asarray(times, float)
+    e = np.asarray(errors, float)
+    if len(t) < 2 or len(t) != len(e):
+        raise ValueError("time_to_error needs at least two runs with one time and one error each")
+    if np.any(t <= 0) or np.any(e <= 0) or not target > 0:
+        raise ValueError("times, errors and the target must be > 0")
+    if np.any(np.diff(e) >= 0):
+        raise ValueError(f"errors must decrease from run to run, got {list(e)}")
+    lt, le, lg = np.log(t), np.log(e), math.log(target)
+    for i in range(len(e) - 1):
+        if e[i] >= target >= e[i + 1]:
+            i0, extrapolated = i, False
+            break
+    else:
+        i0, extrapolated = (len(e) - 2, True) if target < e[-1] else (0, True)
+    s = (lg - le[i0]) / (le[i0 + 1] - le[i0])
+    return float(math.exp(lt[i0] + s * (lt[i0 + 1] - lt[i0]))), extrapolated

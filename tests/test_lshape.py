@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from ngfracture import lshape
-from ngfracture.verify import fit_rate, lshape_study, solve_ngfracture, solve_plain
+from ngfracture.verify import fit_rate, lshape_study, solve_ngfracture, solve_plain, time_to_error
 
 ALPHA_REF = 0.544483736782  # 12 digits, NGSOLVE_NOTES.md (root of sin(3 pi a / 2) = a)
 C1_REF = 1.841364331171
@@ -226,6 +226,20 @@ def test_hyperelastic_models_approach_linear(sol):
     assert abs(svk[1] / lin[1] - 1) < 1e-3
     with pytest.raises(ValueError, match="solver='ngfracture'"):
         lshape_study(1, 2, model="svk", solver="plain")
+
+
+def test_time_to_error_interpolation():
+    # Runs on an exact power law err = 2 t^-0.5: interpolation and extrapolation are exact.
+    t = np.array([0.1, 0.4, 1.6, 6.4])
+    e = 2 * t**-0.5
+    for target in (3.0, 2.0, 1.2):
+        sec, extra = time_to_error(t, e, target)
+        assert abs(sec / (2 / target) ** 2 - 1) < 1e-12 and not extra
+    for target in (0.1, 10.0):
+        sec, extra = time_to_error(t, e, target)
+        assert abs(sec / (2 / target) ** 2 - 1) < 1e-12 and extra
+    with pytest.raises(ValueError, match="decrease"):
+        time_to_error([1, 2], [1e-2, 2e-2], 1e-3)
 
 
 @pytest.mark.slow
