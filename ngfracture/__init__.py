@@ -7,6 +7,9 @@ constraints  Dirichlet, gliding and point constraints (Lagrange multiplier rows)
 kkt          the constrained linear solve (elimination + Schur complement)
 solver       modified and full Newton-Raphson with a status that says why it stopped
 problem      ElasticProblem: mesh, material, constraints, solve
+lshape       the L-shape manufactured solution of the paper (section 4.1), meshes, errors
+verify       convergence studies against exact solutions
+cli          the command line, python -m ngfracture
 """
 import ngsolve  # load NGSolve's shared libraries before the compiled add-on
 

@@ -87,7 +87,7 @@ def _add_verify(subparsers):
                    help="polynomial order of the displacement space (default 1)")
     p.add_argument("--levels", type=_int_at_least(2), default=6,
                    help="number of meshes: the coarse mesh and LEVELS-1 uniform refinements, "
-                        "h = h0/2^level (default 6)")
+                        "h = h_coarse/2^level (default 6)")
     p.add_argument("--variant", choices=verify.VARIANTS, default="dirichlet",
                    help="dirichlet: exact displacement on the whole boundary; traction-free: "
                         "free reentrant edges, exact displacement elsewhere (default dirichlet)")
@@ -100,7 +100,7 @@ def _add_verify(subparsers):
                    help="grading exponent (>= 1) for --mesh graded; default 2 for order 1, "
                         "4 for order 2, ceil(order/alpha) in general")
     p.add_argument("--h0", type=_positive_float, default=0.5,
-                   help="target edge length of the coarse mesh, at most 2 (default 0.5)")
+                   help="target edge length (netgen maxh) of the coarse mesh, at most 2 (default 0.5)")
     p.add_argument("--E", type=_positive_float, default=1e5, help="Young's modulus (default 1e5)")
     p.add_argument("--nu", type=float, default=0.3,
                    help="Poisson's ratio, -1 < nu < 0.5 (default 0.3; plane strain)")

@@ -22,11 +22,12 @@ displacement is in ``H^{1+alpha-eps}`` only, ``sigma ~ r^(alpha-1)``.
 
 Meshes
 ------
-``uniform_meshes``: a netgen mesh of maximal edge length ``h0`` refined
-``level`` times (each refinement splits every triangle into four), so
-``h = h0 / 2^level``.
+``mesh_hierarchy(levels, h0, gamma=1)``: a netgen mesh generated with
+``maxh = h0`` refined ``level`` times (each refinement splits every triangle
+into four), so ``h = h_coarse / 2^level``; netgen's maxh is a target, the
+coarse mesh for ``h0 = 0.5`` has longest edge 0.72.
 
-``graded_meshes``: the same meshes mapped by ``x -> x rho^(gamma-1)`` with
+``mesh_hierarchy(levels, h0, gamma > 1)``: the same meshes mapped by ``x -> x rho^(gamma-1)`` with
 ``rho = max(|x|, |y|)``.  The L-shape is ``{rho <= 1}`` minus a quadrant, so
 the map keeps every boundary edge on its line (rays through the corner and the
 lines ``rho = 1``); the mesh size near the corner becomes
@@ -350,7 +351,7 @@ def max_edge_length(mesh):
     return float(np.max(np.linalg.norm(xy[ev[:, 0]] - xy[ev[:, 1]], axis=1)))
 
 
-def energy_errors(mesh, uh, sol, order):
+def relative_errors(mesh, uh, sol, order):
     """Relative L2 and energy-norm errors of a discrete displacement.
 
     The energy error uses ``|u - uh|_a^2 = a(u,u) - 2 a(u,uh) + a(uh,uh)``

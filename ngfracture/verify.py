@@ -104,7 +104,7 @@ def solve_plain(mesh, order, sol, variant="dirichlet", dual=False):
     return gfu
 
 
-def solve_ngfracture(mesh, order, sol, variant="dirichlet", model="linear"):
+def solve_ngfracture(mesh, order, sol, variant="dirichlet", model="linear", return_status=False):
     """The L-shape problem solved through ``ngfracture.ElasticProblem``.
 
     Modified Newton (the paper's scheme): for the linear model it converges in
@@ -120,11 +120,13 @@ def solve_ngfracture(mesh, order, sol, variant="dirichlet", model="linear"):
         Material model (``ngfracture.make_material`` names).  Eq. 15 is exact
         for "linear" only; the hyperelastic models approach it in the
         small-strain limit (see ``lshape_study``).
+    return_status : bool
+        Also return the ``SolveStatus`` (iterations, timings per phase).
 
     Returns
     -------
-    ngsolve.GridFunction
-        ``prob.u``.
+    ngsolve.GridFunction or (ngsolve.GridFunction, SolveStatus)
+        ``prob.u``, with the status if ``return_status``.
 
     Raises
     ------
@@ -141,7 +143,7 @@ def solve_ngfracture(mesh, order, sol, variant="dirichlet", model="linear"):
     if not status.converged:
         raise RuntimeError(f"ngfracture solve did not converge ({status.reason}) "
                            f"on a mesh with {mesh.nv} vertices, order {order}")
-    return prob.u
+    return (prob.u, status) if return_status else prob.u
 
 
 def fit_rate(h, err, last=3):
@@ -239,7 +241,7 @@ def lshape_study(order, levels, variant="dirichlet", model="linear", mesh="unifo
         else:
             uh = solve_ngfracture(m, order, sol, variant, model)
         elapsed = time.perf_counter() - t0
-        rel_l2, rel_energy = lshape.energy_errors(m, uh, sol, order)
+        rel_l2, rel_energy = lshape.relative_errors(m, uh, sol, order)
         rows.append({"level": level, "ndof": uh.space.ndof, "nverts": m.nv,
                      "h": lshape.max_edge_length(m), "rel_l2": rel_l2,
                      "rel_energy": rel_energy, "time_s": elapsed})
