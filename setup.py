@@ -61,7 +61,7 @@ setup(
         "pyvista",
         "matplotlib",
     ],
-    extras_require={"test": ["pytest", "nbmake", "jupyter"]},
+    extras_require={"test": ["pytest"]},
     entry_points={"console_scripts": ["ngfracture=ngfracture.__main__:main"]},
     zip_safe=False,
 )

@@ -9,9 +9,21 @@ eliminated exactly, the symmetric positive definite block K_ff is factorised onc
 complement S = C_f K_ff^-1 C_f^T, a small dense matrix.  The factorisation is kept
 and reused by every solve until the tangent changes (modified Newton).
 
+Pieces held only by general rows (a fragment in contact, a free fragment whose
+rigid modes are fixed by multiplier rows) leave K_ff singular.  Their free rigid
+modes R are known (rigid.py): K is factorised with one extra pin per mode (K^+),
+and the modes come back through a coarse problem, as in FETI:
+
+    u_f = K^+ (q - C_f^T lam) + R alpha,   C_f u_f = h,   R^T (q - C_f^T lam) = 0,
+
+i.e. [S  -G; -G^T 0] [lam; alpha] = [C_f K^+ q - h; -R^T q] with G = C_f R.
+This is exact when K R = 0, i.e. for pieces free of initial stress.
+
 Failures are reported, never returned as numbers: a factorisation that produces
 NaN/inf or does not solve its own system is ``SingularSystem``.
 """
+import warnings
+
 import numpy as np
 import ngsolve as ng
 import scipy.linalg as sla
@@ -38,8 +50,8 @@ class ConstrainedSolver:
     ----------
     K : ngsolve.SparseMatrix
         Tangent stiffness on all dofs.
-    freedofs : ngsolve.BitArray
-        Dofs not fixed by single-dof rows.
+    fixed_dofs : numpy.ndarray
+        Dofs fixed by single-dof rows (eliminated).
     C : scipy.sparse matrix, shape (m, ndof)
         General constraint rows (may have m = 0).
     linear_solver : {"direct", "gmres"}
@@ -54,21 +66,29 @@ class ConstrainedSolver:
         If K_ff or the Schur complement is singular.
     """
 
-    def __init__(self, K, freedofs, C, linear_solver="direct", inverse="sparsecholesky", gmres_tol=1e-12):
+    def __init__(self, K, fixed_dofs, C, linear_solver="direct", inverse="sparsecholesky", gmres_tol=1e-12,
+                 modes=None, pins=None):
         if linear_solver not in LINEAR_SOLVERS:
             raise ValueError(f"linear_solver must be one of {LINEAR_SOLVERS}, got {linear_solver!r}")
         self.K = K
-        self.freedofs = freedofs
-        self.free = np.array(freedofs, dtype=bool)
         self.ndof = K.height
+        pins = np.zeros(0, dtype=np.int64) if pins is None else np.asarray(pins, dtype=np.int64)
+        self.free = np.ones(self.ndof, dtype=bool)
+        self.free[fixed_dofs] = False
+        self.factor_free = self.free.copy()
+        self.factor_free[pins] = False
+        factor_dofs = ng.BitArray(self.ndof)
+        factor_dofs.Set()
+        for d in np.flatnonzero(~self.factor_free).tolist():
+            factor_dofs.Clear(d)
         self.linear_solver = linear_solver
         self.gmres_tol = gmres_tol
         self._tmp = K.CreateColVector()
         if linear_solver == "direct":
-            self._inv = K.Inverse(freedofs, inverse=inverse)
+            self._inv = K.Inverse(factor_dofs, inverse=inverse)
             self._checked = False
         else:
-            Kff = to_scipy(K)[self.free][:, self.free].tocsc()
+            Kff = to_scipy(K)[self.factor_free][:, self.factor_free].tocsc()
             self._Kff = Kff
             try:
                 ilu = spla.spilu(Kff, drop_tol=1e-5, fill_factor=20, permc_spec="MMD_AT_PLUS_A")
@@ -77,48 +97,56 @@ class ConstrainedSolver:
             self._precond = spla.LinearOperator(Kff.shape, ilu.solve)
         self.C = sp.csr_matrix(C)
         self.m = self.C.shape[0]
+        self._R = (sp.csr_matrix(modes)[self.free] if modes is not None and modes.shape[1]
+                   else sp.csr_matrix((int(self.free.sum()), 0)))
+        self.k = self._R.shape[1]
+        if self.k and not self.m:
+            raise SingularSystem(f"{self.k} rigid-body mode(s) are held by no constraint (floating body)")
         if self.m:
             Cf = self.C[:, self.free]
             self._Cf = Cf
-            Z = np.column_stack([self._solve_free(np.asarray(Cf[i].todense()).ravel()) for i in range(self.m)])
-            self._Z = Z
-            S = Cf @ Z
+            self._Z = np.column_stack([self._solve_free(np.asarray(Cf[i].todense()).ravel())
+                                       for i in range(self.m)])
+            S = Cf @ self._Z
             S = 0.5 * (S + S.T)
-            try:
-                self._S = sla.cho_factor(S)
-            except np.linalg.LinAlgError:
-                raise SingularSystem(f"the {self.m} general constraint rows are linearly dependent "
-                                     "(remove redundant rows before the solve)") from None
-            pivots = np.diag(self._S[0]) ** 2
-            if pivots.min() <= 1e-12 * pivots.max():
-                raise SingularSystem(f"the {self.m} general constraint rows are (nearly) linearly dependent: "
-                                     f"Schur complement pivot ratio {pivots.min() / pivots.max():.2e}")
+            G = (Cf @ self._R).toarray()
+            coarse = np.block([[S, -G], [-G.T, np.zeros((self.k, self.k))]])
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", sla.LinAlgWarning)   # judged by the pivots below
+                self._coarse = sla.lu_factor(coarse)
+            pivots = np.abs(np.diag(self._coarse[0]))
+            if not np.all(np.isfinite(pivots)) or pivots.min() <= 1e-12 * pivots.max():
+                raise SingularSystem(f"the {self.m} general constraint rows are (nearly) linearly dependent "
+                                     f"or leave rigid modes free: coarse pivot ratio {pivots.min() / pivots.max():.2e}")
 
     def _solve_free(self, rhs_free):
-        """x_f = K_ff^-1 rhs_f, with a check that the factorisation solves its own system."""
+        """x_f = K^+ rhs_f (pinned dofs get 0), checked: the factorisation must solve its own system."""
+        rhs = rhs_free[self.factor_free[self.free]]
         if self.linear_solver == "gmres":
-            x, info = spla.gmres(self._Kff, rhs_free, M=self._precond, rtol=self.gmres_tol,
+            x, info = spla.gmres(self._Kff, rhs, M=self._precond, rtol=self.gmres_tol,
                                  atol=0.0, restart=200, maxiter=50)
             if info != 0 or not np.all(np.isfinite(x)):
                 raise SingularSystem(f"GMRES did not converge (info={info})")
-            return x
-        full = np.zeros(self.ndof)
-        full[self.free] = rhs_free
-        self._tmp.FV().NumPy()[:] = full
-        x = (self._inv * self._tmp).Evaluate()
-        xf = x.FV().NumPy()[self.free].copy()
-        if not np.all(np.isfinite(xf)):
-            raise SingularSystem("the factorised stiffness produced NaN/inf: singular (a floating body?)")
-        if not self._checked and np.any(rhs_free):
-            # One residual check per factorisation: sparse Cholesky of a singular or
-            # indefinite matrix can return finite garbage.
-            x.FV().NumPy()[~self.free] = 0.0
-            r = (self.K * x).Evaluate().FV().NumPy()[self.free] - rhs_free
-            rel = np.linalg.norm(r) / np.linalg.norm(rhs_free)
-            if not rel < 1e-6:
-                raise SingularSystem(f"the factorised stiffness does not solve its system (relative residual {rel:.1e}): singular or indefinite")
-            self._checked = True
-        return xf
+        else:
+            full = np.zeros(self.ndof)
+            full[self.factor_free] = rhs
+            self._tmp.FV().NumPy()[:] = full
+            xv = (self._inv * self._tmp).Evaluate()
+            x = xv.FV().NumPy()[self.factor_free].copy()
+            if not np.all(np.isfinite(x)):
+                raise SingularSystem("the factorised stiffness produced NaN/inf: singular (a floating body?)")
+            if not self._checked and np.any(rhs):
+                # One residual check per factorisation: sparse Cholesky of a singular or
+                # indefinite matrix can return finite garbage.
+                xv.FV().NumPy()[~self.factor_free] = 0.0
+                r = (self.K * xv).Evaluate().FV().NumPy()[self.factor_free] - rhs
+                rel = np.linalg.norm(r) / np.linalg.norm(rhs)
+                if not rel < 1e-6:
+                    raise SingularSystem(f"the factorised stiffness does not solve its system (relative residual {rel:.1e}): singular or indefinite")
+                self._checked = True
+        out = np.zeros(rhs_free.size)
+        out[self.factor_free[self.free]] = x
+        return out
 
     def solve(self, r, du_fixed, h):
         """Solve the eliminated KKT system.
@@ -141,12 +169,15 @@ class ConstrainedSolver:
         self._tmp.FV().NumPy()[:] = du_fixed
         q = r - (self.K * self._tmp).Evaluate().FV().NumPy()
         self.last_load_norm = float(np.linalg.norm(q[self.free]))
-        x0 = self._solve_free(q[self.free])
+        qf = q[self.free]
+        x0 = self._solve_free(qf)
         du = du_fixed.copy()
         lam = np.zeros(self.m)
         if self.m:
-            rhs = self._Cf @ x0 - (h - self.C[:, ~self.free] @ du_fixed[~self.free])
-            lam = sla.cho_solve(self._S, rhs)
-            x0 = x0 - self._Z @ lam
+            hf = h - self.C[:, ~self.free] @ du_fixed[~self.free]
+            rhs = np.concatenate([self._Cf @ x0 - hf, -(self._R.T @ qf)])
+            sol = sla.lu_solve(self._coarse, rhs)
+            lam, alpha = sol[:self.m], sol[self.m:]
+            x0 = x0 - self._Z @ lam + self._R @ alpha
         du[self.free] = x0
         return du, lam

@@ -12,9 +12,8 @@ Lagrange-multiplier rows (constraints.py) solved as described in kkt.py.
 """
 import numpy as np
 import ngsolve as ng
-import scipy.sparse as sp
-from scipy.sparse.csgraph import connected_components
 
+from . import rigid
 from .constraints import ConstraintSet
 from .materials import Material
 from .solver import NewtonSolver
@@ -162,100 +161,40 @@ class ElasticProblem:
             form.Apply(self.u.vec, self._res)
         return -self._res.FV().NumPy().copy()
 
-    def freedofs(self, fixed_dofs):
-        """BitArray of the dofs not fixed by single-dof rows."""
-        free = ng.BitArray(self.fes.ndof)
-        free.Set()
-        for d in fixed_dofs.tolist():
-            free.Clear(d)
-        return free
-
     def assemble_constraints(self):
         return self.constraints.assemble()
 
     # -- checks that turn silent garbage into reasons -------------------------------------
     def fragments(self):
-        """Connected components of the mesh: (count, component id per vertex)."""
-        els = self._elements
-        nv = self.mesh.nv
-        rows = np.repeat(els, 3, axis=1).ravel()
-        cols = np.tile(els, (1, 3)).ravel()
-        graph = sp.csr_matrix((np.ones(rows.size), (rows, cols)), shape=(nv, nv))
-        return connected_components(graph, directed=False)
+        """Connected components of the mesh: (count, piece id per vertex)."""
+        return rigid.pieces(self._elements, self.mesh.nv)
 
-    def floating_bodies(self, rows):
+    def support(self, rows):
+        """The rigid modes that single-dof rows leave free, with pins to factorise around them."""
+        n = self.fes.ndof // 2
+        x = self._points + self.u.vec.FV().NumPy().reshape(2, n)[:, :self.mesh.nv].T
+        return rigid.analyse_support(x, self._elements, n, self.fes.ndof, rows.fixed_dofs)
+
+    def floating_bodies(self, rows, support=None):
         """A message naming the pieces whose rigid-body modes no constraint fixes ('' if none).
 
-        The tangent is singular exactly when some combination of rigid-body modes of the
-        pieces passes all constraint rows; this checks that per group of pieces coupled by
-        general rows, with the rigid modes taken at the current configuration.
+        Modes left free by the single-dof rows must be fixed by the general rows:
+        C R must have full column rank (R: those modes at the current configuration).
         """
-        ncomp, comp = self.fragments()
-        nv, n = self.mesh.nv, self.fes.ndof // 2
-        x = self._points + self.u.vec.FV().NumPy().reshape(2, n)[:, :nv].T
-        # group pieces that general rows couple together (union-find over rows)
-        parent = np.arange(ncomp)
-
-        def find(a):
-            while parent[a] != a:
-                parent[a] = parent[parent[a]]
-                a = parent[a]
-            return a
-
-        dof_vertex = lambda d: d % n
-        C = rows.C.tocsr()
-        for i in range(C.shape[0]):
-            cols = C.indices[C.indptr[i]:C.indptr[i + 1]]
-            pieces = {comp[dof_vertex(d)] for d in cols if dof_vertex(d) < nv}
-            pieces = [find(p) for p in pieces]
-            for p in pieces[1:]:
-                parent[find(p)] = pieces[0]
-        group = np.array([find(p) for p in range(ncomp)])
-        fixed_v = rows.fixed_dofs % n
-        problems = []
-        for g in np.unique(group):
-            pieces = np.flatnonzero(group == g)
-            # rigid modes of each piece at current positions, centred for conditioning
-            blocks = []
-            for p in pieces:
-                verts = np.flatnonzero(comp == p)
-                c = x[verts].mean(axis=0)
-                scale = max(np.ptp(x[verts], axis=0).max(), 1e-300)
-                blocks.append((verts, c, scale))
-
-            def mode(dofs):
-                """Rigid-mode matrix rows (len(dofs) x 3*len(pieces)) at the given dofs."""
-                out = np.zeros((len(dofs), 3 * len(pieces)))
-                v, cpt = dofs % n, dofs // n
-                for j, p in enumerate(pieces):
-                    verts, c, scale = blocks[j]
-                    m = (comp[np.minimum(v, nv - 1)] == p) & (v < nv)
-                    out[m, 3 * j + cpt[m]] = 1.0
-                    rel = (x[v[m]] - c) / scale
-                    out[m, 3 * j + 2] = np.where(cpt[m] == 0, -rel[:, 1], rel[:, 0])
-                return out
-
-            in_group = (fixed_v < nv) & np.isin(comp[np.minimum(fixed_v, nv - 1)], pieces)
-            rmat = [mode(rows.fixed_dofs[in_group])]
-            if C.shape[0]:
-                touched = np.unique(C.indices)
-                touched = touched[(touched % n < nv)]
-                touched = touched[np.isin(comp[touched % n], pieces)]
-                if touched.size:
-                    sub = C[:, touched]
-                    keep = np.flatnonzero(np.diff(sub.indptr))
-                    rmat.append(sub[keep].toarray() @ mode(touched))
-            R = np.vstack(rmat)
-            need = 3 * len(pieces)
-            sv = np.linalg.svd(R, compute_uv=False) if R.shape[0] else np.zeros(0)
-            rank = int(np.sum(sv > 1e-10 * max(sv.max(initial=0.0), 1.0)))
-            if rank < need:
-                sizes = [int(np.sum(comp == p)) for p in pieces]
-                problems.append(f"piece(s) {pieces.tolist()} ({sizes} vertices) keep {need - rank} "
-                                "unconstrained rigid-body mode(s)")
-        if problems:
-            return "floating body: " + "; ".join(problems)
-        return ""
+        support = support if support is not None else self.support(rows)
+        k = support.modes.shape[1]
+        if k == 0:
+            return ""
+        held = (rows.C @ support.modes).toarray() if rows.C.shape[0] else np.zeros((0, k))
+        s = np.linalg.svd(held, compute_uv=False) if held.size else np.zeros(0)
+        rank = int(np.sum(s > 1e-10 * max(s.max(initial=0.0), 1.0)))
+        if rank == k:
+            return ""
+        _, comp = self.fragments()
+        described = ", ".join(f"piece {p} ({int(np.sum(comp == p))} vertices, {d} free mode(s))"
+                              for p, d in support.unheld[:10])
+        return (f"floating body: {k - rank} rigid-body mode(s) are held by no constraint; "
+                f"pieces without full support from single-dof rows: {described}")
 
     def inverted_elements(self):
         """A message naming the elements with det F <= 0 at a check point ('' if none)."""

@@ -44,6 +44,9 @@ class SolveStatus:
         Euclidean norm of the free out-of-balance force after every iteration.
     timings : dict
         Seconds per phase: assemble, factorize, solve, residual, checks.
+    multipliers : numpy.ndarray
+        Lagrange multipliers of the general rows at the end (the forces -C^T lam
+        they exert on the dofs); empty without general rows.
     """
     converged: bool = False
     reason: str = "max_iterations"
@@ -54,6 +57,7 @@ class SolveStatus:
     residual_history: list = field(default_factory=list)
     timings: dict = field(default_factory=lambda: dict.fromkeys(
         ("assemble", "factorize", "solve", "residual", "checks"), 0.0))
+    multipliers: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     def __bool__(self):
         return self.converged
@@ -123,7 +127,8 @@ class NewtonSolver:
         status = SolveStatus()
         with _Timer(status.timings, "checks"):
             rows = prob.assemble_constraints()
-            floating = prob.floating_bodies(rows)
+            support = prob.support(rows)
+            floating = prob.floating_bodies(rows, support)
         if floating:
             return status.fail("singular", floating)
         u = prob.u.vec.FV().NumPy()
@@ -136,7 +141,7 @@ class NewtonSolver:
             target_fixed = start_fixed + t * (rows.fixed_values - start_fixed)
             target_rows = start_rows + t * (rows.g - start_rows)
             saved = u.copy()
-            self._load_step(rows, target_fixed, target_rows, status)
+            self._load_step(rows, support, target_fixed, target_rows, status)
             if not status.converged:
                 u[:] = saved  # the last converged state, never a failed iterate
                 prob.load_factor.Set(start_load + (step - 1) / load_steps * (1.0 - start_load))
@@ -145,7 +150,7 @@ class NewtonSolver:
             status.steps = step
         return status
 
-    def _load_step(self, rows, target_fixed, target_rows, status):
+    def _load_step(self, rows, support, target_fixed, target_rows, status):
         prob = self.problem
         u = prob.u.vec.FV().NumPy()
         timings = status.timings
@@ -164,8 +169,9 @@ class NewtonSolver:
                     K = prob.tangent()
                 try:
                     with _Timer(timings, "factorize"):
-                        kkt = ConstrainedSolver(K, prob.freedofs(rows.fixed_dofs), rows.C,
-                                                self.linear_solver, self.inverse)
+                        kkt = ConstrainedSolver(K, rows.fixed_dofs, rows.C,
+                                                self.linear_solver, self.inverse,
+                                                modes=support.modes, pins=support.pins)
                 except SingularSystem as err:
                     status.fail("singular", str(err))
                     return
@@ -177,7 +183,7 @@ class NewtonSolver:
             h = target_rows - rows.C @ u
             try:
                 with _Timer(timings, "solve"):
-                    du, _ = kkt.solve(r, du_fixed, h)
+                    du, status.multipliers = kkt.solve(r, du_fixed, h)
                 if k == 0:
                     # the force scale of the step: out-of-balance plus the pull of the prescribed values
                     force_scale = kkt.last_load_norm

@@ -186,7 +186,7 @@ def test_floating_body_is_reported_not_solved(square):
     prob.add_point_constraint(0, (0.0, 0.0))       # translation fixed, rotation free
     status = prob.solve()
     assert not status.converged and status.reason == "singular"
-    assert "floating body" in status.message and "1 unconstrained rigid-body mode" in status.message
+    assert "floating body: 1 rigid-body mode(s) are held by no constraint" in status.message
     assert np.all(prob.u.vec.FV().NumPy() == 0.0)
 
 
@@ -196,7 +196,7 @@ def test_second_free_body_is_named():
     prob.add_dirichlet("a_left", (0.0, 0.0))
     prob.add_dirichlet("a_right", (0.1, 0.0))
     status = prob.solve()
-    assert status.reason == "singular" and "3 unconstrained rigid-body mode" in status.message
+    assert status.reason == "singular" and "3 rigid-body mode(s) are held by no constraint" in status.message
 
 
 def test_general_rows_on_a_supported_body(square):
@@ -221,13 +221,19 @@ def test_general_rows_on_a_supported_body(square):
     B = sp.vstack([G, sp.csr_matrix(C)])
     kkt = sp.bmat([[K, B.T], [B, None]]).tocsc()
     rhs = np.concatenate([np.zeros(prob.fes.ndof), rows.fixed_values, [0.01]])
-    ref = sp.linalg.spsolve(kkt, rhs)[:prob.fes.ndof]
-    assert np.linalg.norm(u - ref) < 1e-12 * np.linalg.norm(ref)
+    ref = sp.linalg.spsolve(kkt, rhs)
+    assert np.linalg.norm(u - ref[:prob.fes.ndof]) < 1e-12 * np.linalg.norm(ref)
+    # the multiplier of the general row is the same as in the whole saddle-point system
+    assert status.multipliers[0] == pytest.approx(ref[-1], rel=1e-10)
 
 
-def test_body_held_only_by_general_rows_is_reported(square):
-    """Known limitation (see kkt.py): pieces must be supported by single-dof rows for now."""
-    prob = nf.ElasticProblem(square, nf.LinearElastic(1.0, 0.3))
+@pytest.mark.parametrize("cls", [nf.LinearElastic, nf.StVenantKirchhoff])
+def test_free_body_held_by_rigid_mode_rows(square, cls):
+    """Self-equilibrated tractions on a free square; three multiplier rows fix its rigid modes."""
+    sigma = 1e-3
+    prob = nf.ElasticProblem(square, cls(1.0, 0.3, plane="stress"))
+    prob.add_traction("right", (sigma, 0.0))
+    prob.add_traction("left", (-sigma, 0.0))
     n, nv = prob.fes.ndof // 2, square.nv
     x = square.ngmesh.Coordinates()[:, :2] - 0.5
     C = np.zeros((3, prob.fes.ndof))
@@ -235,9 +241,17 @@ def test_body_held_only_by_general_rows_is_reported(square):
     C[1, n:n + nv] = 1.0
     C[2, :nv], C[2, n:n + nv] = -x[:, 1], x[:, 0]
     prob.constraints.add_rows(sp.csr_matrix(C), np.zeros(3), label="rigid")
-    status = prob.solve()
-    assert status.reason == "singular" and not status.converged
-    assert np.all(prob.u.vec.FV().NumPy() == 0.0)
+    status = prob.solve(tol=1e-12)
+    assert status.converged, status.message
+    u = prob.u.vec.FV().NumPy()
+    assert np.abs(C @ u).max() < 1e-13
+    # the load is self-equilibrated: the rigid-mode rows carry no force (linear exactly;
+    # SVK: the dead tractions equilibrate in the reference configuration only up to O(sigma^2))
+    assert np.abs(status.multipliers).max() < (1e-14 if cls is nf.LinearElastic else sigma ** 2)
+    # uniaxial stress: the linear strain is diag(sigma, -nu sigma)/E exactly; SVK to O(sigma^2)
+    eps = ng.CF((sigma, 0, 0, -0.3 * sigma), dims=(2, 2))
+    tol = 1e-12 if cls is nf.LinearElastic else 10 * sigma ** 2
+    assert l2(nf.materials.small_strain(ng.Grad(prob.u)) - eps, square) < tol
 
 
 def test_dependent_general_rows_are_reported(square):

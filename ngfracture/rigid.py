@@ -1,0 +1,114 @@
+"""Rigid-body modes of the pieces of a mesh and how the constraints hold them.
+
+A piece (connected component) whose rigid-body modes are not all fixed by
+single-dof rows makes the eliminated stiffness K_ff singular.  If general rows
+(contact, rigid-mode rows) fix the remaining modes, the KKT system is still
+regular; kkt.py then factorises K with a few extra "pins" (one dof per unheld
+mode) and restores the modes through a small coarse problem.  If nothing fixes
+them, the body floats and the solve is refused with a message naming it.
+
+All modes are the infinitesimal rigid motions at the current configuration; for
+NGSolve's hierarchical H1 basis they live on the vertex dofs only.
+"""
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components
+
+
+def pieces(elements, nv):
+    """Connected components of a triangle mesh: (count, piece id per vertex)."""
+    # two edges per triangle connect its three vertices
+    rows = np.concatenate([elements[:, 0], elements[:, 1]])
+    cols = np.concatenate([elements[:, 1], elements[:, 2]])
+    graph = sp.coo_matrix((np.ones(rows.size, dtype=np.int8), (rows, cols)), shape=(nv, nv))
+    return connected_components(graph, directed=False)
+
+
+def piece_modes(x, verts, n):
+    """The three rigid modes of one piece as dense columns over its vertex dofs.
+
+    Returns (dofs, M) with dofs the x dofs then the y dofs of verts (dof = c*n + v)
+    and M of shape (2 len(verts), 3): translation x, translation y, rotation about
+    the centroid (scaled by the piece size for conditioning).
+    """
+    p = x[verts]
+    rel = (p - p.mean(axis=0)) / max(np.ptp(p, axis=0).max(), 1e-300)
+    k = verts.size
+    M = np.zeros((2 * k, 3))
+    M[:k, 0] = 1.0
+    M[k:, 1] = 1.0
+    M[:k, 2] = -rel[:, 1]
+    M[k:, 2] = rel[:, 0]
+    return np.concatenate([verts, n + verts]), M
+
+
+@dataclass
+class Support:
+    """How the single-dof rows hold every piece.
+
+    Attributes
+    ----------
+    modes : scipy.sparse.csc_matrix (ndof, k)
+        Rigid modes that the single-dof rows leave free (zero on fixed dofs).
+    pins : numpy.ndarray (k,)
+        One free dof per such mode; pinning them makes K_ff regular.
+    unheld : list of (piece, number of free modes)
+    """
+    modes: sp.csc_matrix
+    pins: np.ndarray
+    unheld: list
+
+
+def analyse_support(x, elements, n, ndof, fixed_dofs):
+    """Find the rigid modes left free by the single-dof rows, piece by piece.
+
+    Parameters
+    ----------
+    x : numpy.ndarray (nv, 2)
+        Current vertex positions.
+    elements : numpy.ndarray (ne, 3)
+        Triangle vertex numbers.
+    n : int
+        Scalar dofs per component (dof = c*n + v).
+    ndof : int
+    fixed_dofs : numpy.ndarray
+        Dofs fixed by single-dof rows.
+
+    Returns
+    -------
+    Support
+    """
+    nv = x.shape[0]
+    ncomp, comp = pieces(elements, nv)
+    fixed = np.zeros(ndof, dtype=bool)
+    fixed[fixed_dofs] = True
+    order = np.argsort(comp, kind="stable")
+    bounds = np.searchsorted(comp[order], np.arange(ncomp + 1))
+    cols, pins, unheld = [], [], []
+    for p in range(ncomp):
+        verts = order[bounds[p]:bounds[p + 1]]
+        dofs, M = piece_modes(x, verts, n)
+        held = M[fixed[dofs]]
+        # modes in the null space of the fixed rows: what the single-dof rows leave free
+        if held.shape[0]:
+            # reduce to at most 3x3 first: the full V of the SVD is then cheap
+            _, s, vt = np.linalg.svd(np.linalg.qr(held, mode="r"), full_matrices=True)
+            rank = int(np.sum(s > 1e-10 * max(s.max(), 1.0)))
+            free_modes = vt[rank:].T
+        else:
+            free_modes = np.eye(3)
+        if free_modes.shape[1] == 0:
+            continue
+        N = M @ free_modes
+        N[fixed[dofs]] = 0.0   # exactly zero there (they are, up to rounding)
+        # pin the dofs that best resolve these modes (column-pivoted QR)
+        _, _, piv = sla.qr(N.T, pivoting=True, mode="economic")
+        pins.extend(dofs[piv[:N.shape[1]]].tolist())
+        for j in range(N.shape[1]):
+            cols.append(sp.csc_matrix((N[:, j], (dofs, np.zeros(dofs.size, dtype=int))), shape=(ndof, 1)))
+        unheld.append((p, N.shape[1]))
+    modes = sp.hstack(cols).tocsc() if cols else sp.csc_matrix((ndof, 0))
+    return Support(modes, np.array(pins, dtype=np.int64), unheld)
