@@ -24,7 +24,7 @@ def write_json_atomic(path, data, force=False):
     Parameters
     ----------
     path : str or os.PathLike
-        Target file.
+        Target file; missing parent folders are created.
     data : object
         JSON-serialisable data.
     force : bool
@@ -39,6 +39,7 @@ def write_json_atomic(path, data, force=False):
     if os.path.exists(path) and not force:
         raise FileExistsError(f"{path} exists; pass --force to overwrite it")
     directory = os.path.dirname(os.path.abspath(path))
+    os.makedirs(directory, exist_ok=True)  # e.g. out/ on a fresh checkout
     fd, tmp = tempfile.mkstemp(dir=directory, prefix=os.path.basename(path) + ".", suffix=".tmp")
     try:
         with os.fdopen(fd, "w", encoding="utf-8") as f:

@@ -35,6 +35,9 @@ def test_existing_json_needs_force(tmp_path):
     assert json.loads(out.read_text())["problem"] == "lshape"
     with pytest.raises(FileExistsError):
         write_json_atomic(out, {})
+    nested = tmp_path / "new" / "dir" / "r.json"  # the README writes to out/ on a fresh checkout
+    write_json_atomic(nested, {"a": 1})
+    assert json.loads(nested.read_text()) == {"a": 1}
 
 
 @pytest.mark.parametrize("args,message", [
