@@ -35,7 +35,8 @@ lines ``rho = 1``); the mesh size near the corner becomes
 gives the optimal energy rate ``h^p`` (``p`` the order) for
 ``gamma >= p / alpha``; we take ``gamma = 2`` for ``p = 1`` (``1/alpha = 1.84``)
 and ``gamma = 4`` for ``p = 2`` (``2/alpha = 3.67``), see ``default_grading``.
-Element aspect ratios stay below about ``gamma``.
+The map stretches radially ``gamma`` times more than tangentially, so element
+aspect ratios grow by a factor of about ``gamma`` at most.
 """
 import math
 
@@ -44,45 +45,12 @@ import ngsolve as ng
 import numpy as np
 from scipy.optimize import brentq
 
+from .materials import lame_parameters
+
 OMEGA = 3.0 * math.pi / 4.0
 """Half of the reentrant interior angle 3 pi / 2."""
 
 BOUNDARIES = ("reentrant", "outer")
-
-
-def lame(E, nu, plane="strain"):
-    """Lame parameters (lambda, mu) of the 2D linear-elastic model.
-
-    Parameters
-    ----------
-    E : float
-        Young's modulus, > 0.
-    nu : float
-        Poisson's ratio, -1 < nu < 0.5.
-    plane : {"strain", "stress"}
-        The 2D reduction; plane stress uses ``lambda* = 2 lambda mu / (lambda + 2 mu)``.
-
-    Returns
-    -------
-    (float, float)
-        ``(lambda, mu)``.
-
-    Raises
-    ------
-    ValueError
-        If a parameter is out of range or ``plane`` is unknown.
-    """
-    if not (isinstance(E, (int, float)) and math.isfinite(E) and E > 0):
-        raise ValueError(f"E must be a finite number > 0, got {E!r}")
-    if not (isinstance(nu, (int, float)) and math.isfinite(nu) and -1.0 < nu < 0.5):
-        raise ValueError(f"nu must be a finite number with -1 < nu < 0.5, got {nu!r}")
-    if plane not in ("strain", "stress"):
-        raise ValueError(f"plane must be 'strain' or 'stress', got {plane!r}")
-    mu = E / (2.0 * (1.0 + nu))
-    lam = E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))
-    if plane == "stress":
-        lam = 2.0 * lam * mu / (lam + 2.0 * mu)
-    return lam, mu
 
 
 def singular_exponent(omega=OMEGA):
@@ -145,6 +113,11 @@ class LShapeSolution:
     plane : {"strain", "stress"}
         2D reduction; it sets lambda and hence C2.
 
+    Raises
+    ------
+    ValueError
+        On invalid material parameters (``ngfracture.materials.lame_parameters``).
+
     Attributes
     ----------
     lam, mu, alpha, C1, C2 : float
@@ -157,7 +130,7 @@ class LShapeSolution:
 
     def __init__(self, E=1e5, nu=0.3, plane="strain"):
         self.E, self.nu, self.plane = E, nu, plane
-        self.lam, self.mu = lame(E, nu, plane)
+        self.lam, self.mu = lame_parameters(E, nu, plane)
         self.alpha, self.C1, self.C2 = constants(self.lam, self.mu)
         self.u, self.sigma = self._build()
 

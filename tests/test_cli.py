@@ -44,7 +44,7 @@ def test_existing_json_needs_force(tmp_path):
     (["--levels", "-1"], "--levels: must be >= 2"),
     (["--order", "0"], "--order: must be >= 1"),
     (["--levels", "x"], "expected an integer"),
-    (["--nu", "0.5"], "nu must be"),
+    (["--nu", "0.5"], "nu must satisfy"),
     (["--variant", "free"], "invalid choice"),
     (["--gamma", "2"], "--gamma needs --mesh graded"),
 ])
