@@ -13,6 +13,9 @@ crack        nodal strain criterion and node splitting with a netgen rebuild (C+
 collision    exact orient2d, grid broad phase and exact narrow phase on numpy arrays
 contact      node-to-segment contact rows (selection rules, gap linearisation) and
              redundancy removal by rank-revealing QR
+lshape       the L-shape manufactured solution of the paper (section 4.1), meshes, errors
+verify       convergence studies against exact solutions
+cli          the command line, python -m ngfracture
 """
 import ngsolve  # load NGSolve's shared libraries before the compiled add-on
 

@@ -1,0 +1,178 @@
+"""Command line of ngfracture: ``python -m ngfracture <command> ...``.
+
+Commands
+--------
+verify   convergence studies against exact solutions (``verify lshape ...``)
+
+Each command is one ``_add_<command>(subparsers)`` function that registers its
+parser and sets ``func``; a ``run`` command (scenes) plugs in the same way.
+"""
+import argparse
+import json
+import math
+import os
+import sys
+import tempfile
+
+
+def write_json_atomic(path, data, force=False):
+    """Write ``data`` as JSON to ``path`` through a temporary file and a rename.
+
+    A reader never sees a half-written file, and an interrupted run leaves the
+    old file (if any) intact.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        Target file; missing parent folders are created.
+    data : object
+        JSON-serialisable data.
+    force : bool
+        Replace an existing file; without it an existing file is an error.
+
+    Raises
+    ------
+    FileExistsError
+        If ``path`` exists and ``force`` is false.
+    """
+    path = os.fspath(path)
+    if os.path.exists(path) and not force:
+        raise FileExistsError(f"{path} exists; pass --force to overwrite it")
+    directory = os.path.dirname(os.path.abspath(path))
+    os.makedirs(directory, exist_ok=True)  # e.g. out/ on a fresh checkout
+    fd, tmp = tempfile.mkstemp(dir=directory, prefix=os.path.basename(path) + ".", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as f:
+            json.dump(data, f, indent=2, allow_nan=False)
+            f.write("\n")
+        os.replace(tmp, path)
+    except BaseException:
+        os.unlink(tmp)
+        raise
+
+
+def _int_at_least(minimum):
+    def parse(text):
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected an integer, got {text!r}") from None
+        if value < minimum:
+            raise argparse.ArgumentTypeError(f"must be >= {minimum}, got {value}")
+        return value
+    return parse
+
+
+def _positive_float(text):
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
+    if not (math.isfinite(value) and value > 0):
+        raise argparse.ArgumentTypeError(f"must be a finite number > 0, got {text}")
+    return value
+
+
+def _add_verify(subparsers):
+    from . import verify
+
+    p = subparsers.add_parser(
+        "verify", help="convergence study against an exact solution",
+        description="Solve a problem with a known exact solution on a sequence of meshes, "
+                    "report relative L2 and energy-norm errors per level and the rates fitted "
+                    "by least squares in log-log over the finest three levels.")
+    p.add_argument("problem", choices=["lshape"],
+                   help="lshape: the L-shaped domain with the corner singularity of the paper "
+                        "(section 4.1, eq. 15)")
+    p.add_argument("--order", type=_int_at_least(1), default=1,
+                   help="polynomial order of the displacement space (default 1)")
+    p.add_argument("--levels", type=_int_at_least(2), default=6,
+                   help="number of meshes: the coarse mesh and LEVELS-1 uniform refinements, "
+                        "h = h_coarse/2^level (default 6)")
+    p.add_argument("--variant", choices=verify.VARIANTS, default="dirichlet",
+                   help="dirichlet: exact displacement on the whole boundary; traction-free: "
+                        "free reentrant edges, exact displacement elsewhere (default dirichlet)")
+    p.add_argument("--model", choices=verify.MODELS, default="linear",
+                   help="material model; the exact solution is linear-elastic (default linear)")
+    p.add_argument("--mesh", choices=verify.MESHES, default="uniform",
+                   help="uniform refinements, or the same meshes graded toward the corner "
+                        "(default uniform)")
+    p.add_argument("--gamma", type=_positive_float, default=None,
+                   help="grading exponent (>= 1) for --mesh graded; default 2 for order 1, "
+                        "4 for order 2, ceil(order/alpha) in general")
+    p.add_argument("--h0", type=_positive_float, default=0.5,
+                   help="target edge length (netgen maxh) of the coarse mesh, at most 2 (default 0.5)")
+    p.add_argument("--E", type=_positive_float, default=1e5, help="Young's modulus (default 1e5)")
+    p.add_argument("--nu", type=float, default=0.3,
+                   help="Poisson's ratio, -1 < nu < 0.5 (default 0.3; plane strain)")
+    p.add_argument("--solver", choices=verify.SOLVERS, default=verify.DEFAULT_SOLVER,
+                   help="ngfracture: through ngfracture.ElasticProblem; plain: a textbook "
+                        f"NGSolve solve (default {verify.DEFAULT_SOLVER})")
+    p.add_argument("--json", metavar="FILE", default=None,
+                   help="write the results as JSON to FILE (atomically); refused if FILE "
+                        "exists, unless --force")
+    p.add_argument("--force", action="store_true", help="overwrite an existing --json file")
+    p.set_defaults(func=_run_verify)
+
+
+def _run_verify(args):
+    from . import verify
+
+    if args.json is not None and os.path.exists(args.json) and not args.force:
+        raise FileExistsError(f"{args.json} exists; pass --force to overwrite it")
+    if args.gamma is not None and args.mesh != "graded":
+        raise ValueError("--gamma needs --mesh graded")
+    res = verify.lshape_study(args.order, args.levels, variant=args.variant, model=args.model,
+                              mesh=args.mesh, E=args.E, nu=args.nu, h0=args.h0,
+                              gamma=args.gamma, solver=args.solver)
+    print(f"lshape, order {res['order']}, {res['variant']}, {res['mesh']} mesh, "
+          f"solver {res['solver']}, alpha = {res['alpha']:.6f}")
+    print(f"{'level':>5} {'ndof':>9} {'nverts':>8} {'h':>10} {'rel_l2':>11} {'rel_energy':>11} "
+          f"{'time_s':>8}")
+    for r in res["levels"]:
+        print(f"{r['level']:5d} {r['ndof']:9d} {r['nverts']:8d} {r['h']:10.4g} {r['rel_l2']:11.4e} "
+              f"{r['rel_energy']:11.4e} {r['time_s']:8.3f}")
+    rates = res["rates"]
+    print(f"rates over the finest three levels: L2 {rates['l2']:.3f}, energy {rates['energy']:.3f}")
+    if args.json is not None:
+        write_json_atomic(args.json, res, force=args.force)
+    return 0
+
+
+def build_parser():
+    """The argument parser of ``python -m ngfracture``.
+
+    Returns
+    -------
+    argparse.ArgumentParser
+    """
+    parser = argparse.ArgumentParser(
+        prog="ngfracture",
+        description="ngfracture: brittle fracture by node splitting, an NGSolve plugin.")
+    subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+    _add_verify(subparsers)
+    return parser
+
+
+def main(argv=None):
+    """Entry point of ``python -m ngfracture`` and the ``ngfracture`` script.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        Arguments without the program name; default ``sys.argv[1:]``.
+
+    Returns
+    -------
+    int
+        Exit status: 0 on success, 2 on bad input, 1 on a failed computation.
+    """
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return args.func(args)
+    except (ValueError, FileExistsError) as exc:
+        parser.exit(2, f"{parser.prog} {args.command}: error: {exc}\n")
+    except RuntimeError as exc:
+        print(f"{parser.prog} {args.command}: failed: {exc}", file=sys.stderr)
+        return 1
