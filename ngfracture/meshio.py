@@ -1,0 +1,152 @@
+"""2D meshes as plain arrays and back, and separate bodies merged into one mesh.
+
+Checkpoints store a mesh as arrays; scenes with several bodies (a disk and its core)
+mesh each body with netgen and merge them into one mesh whose bodies share no
+vertex, so that only contact couples them.  Building goes through netgen's bulk
+``AddPoints`` / ``AddElements`` (vectorised, no per-element Python loop).
+
+Arrays (all 0-based):
+
+    points     (nv, 2) float    reference coordinates
+    triangles  (ne, 3) int      counter-clockwise
+    regions    (ne,)   int      material region number, 1-based into region_names
+    segments   (ns, 2) int      boundary edges, the domain on their left
+    seg_bc     (ns,)   int      boundary number, 1-based into bc_names
+"""
+from dataclasses import dataclass
+
+import netgen.meshing as nm
+import ngsolve as ng
+import numpy as np
+
+
+@dataclass
+class MeshArrays:
+    """A 2D triangle mesh as plain arrays (see the module docstring)."""
+    points: np.ndarray
+    triangles: np.ndarray
+    regions: np.ndarray
+    region_names: list
+    segments: np.ndarray
+    seg_bc: np.ndarray
+    bc_names: list
+
+    def as_dict(self, prefix="mesh_"):
+        """Arrays for a checkpoint (names are stored as one '\\n'-joined string each)."""
+        return {prefix + "points": self.points, prefix + "triangles": self.triangles,
+                prefix + "regions": self.regions, prefix + "segments": self.segments,
+                prefix + "seg_bc": self.seg_bc,
+                prefix + "region_names": np.array("\n".join(self.region_names)),
+                prefix + "bc_names": np.array("\n".join(self.bc_names))}
+
+    @classmethod
+    def from_dict(cls, d, prefix="mesh_"):
+        return cls(d[prefix + "points"], d[prefix + "triangles"], d[prefix + "regions"],
+                   str(d[prefix + "region_names"]).split("\n"), d[prefix + "segments"],
+                   d[prefix + "seg_bc"], str(d[prefix + "bc_names"]).split("\n"))
+
+
+def mesh_to_arrays(mesh):
+    """The arrays of an NGSolve (or netgen) 2D triangle mesh.
+
+    Raises
+    ------
+    ValueError
+        If the mesh is not 2D or holds elements other than triangles.
+    """
+    ngmesh = mesh.ngmesh if isinstance(mesh, ng.Mesh) else mesh
+    if ngmesh.dim != 2:
+        raise ValueError(f"mesh_to_arrays needs a 2D mesh, this one has dimension {ngmesh.dim}")
+    els = ngmesh.Elements2D().NumPy()
+    nodes = els["nodes"]
+    if nodes.shape[1] > 3 and np.any(nodes[:, 3] != 0):
+        raise ValueError("mesh_to_arrays: only triangles are supported (the mesh has quadrilaterals)")
+    segs = ngmesh.Elements1D().NumPy()
+    nregions = int(els["index"].max()) if len(els) else 0
+    nbc = int(segs["index"].max()) if len(segs) else 0
+    return MeshArrays(
+        points=ngmesh.Coordinates()[:, :2].copy(),
+        triangles=nodes[:, :3].astype(np.int64) - 1,
+        regions=els["index"].astype(np.int64),
+        region_names=[ngmesh.GetMaterial(i) for i in range(1, nregions + 1)],
+        segments=segs["nodes"][:, :2].astype(np.int64) - 1,
+        seg_bc=segs["index"].astype(np.int64),
+        bc_names=[ngmesh.GetBCName(i) for i in range(nbc)])
+
+
+def mesh_from_arrays(arrays):
+    """An NGSolve mesh from MeshArrays (vertex i is point i, elements in the given order).
+
+    Raises
+    ------
+    ValueError
+        On inconsistent shapes or out-of-range indices.
+    """
+    a = arrays
+    pts = np.asarray(a.points, dtype=float)
+    tris = np.asarray(a.triangles, dtype=np.int64)
+    nv = pts.shape[0]
+    if pts.ndim != 2 or pts.shape[1] != 2 or not np.all(np.isfinite(pts)):
+        raise ValueError("mesh_from_arrays: points must be a finite (nv, 2) array")
+    if tris.ndim != 2 or tris.shape[1] != 3 or tris.size == 0:
+        raise ValueError("mesh_from_arrays: triangles must be a non-empty (ne, 3) array")
+    if tris.min() < 0 or tris.max() >= nv:
+        raise ValueError(f"mesh_from_arrays: triangle vertex numbers must lie in [0, {nv})")
+    regions = np.asarray(a.regions, dtype=np.int64)
+    if regions.shape != (tris.shape[0],) or regions.min() < 1 or regions.max() > len(a.region_names):
+        raise ValueError("mesh_from_arrays: regions must give a 1-based region number per triangle")
+    segs = np.asarray(a.segments, dtype=np.int64).reshape(-1, 2)
+    seg_bc = np.asarray(a.seg_bc, dtype=np.int64).reshape(-1)
+    if seg_bc.shape[0] != segs.shape[0] or (segs.size and (segs.min() < 0 or segs.max() >= nv)):
+        raise ValueError("mesh_from_arrays: segments and seg_bc do not fit the points")
+    if seg_bc.size and (seg_bc.min() < 1 or seg_bc.max() > len(a.bc_names)):
+        raise ValueError("mesh_from_arrays: seg_bc must be 1-based numbers into bc_names")
+
+    m = nm.Mesh(dim=2)
+    m.AddPoints(np.ascontiguousarray(np.column_stack([pts, np.zeros(nv)])))
+    for r, name in enumerate(a.region_names, start=1):
+        m.Add(nm.FaceDescriptor(bc=1, domin=r, surfnr=1))
+        m.SetMaterial(r, name)
+    # one bulk call per run of equal regions keeps the element order exactly
+    starts = np.flatnonzero(np.r_[True, regions[1:] != regions[:-1]])
+    for s, e in zip(starts, np.r_[starts[1:], regions.size]):
+        m.AddElements(dim=2, index=int(regions[s]), data=np.ascontiguousarray(tris[s:e].astype(np.int32)), base=0)
+    starts = np.flatnonzero(np.r_[True, seg_bc[1:] != seg_bc[:-1]]) if seg_bc.size else []
+    for s, e in zip(starts, np.r_[starts[1:], seg_bc.size] if seg_bc.size else []):
+        m.AddElements(dim=1, index=int(seg_bc[s]), data=np.ascontiguousarray(segs[s:e].astype(np.int32)), base=0)
+    for b, name in enumerate(a.bc_names, start=1):
+        m.SetBCName(b - 1, name)
+    return ng.Mesh(m)
+
+
+def merge_meshes(*meshes):
+    """One mesh holding several bodies that share no vertex (only contact couples them).
+
+    Region and boundary names are merged by name: equal names become one region or
+    one boundary.  Elements keep the order of the inputs, body after body.
+
+    Returns
+    -------
+    ngsolve.Mesh
+    """
+    parts = [mesh_to_arrays(m) for m in meshes]
+    region_names, bc_names = [], []
+    pts, tris, regs, segs, sbc = [], [], [], [], []
+    offset = 0
+    for p in parts:
+        for n in p.region_names:
+            if n not in region_names:
+                region_names.append(n)
+        for n in p.bc_names:
+            if n not in bc_names:
+                bc_names.append(n)
+        rmap = np.array([0] + [region_names.index(n) + 1 for n in p.region_names])
+        bmap = np.array([0] + [bc_names.index(n) + 1 for n in p.bc_names])
+        pts.append(p.points)
+        tris.append(p.triangles + offset)
+        regs.append(rmap[p.regions])
+        segs.append(p.segments + offset)
+        sbc.append(bmap[p.seg_bc])
+        offset += p.points.shape[0]
+    return mesh_from_arrays(MeshArrays(np.vstack(pts), np.vstack(tris), np.concatenate(regs),
+                                       region_names, np.vstack(segs), np.concatenate(sbc), bc_names))
