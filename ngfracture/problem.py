@@ -261,7 +261,7 @@ class ElasticProblem:
         return self.mesh.MaterialCF({name: make(m) for name, m in self.materials.items()})
 
     def solve(self, method="modified", load_steps=1, tol=1e-10, maxit=50, linear_solver="direct",
-              inverse="sparsecholesky"):
+              inverse="sparsecholesky", fix_free_modes=False):
         """Solve for equilibrium with the current constraints and loads.
 
         Parameters
@@ -277,6 +277,9 @@ class ElasticProblem:
         linear_solver : {"direct", "gmres"}
         inverse : str
             NGSolve direct solver for "direct".
+        fix_free_modes : bool
+            Hold free fragments by multiplier rows on their unheld rigid modes
+            instead of reporting them as floating bodies.
 
         Returns
         -------
@@ -289,6 +292,6 @@ class ElasticProblem:
         ValueError
             On invalid options or constraints (unknown boundary, conflicting values).
         """
-        solver = NewtonSolver(self, method=method, tol=tol, maxit=maxit,
-                              linear_solver=linear_solver, inverse=inverse)
+        solver = NewtonSolver(self, method=method, tol=tol, maxit=maxit, linear_solver=linear_solver,
+                              inverse=inverse, fix_free_modes=fix_free_modes)
         return solver.solve(load_steps)

@@ -112,3 +112,47 @@ def analyse_support(x, elements, n, ndof, fixed_dofs):
         unheld.append((p, N.shape[1]))
     modes = sp.hstack(cols).tocsc() if cols else sp.csc_matrix((ndof, 0))
     return Support(modes, np.array(pins, dtype=np.int64), unheld)
+
+
+def unheld_mode_rows(C, modes, rtol=1e-10):
+    """Rows that fix exactly the rigid modes that neither single-dof nor general rows hold.
+
+    Parameters
+    ----------
+    C : scipy.sparse matrix (m, ndof)
+        General constraint rows.
+    modes : scipy.sparse matrix (ndof, k)
+        Rigid modes left free by the single-dof rows (Support.modes).
+    rtol : float
+        Relative singular-value threshold for "held".
+
+    Returns
+    -------
+    scipy.sparse.csr_matrix (k', ndof)
+        One row n^T per unheld mode n (a rigid mode, so its multiplier exerts no
+        stress on the piece: it only stops the piece from drifting).
+    """
+    k = modes.shape[1]
+    ndof = modes.shape[0]
+    if k == 0:
+        return sp.csr_matrix((0, ndof))
+    G = (sp.csr_matrix(C) @ modes).tocsc() if C.shape[0] else sp.csc_matrix((0, k))
+    # modes coupled through rows form groups; each group is a small dense problem
+    link = (abs(G).T @ abs(G)) if G.shape[0] else sp.csr_matrix((k, k))
+    ngroups, group = connected_components(link + sp.identity(k), directed=False)
+    rows = []
+    for gidx in range(ngroups):
+        cols = np.flatnonzero(group == gidx)
+        sub = G[:, cols]
+        touched = np.flatnonzero(np.diff(sub.tocsr().indptr))
+        if touched.size:
+            dense = sub.tocsr()[touched].toarray()
+            _, s, vt = np.linalg.svd(np.linalg.qr(dense, mode="r") if dense.shape[0] > cols.size else dense,
+                                     full_matrices=True)
+            rank = int(np.sum(s > rtol * max(s.max(initial=0.0), 1e-300)))
+            null = vt[rank:].T
+        else:
+            null = np.eye(cols.size)
+        if null.shape[1]:
+            rows.append((modes[:, cols] @ sp.csr_matrix(null)).T.tocsr())
+    return sp.vstack(rows).tocsr() if rows else sp.csr_matrix((0, ndof))

@@ -15,7 +15,10 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
+import scipy.sparse as sp
 
+from . import rigid
+from .constraints import ConstraintRows
 from .kkt import ConstrainedSolver, SingularSystem
 
 METHODS = ("modified", "full")
@@ -96,10 +99,13 @@ class NewtonSolver:
         NGSolve direct solver name.
     divergence_factor : float
         An increment this many times larger than the first one means divergence.
+    fix_free_modes : bool
+        Fix the rigid modes that no constraint holds (free fragments) by multiplier
+        rows that stop them from drifting; otherwise such a body is reported as floating.
     """
 
     def __init__(self, problem, method="modified", tol=1e-10, maxit=50, linear_solver="direct",
-                 inverse="sparsecholesky", divergence_factor=1e4):
+                 inverse="sparsecholesky", divergence_factor=1e4, fix_free_modes=False):
         if method not in METHODS:
             raise ValueError(f"method must be one of {METHODS}, got {method!r}")
         if not (isinstance(tol, (int, float)) and 0 < tol < 1):
@@ -110,6 +116,7 @@ class NewtonSolver:
         self.method, self.tol, self.maxit = method, float(tol), maxit
         self.linear_solver, self.inverse = linear_solver, inverse
         self.divergence_factor = divergence_factor
+        self.fix_free_modes = fix_free_modes
 
     def solve(self, load_steps=1):
         """Bring the problem from its current state to the prescribed constraint values.
@@ -128,6 +135,8 @@ class NewtonSolver:
         with _Timer(status.timings, "checks"):
             rows = prob.assemble_constraints()
             support = prob.support(rows)
+            if self.fix_free_modes:
+                rows = self._hold_free_modes(rows, support)
             floating = prob.floating_bodies(rows, support)
         if floating:
             return status.fail("singular", floating)
@@ -149,6 +158,15 @@ class NewtonSolver:
                 return status
             status.steps = step
         return status
+
+    def _hold_free_modes(self, rows, support):
+        """Append rows n^T du = 0 for every rigid mode n that nothing holds."""
+        extra = rigid.unheld_mode_rows(rows.C, support.modes)
+        if extra.shape[0] == 0:
+            return rows
+        u = self.problem.u.vec.FV().NumPy()
+        return ConstraintRows(rows.fixed_dofs, rows.fixed_values, sp.vstack([rows.C, extra]).tocsr(),
+                              np.concatenate([rows.g, extra @ u]), rows.labels + ["free modes"])
 
     def _load_step(self, rows, support, target_fixed, target_rows, status):
         prob = self.problem
@@ -202,7 +220,8 @@ class NewtonSolver:
             status.increment_history.append(ratio)
             with _Timer(timings, "residual"):
                 r = prob.out_of_balance()
-            res_norm = float(np.linalg.norm(r[free]))
+            # out-of-balance with the constraint forces of the general rows included
+            res_norm = float(np.linalg.norm((r - rows.C.T @ status.multipliers)[free]))
             status.residual_history.append(res_norm)
             with _Timer(timings, "checks"):
                 inverted = prob.inverted_elements() if prob.nonlinear else None
@@ -212,7 +231,9 @@ class NewtonSolver:
             # eq. 7; for the linear model one step is exact, and a residual at rounding level
             # proves it without a second solve
             exact = not prob.nonlinear and res_norm <= self.tol * force_scale
-            if ratio < self.tol or norm == 0.0 or exact:
+            # below the rounding of u itself eq. 7 cannot improve (an already converged start)
+            rounding = norm <= 64 * np.finfo(float).eps * np.linalg.norm(u)
+            if ratio < self.tol or norm == 0.0 or exact or rounding:
                 status.converged, status.reason, status.message = True, "converged", ""
                 return
             if not np.isfinite(ratio) or ratio > self.divergence_factor:

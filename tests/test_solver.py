@@ -327,3 +327,39 @@ def test_region_materials_are_validated():
     with pytest.raises(ValueError, match="'steel' does not exist"):
         nf.ElasticProblem(mesh, {"soft": nf.LinearElastic(1.0, 0.0), "stiff": nf.LinearElastic(1.0, 0.0),
                                  "steel": nf.LinearElastic(1.0, 0.0)})
+
+
+def free_pieces_mesh():
+    """A unit square, a single free triangle and a free chunk (three bodies, no shared vertex)."""
+    from netgen.geom2d import SplineGeometry
+    from ngfracture.meshio import MeshArrays, merge_meshes, mesh_from_arrays
+    tri = mesh_from_arrays(MeshArrays(np.array([[2.0, 0.0], [2.3, 0.0], [2.0, 0.3]]), np.array([[0, 1, 2]]),
+                                      np.array([1]), ["default"], np.array([[0, 1], [1, 2], [2, 0]]),
+                                      np.array([1, 1, 1]), ["crack"]))
+    geo = SplineGeometry()
+    geo.AddRectangle((3, 0), (3.5, 0.5), bc="crack")
+    chunk = ng.Mesh(geo.GenerateMesh(maxh=0.2))
+    return merge_meshes(square_mesh(0.25), tri, chunk)
+
+
+@pytest.mark.parametrize("cls", [nf.LinearElastic, nf.StVenantKirchhoff, nf.NeoHookean])
+def test_free_fragments_get_their_rigid_modes_fixed(cls):
+    mesh = free_pieces_mesh()
+    prob = nf.ElasticProblem(mesh, cls(1.0, 0.3))
+    prob.add_dirichlet("left", (0.0, 0.0))
+    prob.add_dirichlet("right", (0.05, 0.01))
+    assert prob.solve().reason == "singular"          # reported by default ...
+    status = prob.solve(fix_free_modes=True)            # ... held on request
+    assert status.converged, status.message
+    u = prob.u.vec.FV().NumPy()
+    n = prob.fes.ndof // 2
+    free_vertices = np.flatnonzero(mesh.ngmesh.Coordinates()[:, 0] > 1.5)
+    assert free_vertices.size >= 3 + 4
+    # nothing loads the free pieces: they neither move nor strain, and nothing is garbage
+    assert np.all(np.isfinite(u)) and np.abs(u).max() < 1.0
+    assert np.abs(u[free_vertices]).max() < 1e-12 and np.abs(u[n + free_vertices]).max() < 1e-12
+    strain = l2(prob.strain(), mesh, order=4)
+    assert strain > 0.01   # the square is stretched
+    free_strain = math.sqrt(ng.Integrate(ng.IfPos(ng.x - 1.5, 1, 0) *
+                                         ng.InnerProduct(prob.strain(), prob.strain()), mesh, order=4))
+    assert free_strain < 1e-12

@@ -1,0 +1,258 @@
+"""Equilibrium with frictionless unilateral contact between pieces (paper eq. 8-14).
+
+An active set around the Newton solver, in the paper's predict-and-correct manner:
+
+    1. solve without contact rows (free pieces held on their rigid modes);
+    2. detect colliding triangle pairs at the solved configuration, choose node-to-
+       segment constraints (rules 1-4), linearise the gap there (eq. 13, 14), drop
+       redundant rows (pivoted QR), and impose them as equalities (eq. 12);
+    3. solve again; a row whose multiplier is adhesive (lambda > 0; compression is
+       lambda <= 0, the paper's p_N <= 0) is released; repeat from 2 until the set of
+       rows no longer changes, no multiplier is adhesive and no node penetrates.
+
+At the end the Kuhn-Tucker conditions of eq. 8 hold to the solver tolerance:
+g_N >= 0 up to ``penetration_tol``, lambda <= 0, and lambda g_N = 0 (active rows have
+g_N = 0, released ones carry no force).
+"""
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sp
+
+from . import contact
+from .collision import detect_collisions
+from .meshio import mesh_to_arrays
+from .solver import SolveStatus
+
+LABEL = "contact"
+
+
+@dataclass
+class ContactResult:
+    """How a contact solve ended.
+
+    Attributes
+    ----------
+    status : SolveStatus
+        The last Newton solve (its reason says why a failure happened).
+    converged : bool
+    reason : str
+        "converged", a Newton reason, or "active_set" if the set did not settle.
+    rounds : int
+        Detect-and-solve rounds.
+    constraints : contact.ContactConstraints
+        The active node-to-segment constraints at the end.
+    multipliers : numpy.ndarray
+        Their multipliers (<= 0: compressive).
+    released : int
+        Rows released as adhesive over all rounds.
+    max_penetration : float
+        Largest penetration depth of an active slave node at the end (>= 0).
+    timings : dict
+        Seconds in collision detection + row assembly and in the Newton solves.
+    """
+    status: SolveStatus
+    converged: bool = False
+    reason: str = ""
+    rounds: int = 0
+    constraints: object = None
+    multipliers: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    released: int = 0
+    max_penetration: float = 0.0
+    timings: dict = field(default_factory=lambda: {"contact": 0.0, "solve": 0.0})
+
+    def __bool__(self):
+        return self.converged
+
+
+def _space_columns(C, nv, n):
+    """Map contact columns comp*nv + v (P1 layout) to the space's comp*n + v."""
+    C = sp.csr_matrix(C)
+    cols = C.indices
+    mapped = np.where(cols < nv, cols, cols - nv + n)
+    return sp.csr_matrix((C.data, mapped, C.indptr), shape=(C.shape[0], 2 * n))
+
+
+class ContactSolver:
+    """Newton solves with an active set of node-to-segment contact constraints.
+
+    Parameters
+    ----------
+    problem : ElasticProblem
+    tol : float
+        Precision threshold of the detection (a length): pairs closer than tol count,
+        and slave nodes within tol of a master segment can get a constraint.
+    penetration_tol : float
+        Penetration depth accepted at the end.
+    max_rounds : int
+        Detect-and-solve rounds before giving up with reason "active_set".
+    **solve_options
+        Passed to ``problem.solve`` (method, tol, maxit, ...).
+    """
+
+    def __init__(self, problem, tol, penetration_tol=None, max_rounds=20, **solve_options):
+        if not np.isfinite(tol) or tol < 0:
+            raise ValueError(f"contact detection tol must be finite and >= 0, got {tol!r}")
+        self.problem = problem
+        self.tol = float(tol)
+        self.penetration_tol = 1e-10 * max(self.tol, 1e-300) if penetration_tol is None else penetration_tol
+        self.max_rounds = max_rounds
+        self.options = dict(solve_options)
+        self.options["fix_free_modes"] = True
+
+    def _geometry(self):
+        prob = self.problem
+        arrays = mesh_to_arrays(prob.mesh)
+        nv, n = prob.mesh.nv, prob.fes.ndof // 2
+        U = prob.u.vec.FV().NumPy().reshape(2, n)[:, :nv].T.copy()
+        _, comp = prob.fragments()
+        fragment = comp[arrays.triangles[:, 0]]
+        return arrays, U, fragment
+
+    def _fixed_p1(self):
+        """Fixed dofs of the problem in the P1 layout of the contact rows (vertex dofs only)."""
+        prob = self.problem
+        nv, n = prob.mesh.nv, prob.fes.ndof // 2
+        fixed = prob.assemble_constraints().fixed_dofs
+        v, c = fixed % n, fixed // n
+        return (c * nv + v)[v < nv]
+
+    def _contact_offset(self):
+        offset = 0
+        for C, _, label in self.problem.constraints.rows:
+            if label == LABEL:
+                return offset
+            offset += C.shape[0]
+        return offset
+
+    def solve(self):
+        """Solve for equilibrium with contact; returns a ContactResult."""
+        import time
+        prob = self.problem
+        prob.constraints.clear_rows(LABEL)
+        t0 = time.perf_counter()
+        status = prob.solve(**self.options)
+        result = ContactResult(status)
+        result.timings["solve"] += time.perf_counter() - t0
+        if not status.converged:
+            result.reason = status.reason
+            return result
+        if prob.fragments()[0] == 1 and "crack" not in prob.mesh.GetBoundaries():
+            # one uncracked body cannot touch itself: no collision work at all
+            result.converged, result.reason = True, "converged"
+            return result
+        fixed = self._fixed_p1()
+        released = set()
+        previous = None
+        nv, n = prob.mesh.nv, prob.fes.ndof // 2
+        for rnd in range(1, self.max_rounds + 1):
+            result.rounds = rnd
+            t0 = time.perf_counter()
+            arrays, U, fragment = self._geometry()
+            cs = contact.contact_constraints(arrays.points, U, arrays.triangles, arrays.segments,
+                                             fragment=fragment, tol=self.tol, fixed_dofs=fixed)
+            keys = [tuple(k) for k in np.stack([cs.slave, cs.a, cs.c], axis=1).tolist()]
+            # a released row stays released unless its node penetrates again
+            keep = np.array([k not in released or d < -self.penetration_tol
+                             for k, d in zip(keys, cs.dist)], dtype=bool)
+            cs = cs.subset(np.flatnonzero(keep))
+            keys = [k for k, kp in zip(keys, keep) if kp]
+            penetration = float(max(0.0, -cs.dist.min())) if len(cs) else 0.0
+            result.constraints, result.max_penetration = cs, penetration
+            result.timings["contact"] += time.perf_counter() - t0
+            if previous is not None and set(keys) == previous and penetration <= self.penetration_tol:
+                result.converged, result.reason = True, "converged"
+                return result
+            previous = set(keys)
+            prob.constraints.clear_rows(LABEL)
+            if len(cs):
+                # active: the linearised gap closes, C u + g = 0
+                prob.constraints.add_rows(_space_columns(cs.C, nv, n), -cs.g, label=LABEL)
+            t0 = time.perf_counter()
+            status = prob.solve(**self.options)
+            result.status = status
+            result.timings["solve"] += time.perf_counter() - t0
+            if not status.converged:
+                result.reason = status.reason
+                return result
+            offset = self._contact_offset()
+            lam = status.multipliers[offset:offset + len(cs)]
+            result.multipliers = lam
+            # adhesive beyond rounding: relative to the largest force the constraints carry
+            r = prob.out_of_balance()
+            scale = max(float(np.abs(lam).max(initial=0.0)),
+                        float(np.linalg.norm(r[prob.assemble_constraints().fixed_dofs])), 1e-300)
+            adhesive = np.flatnonzero(lam > 1e-10 * scale)
+            if adhesive.size:
+                released.update(keys[i] for i in adhesive)
+                result.released += adhesive.size
+                previous = None   # the set changes: solve again
+        result.reason = "active_set"
+        return result
+
+
+def overlap_area(x, triangles, pairs):
+    """Total area of the intersections of the given triangle pairs (convex clipping).
+
+    Parameters
+    ----------
+    x : numpy.ndarray (nv, 2)
+        Current vertex positions.
+    triangles : numpy.ndarray (ne, 3)
+        Counter-clockwise triangles.
+    pairs : numpy.ndarray (k, 2)
+        Triangle pairs to intersect.
+
+    Returns
+    -------
+    float
+    """
+    total = 0.0
+    for i, j in np.asarray(pairs, dtype=np.int64).reshape(-1, 2):
+        poly = [tuple(p) for p in x[triangles[i]]]
+        clip = x[triangles[j]]
+        if _signed_area(clip) < 0:
+            clip = clip[::-1]
+        for k in range(3):
+            a, b = clip[k], clip[(k + 1) % 3]
+            poly = _clip_half_plane(poly, a, b)
+            if not poly:
+                break
+        if len(poly) >= 3:
+            total += abs(_signed_area(np.array(poly)))
+    return total
+
+
+def _signed_area(p):
+    p = np.asarray(p)
+    return 0.5 * float(np.sum(p[:, 0] * np.roll(p[:, 1], -1) - np.roll(p[:, 0], -1) * p[:, 1]))
+
+
+def _clip_half_plane(poly, a, b):
+    """Sutherland-Hodgman: the part of poly left of the directed line a -> b."""
+    def side(p):
+        return (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0])
+    out = []
+    for k in range(len(poly)):
+        p, q = poly[k], poly[(k + 1) % len(poly)]
+        sp_, sq = side(p), side(q)
+        if sp_ >= 0:
+            out.append(p)
+        if sp_ * sq < 0:
+            t = sp_ / (sp_ - sq)
+            out.append((p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1])))
+    return out
+
+
+def fragment_overlap_area(problem):
+    """Total overlap area between triangles of the current configuration (0 if none)."""
+    arrays = mesh_to_arrays(problem.mesh)
+    nv, n = problem.mesh.nv, problem.fes.ndof // 2
+    U = problem.u.vec.FV().NumPy().reshape(2, n)[:, :nv].T
+    _, comp = problem.fragments()
+    fragment = comp[arrays.triangles[:, 0]]
+    pairs = detect_collisions(arrays.points, U, arrays.triangles, boundary_edges=arrays.segments,
+                              fragment=fragment, tol=0.0)
+    if len(pairs) == 0:
+        return 0.0
+    return overlap_area(arrays.points + U, arrays.triangles, pairs)
