@@ -86,17 +86,22 @@ class ContactSolver:
         Penetration depth accepted at the end.
     max_rounds : int
         Detect-and-solve rounds before giving up with reason "active_set".
+    rank_tol : float
+        Rows closer than this (relative) to the span of the kept rows are dropped as
+        redundant. Measured on cracked plates: near-duplicate lip rows at 1e-6 made the
+        Schur complement so ill-conditioned (1e12) that Newton stalled at 5e-10.
     **solve_options
         Passed to ``problem.solve`` (method, tol, maxit, ...).
     """
 
-    def __init__(self, problem, tol, penetration_tol=None, max_rounds=20, **solve_options):
+    def __init__(self, problem, tol, penetration_tol=None, max_rounds=20, rank_tol=1e-5, **solve_options):
         if not np.isfinite(tol) or tol < 0:
             raise ValueError(f"contact detection tol must be finite and >= 0, got {tol!r}")
         self.problem = problem
         self.tol = float(tol)
         self.penetration_tol = 1e-10 * max(self.tol, 1e-300) if penetration_tol is None else penetration_tol
         self.max_rounds = max_rounds
+        self.rank_tol = rank_tol
         self.options = dict(solve_options)
         self.options["fix_free_modes"] = True
 
@@ -150,7 +155,9 @@ class ContactSolver:
             t0 = time.perf_counter()
             arrays, U, fragment = self._geometry()
             cs = contact.contact_constraints(arrays.points, U, arrays.triangles, arrays.segments,
-                                             fragment=fragment, tol=self.tol, fixed_dofs=fixed)
+                                             fragment=fragment, tol=self.tol, fixed_dofs=fixed,
+                                             rtol=self.rank_tol)
+            cs = cs.subset(np.flatnonzero(reachable(cs, U, self.tol)))
             keys = [tuple(k) for k in np.stack([cs.slave, cs.a, cs.c], axis=1).tolist()]
             # a released row stays released unless its node penetrates again
             keep = np.array([k not in released or d < -self.penetration_tol
@@ -189,6 +196,21 @@ class ContactSolver:
                 previous = None   # the set changes: solve again
         result.reason = "active_set"
         return result
+
+
+def reachable(cs, U, tol):
+    """Rows whose penetration the motion can explain.
+
+    The reference mesh has no overlap, so a slave node cannot be deeper behind a master
+    segment than it has moved relative to that segment (plus the threshold).  Deeper
+    "penetrations" come from picking the wrong way out near crack tips and corners;
+    imposing them would tear the mesh (measured: inverted elements), so they are dropped.
+    """
+    if len(cs) == 0:
+        return np.zeros(0, dtype=bool)
+    xi = cs.xi[:, None]
+    rel = U[cs.slave] - xi * U[cs.a] - (1.0 - xi) * U[cs.c]
+    return -cs.dist <= np.linalg.norm(rel, axis=1) + tol
 
 
 def overlap_area(x, triangles, pairs):

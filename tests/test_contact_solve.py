@@ -97,3 +97,4 @@ def test_overlap_area_of_two_triangles():
     tris = np.array([[0, 1, 2], [3, 4, 5]])
     # intersection: the triangle (0.5,0), (1,0), (0.5,0.5), area 1/8
     assert overlap_area(x, tris, np.array([[0, 1]])) == pytest.approx(0.125, rel=1e-15)
+
