@@ -50,6 +50,8 @@ class ContactResult:
         Largest penetration depth of an active slave node at the end (>= 0).
     timings : dict
         Seconds in collision detection + row assembly and in the Newton solves.
+    history : list of (int, float)
+        Rows and penetration depth at the start of every round.
     """
     status: SolveStatus
     converged: bool = False
@@ -60,6 +62,7 @@ class ContactResult:
     released: int = 0
     max_penetration: float = 0.0
     timings: dict = field(default_factory=lambda: {"contact": 0.0, "solve": 0.0})
+    history: list = field(default_factory=list)
 
     def __bool__(self):
         return self.converged
@@ -167,6 +170,7 @@ class ContactSolver:
             penetration = float(max(0.0, -cs.dist.min())) if len(cs) else 0.0
             result.constraints, result.max_penetration = cs, penetration
             result.timings["contact"] += time.perf_counter() - t0
+            result.history.append((len(keys), penetration))
             if previous is not None and set(keys) == previous and penetration <= self.penetration_tol:
                 result.converged, result.reason = True, "converged"
                 return result
