@@ -346,8 +346,10 @@ class TimeSeriesWriter:
         delete this writer's files of later steps, continue the collections.
     last_step : int, optional
         With ``resume``: the last step to keep (e.g. the step of the checkpoint resumed from).
-    compression : {'zlib', 'lz4', 'lzma', None}
-        Compression of the binary VTK arrays (lossless).
+    compression : {'lz4', 'zlib', 'lzma', None}
+        Compression of the binary VTK arrays (lossless). lz4 by default: at 100k triangles
+        it wrote a step 2 to 2.5 times faster than zlib for 1.5 times the size (ParaView
+        >= 5.5 reads it); zlib for the smallest files.
 
     Attributes
     ----------
@@ -369,7 +371,7 @@ class TimeSeriesWriter:
     _OWN = re.compile(r"^(step_\d{6}\.vtu|cracks_\d{6}\.vtp|results\.pvd|cracks\.pvd|\.tmp_ngf_.*)$")
     _STEP = re.compile(r"^(?:step_(\d{6})\.vtu|cracks_(\d{6})\.vtp)$")
 
-    def __init__(self, folder, force=False, resume=False, last_step=None, compression="zlib"):
+    def __init__(self, folder, force=False, resume=False, last_step=None, compression="lz4"):
         if force and resume:
             raise ValueError("TimeSeriesWriter: force=True deletes results, resume=True keeps them; choose one")
         if last_step is not None and not resume:
