@@ -29,6 +29,7 @@ Green-Lagrange by default), the same quantity the crack criterion averages at th
 """
 import ctypes.util
 import glob
+import io
 import json
 import math
 import os
@@ -44,7 +45,7 @@ from . import crack
 from .problem import check_mesh, element_vertices
 
 __all__ = ["MeshArrays", "vertex_arrays", "element_strain", "to_pyvista", "cracks_to_pyvista",
-           "TimeSeriesWriter", "RenderError", "render_png", "plot_fragment_sizes", "write_summary"]
+           "TimeSeriesWriter", "RenderError", "check_headless", "render_png", "plot_fragment_sizes", "write_summary"]
 
 
 # -- arrays ---------------------------------------------------------------------------------
@@ -678,7 +679,6 @@ def plot_fragment_sizes(areas, path, force=False, title="Fragment-size distribut
     ax2.set_xlabel("fragment area A")
     ax2.set_ylabel("fraction of fragments with area >= A")
     fig.suptitle(f"{title} ({A.size} fragments)")
-    import io
     buf = io.BytesIO()
     fig.savefig(buf, format=path.suffix.lstrip(".") or "png", dpi=120)
     _atomic_bytes(path, buf.getvalue(), force)
