@@ -1,0 +1,139 @@
+"""Fragment statistics: a post-processing object on top of a mesh (cf. Akantu's FragmentManager).
+
+    stats = FragmentStatistics(result.mesh, result.fragment)   # after crack.split_by_tensor / crack_step
+    stats.count, stats.areas, stats.centroids, stats.total_area
+
+Everything is measured in the reference configuration (the mesh coordinates): splitting
+never moves material, so fragment areas are exact pieces of the domain area. Element areas
+come from the C++ ``ElementAreas``; the total is ``math.fsum`` of them, so it equals the
+domain area up to the rounding of each element area. Centroids in the deformed
+configuration are available by passing the vertex displacement.
+"""
+import math
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components
+
+from ._ngfracture import ElementAreas
+from .problem import check_mesh, element_vertices
+
+__all__ = ["FragmentStatistics", "fragment_ids"]
+
+
+def fragment_ids(mesh):
+    """Fragment number of every triangle: connected components through shared vertices.
+
+    Numbered by their smallest triangle (fragment 0 holds triangle 0), as in
+    :class:`ngfracture.crack.SplitResult`.
+
+    Parameters
+    ----------
+    mesh : ngsolve.Mesh
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (ne,), int64, values 0 .. count-1.
+    """
+    check_mesh(mesh)
+    T = element_vertices(mesh)
+    ne, nv = len(T), mesh.nv
+    # bipartite triangle-vertex graph: two triangles are connected iff they share a vertex
+    rows = np.repeat(np.arange(ne), 3)
+    A = sp.coo_matrix((np.ones(3 * ne), (rows, ne + T.ravel())), shape=(ne + nv, ne + nv))
+    _, labels = connected_components(A, directed=False)
+    labels = labels[:ne]
+    _, first = np.unique(labels, return_index=True)
+    # relabel by smallest triangle: order components by the first triangle they contain
+    order = np.argsort(first)
+    relabel = np.empty(len(first), dtype=np.int64)
+    relabel[labels[first[order]]] = np.arange(len(first))
+    return relabel[labels]
+
+
+class FragmentStatistics:
+    """Count, areas and centroids of the fragments of a cracked mesh.
+
+    Parameters
+    ----------
+    mesh : ngsolve.Mesh
+        2D triangle mesh in the reference configuration.
+    fragment : array_like of int, optional
+        Fragment id per triangle (shape (ne,)), e.g. ``SplitResult.fragment``. Any
+        integer labels are accepted; they are kept in ``ids``. If omitted they are
+        computed with :func:`fragment_ids`.
+    u : array_like, optional
+        Vertex displacement (nv, 2); if given, ``deformed_centroids`` is filled.
+
+    Attributes
+    ----------
+    ids : numpy.ndarray
+        The distinct fragment labels, increasing; row i of every per-fragment array
+        belongs to ``ids[i]``.
+    count : int
+    areas : numpy.ndarray
+        Reference area of each fragment.
+    ntriangles : numpy.ndarray
+        Triangles per fragment.
+    centroids : numpy.ndarray
+        (count, 2) area centroids in the reference configuration.
+    deformed_centroids : numpy.ndarray or None
+        (count, 2) area centroids of the P1-deformed triangles, weighted by reference area
+        (the centre of mass for a uniform density), when ``u`` is given.
+    total_area : float
+        ``math.fsum`` of the element areas: the domain area.
+    element_areas : numpy.ndarray
+
+    Raises
+    ------
+    ValueError
+        A fragment array of the wrong shape or not integer, a displacement of the wrong
+        shape, or a mesh that is not 2D.
+    """
+
+    def __init__(self, mesh, fragment=None, u=None):
+        check_mesh(mesh)
+        ne = mesh.ne
+        if fragment is None:
+            frag = fragment_ids(mesh)
+        else:
+            frag = np.asarray(fragment)
+            if frag.shape != (ne,):
+                raise ValueError(f"FragmentStatistics: fragment ids must have shape ({ne},) "
+                                 f"(one per triangle), got {frag.shape}")
+            if not np.issubdtype(frag.dtype, np.integer):
+                raise ValueError(f"FragmentStatistics: fragment ids must be integers, got dtype {frag.dtype}")
+        self.ids, index = np.unique(frag, return_inverse=True)
+        index = index.reshape(-1)
+        self.count = len(self.ids)
+        self.fragment = frag
+        self.element_areas = np.asarray(ElementAreas(mesh))
+        a = self.element_areas
+        self.total_area = math.fsum(a)
+        self.areas = np.bincount(index, weights=a, minlength=self.count)
+        self.ntriangles = np.bincount(index, minlength=self.count)
+        T = element_vertices(mesh)
+        X = mesh.ngmesh.Coordinates()[:, :2]
+        self.centroids = self._centroids(X[T].mean(axis=1), a, index)
+        self.deformed_centroids = None
+        if u is not None:
+            U = np.asarray(u, dtype=float)
+            if U.shape != (mesh.nv, 2):
+                raise ValueError(f"FragmentStatistics: displacement must have shape ({mesh.nv}, 2), got {U.shape}")
+            self.deformed_centroids = self._centroids((X + U)[T].mean(axis=1), a, index)
+
+    def _centroids(self, element_centres, a, index):
+        c = np.column_stack([np.bincount(index, weights=a * element_centres[:, k], minlength=self.count)
+                             for k in range(2)])
+        return c / self.areas[:, None]
+
+    def summary(self):
+        """Plain numbers for a JSON summary: count, total area, min/mean/max fragment area."""
+        return {"fragments": self.count, "total_area": self.total_area,
+                "min_area": float(self.areas.min()), "mean_area": float(self.areas.mean()),
+                "max_area": float(self.areas.max()),
+                "single_triangle_fragments": int(np.sum(self.ntriangles == 1))}
+
+    def __repr__(self):
+        return f"FragmentStatistics(count={self.count}, total_area={self.total_area!r})"

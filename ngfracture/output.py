@@ -1,0 +1,749 @@
+"""Writing results: VTK time series for ParaView/PyVista, PNG pictures, plots, JSON summaries.
+
+    writer = TimeSeriesWriter("out/run")                       # refuses a folder with results
+    writer.write(step, load, mesh, u, fragment=result.fragment)   # step_000012.vtu + cracks_000012.vtp
+    render_png(mesh, u, result.fragment, "out/run/final.png")
+    write_summary("out/run/summary.json", {"fragments": stats.count})
+
+Files of a :class:`TimeSeriesWriter` folder
+-------------------------------------------
+``step_NNNNNN.vtu``
+    The mesh with shared vertices (one VTK point per mesh vertex, z = 0), reference
+    coordinates. Point data ``displacement`` (3-vector, z = 0: ParaView's *Warp By Vector*
+    gives the deformed configuration) and, with a strain measure, ``nodal_strain`` (the
+    crack criterion's vertex tensor), ``nodal_principal_strain``, ``nodal_principal_direction``.
+    Cell data ``region`` (0-based material region; names in the field data
+    ``region_names``), ``fragment``, ``strain`` (3x3 tensor, in-plane components, zz = 0),
+    ``principal_strain`` and ``principal_direction`` (unit 3-vector, z = 0).
+``cracks_NNNNNN.vtp``
+    The crack faces as line cells (the boundary segments named ``crack``), with their own
+    copy of the vertices and their ``displacement``, so the same *Warp By Vector* applies.
+    A separate file rather than line cells in the .vtu: mixed cells would break cell data
+    (every line would need a fragment and a strain) and filters like *Threshold*.
+``results.pvd``, ``cracks.pvd``
+    Collections listing the steps with time = load parameter; open these in ParaView
+    (File > Open) or ``pyvista.get_reader``. Rewritten atomically after every step.
+
+Strains are those of the P1 interpolant of the vertex displacements (element-wise constant,
+Green-Lagrange by default), the same quantity the crack criterion averages at the vertices.
+"""
+import ctypes.util
+import glob
+import io
+import json
+import math
+import os
+import re
+import sys
+import tempfile
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import numpy as np
+
+from . import crack
+from .problem import check_mesh, element_vertices
+
+__all__ = ["MeshArrays", "vertex_arrays", "element_strain", "to_pyvista", "cracks_to_pyvista",
+           "TimeSeriesWriter", "RenderError", "check_headless", "render_png", "plot_fragment_sizes", "write_summary"]
+
+
+# -- arrays ---------------------------------------------------------------------------------
+
+class MeshArrays:
+    """Plain arrays of a 2D mesh (reference configuration).
+
+    Attributes
+    ----------
+    points : numpy.ndarray
+        (nv, 2) vertex coordinates (a copy).
+    triangles : numpy.ndarray
+        (ne, 3) 0-based vertex numbers, int64.
+    regions : numpy.ndarray
+        (ne,) 0-based material region of every triangle; names in ``region_names``.
+    region_names : list of str
+    segments : numpy.ndarray
+        (ns, 2) 0-based vertex numbers of the boundary segments (domain on the left).
+    segment_boundary : numpy.ndarray
+        (ns,) 0-based boundary number of every segment; names in ``boundary_names``.
+    boundary_names : list of str
+    """
+
+    def __init__(self, points, triangles, regions, region_names, segments, segment_boundary,
+                 boundary_names):
+        self.points, self.triangles, self.regions = points, triangles, regions
+        self.region_names, self.segments = region_names, segments
+        self.segment_boundary, self.boundary_names = segment_boundary, boundary_names
+
+    def boundary_segments(self, name):
+        """The (m, 2) segments of the boundary called ``name`` (empty if there is none)."""
+        ids = [i for i, n in enumerate(self.boundary_names) if n == name]
+        return self.segments[np.isin(self.segment_boundary, ids)]
+
+
+def vertex_arrays(mesh):
+    """Reference coordinates, triangles, regions and named boundary segments of a mesh.
+
+    Parameters
+    ----------
+    mesh : ngsolve.Mesh
+        2D triangle mesh.
+
+    Returns
+    -------
+    MeshArrays
+        Crack faces are ``arrays.boundary_segments("crack")``.
+
+    Raises
+    ------
+    ValueError
+        Not a 2D NGSolve triangle mesh.
+    """
+    check_mesh(mesh)
+    ngmesh = mesh.ngmesh
+    tri = element_vertices(mesh)
+    regions = ngmesh.Elements2D().NumPy()["index"].astype(np.int32) - 1
+    seg = ngmesh.Elements1D().NumPy()
+    return MeshArrays(points=ngmesh.Coordinates()[:, :2].copy(), triangles=tri, regions=regions,
+                      region_names=list(mesh.GetMaterials()),
+                      segments=seg["nodes"][:, :2].astype(np.int64) - 1,
+                      segment_boundary=seg["index"].astype(np.int32) - 1,
+                      boundary_names=list(mesh.GetBoundaries()))
+
+
+def _displacement(mesh, u):
+    U = crack.vertex_displacement(u)
+    if U.shape != (mesh.nv, 2):
+        raise ValueError(f"ngfracture.output: displacement has {U.shape[0]} vertex values, "
+                         f"the mesh has {mesh.nv} vertices")
+    if not np.all(np.isfinite(U)):
+        raise ValueError("ngfracture.output: displacement has NaN or inf values")
+    return U
+
+
+def _pad3(a):
+    return np.column_stack([a, np.zeros(len(a))])
+
+
+def element_strain(mesh, u, measure="green", arrays=None):
+    """Strain of the P1 interpolant of the vertex displacements, one tensor per triangle.
+
+    Parameters
+    ----------
+    mesh : ngsolve.Mesh
+    u : ngsolve.GridFunction or numpy.ndarray
+        Displacement (``VectorH1``) or vertex values (nv, 2).
+    measure : {'green', 'linear'}
+        (H + H^T + H^T H)/2 or (H + H^T)/2 with H = grad u.
+
+    Returns
+    -------
+    numpy.ndarray
+        (ne, 3), rows (xx, yy, xy), xy the tensor shear.
+
+    Raises
+    ------
+    ValueError
+        Unknown measure, or a displacement that does not fit the mesh.
+    """
+    if measure not in ("green", "linear"):
+        raise ValueError(f"ngfracture.output: measure must be 'green' or 'linear', got {measure!r}")
+    a = arrays or vertex_arrays(mesh)
+    U = _displacement(mesh, u)
+    X, T = a.points, a.triangles
+    D = np.stack([X[T[:, 1]] - X[T[:, 0]], X[T[:, 2]] - X[T[:, 0]]], axis=2)   # columns: edges
+    DU = np.stack([U[T[:, 1]] - U[T[:, 0]], U[T[:, 2]] - U[T[:, 0]]], axis=2)
+    # H D = DU  <=>  D^T H^T = DU^T
+    H = np.linalg.solve(np.transpose(D, (0, 2, 1)), np.transpose(DU, (0, 2, 1))).transpose(0, 2, 1)
+    E = 0.5 * (H + np.transpose(H, (0, 2, 1)))
+    if measure == "green":
+        E = E + 0.5 * np.einsum("eki,ekj->eij", H, H)
+    return np.column_stack([E[:, 0, 0], E[:, 1, 1], E[:, 0, 1]])
+
+
+def _tensor9(t):
+    """(n, 3) rows (xx, yy, xy) as VTK's 9-component tensors (zz = 0)."""
+    out = np.zeros((len(t), 9))
+    out[:, 0], out[:, 4], out[:, 1], out[:, 3] = t[:, 0], t[:, 1], t[:, 2], t[:, 2]
+    return out
+
+
+def _add_user_data(data, extra, n, where):
+    for name, values in (extra or {}).items():
+        v = np.asarray(values)
+        if v.shape[:1] != (n,):
+            raise ValueError(f"ngfracture.output: {where} array {name!r} has shape {v.shape}, "
+                             f"expected {n} rows")
+        data[name] = v
+
+
+def to_pyvista(mesh, u=None, fragment=None, strain="green", point_data=None, cell_data=None,
+               arrays=None):
+    """The mesh as a shared-vertex ``pyvista.UnstructuredGrid`` with result fields.
+
+    Parameters
+    ----------
+    mesh : ngsolve.Mesh
+        2D triangle mesh, reference configuration.
+    u : ngsolve.GridFunction or numpy.ndarray, optional
+        Displacement; point data ``displacement`` as 3-vectors (z = 0), float64.
+    fragment : array_like of int, optional
+        Fragment id per triangle (cell data ``fragment``).
+    strain : {'green', 'linear', None}
+        Strain measure for the strain fields (needs ``u``); None writes none.
+    point_data, cell_data : dict of str -> array_like, optional
+        Further arrays (nv or ne rows), e.g. a stress evaluated by the caller.
+    arrays : MeshArrays, optional
+        Reuse arrays already extracted with :func:`vertex_arrays`.
+
+    Returns
+    -------
+    pyvista.UnstructuredGrid
+        Points (nv, 3) with z = 0, one VTK_TRIANGLE per element in element order. Field
+        data ``region_names``. See the module docstring for the arrays.
+
+    Raises
+    ------
+    ValueError
+        Arrays whose length does not fit the mesh, non-finite displacement.
+    """
+    import pyvista as pv
+    a = arrays or vertex_arrays(mesh)
+    ne, nv = len(a.triangles), len(a.points)
+    cells = np.column_stack([np.full(ne, 3, dtype=np.int64), a.triangles]).ravel()
+    grid = pv.UnstructuredGrid(cells, np.full(ne, pv.CellType.TRIANGLE, dtype=np.uint8),
+                               _pad3(a.points))
+    grid.cell_data["region"] = a.regions
+    grid.field_data["region_names"] = np.array(a.region_names if a.region_names else [""])
+    if fragment is not None:
+        f = np.asarray(fragment)
+        if f.shape != (ne,) or not np.issubdtype(f.dtype, np.integer):
+            raise ValueError(f"ngfracture.output: fragment must be {ne} integers (one per "
+                             f"triangle), got shape {f.shape} dtype {f.dtype}")
+        grid.cell_data["fragment"] = f
+    if u is not None:
+        U = _displacement(mesh, u)
+        grid.point_data["displacement"] = _pad3(U)
+        if strain is not None:
+            E = element_strain(mesh, U, strain, a)
+            val, d = crack.principal(E)
+            grid.cell_data["strain"] = _tensor9(E)
+            grid.cell_data["principal_strain"] = val
+            grid.cell_data["principal_direction"] = _pad3(d)
+            En = crack.vertex_strain(mesh, U, strain)
+            val, d = crack.principal(En)
+            grid.point_data["nodal_strain"] = _tensor9(En)
+            grid.point_data["nodal_principal_strain"] = val
+            grid.point_data["nodal_principal_direction"] = _pad3(d)
+    _add_user_data(grid.point_data, point_data, nv, "point_data")
+    _add_user_data(grid.cell_data, cell_data, ne, "cell_data")
+    return grid
+
+
+def cracks_to_pyvista(mesh, u=None, boundary="crack", arrays=None):
+    """The crack faces (boundary segments named ``boundary``) as line cells.
+
+    Parameters
+    ----------
+    mesh : ngsolve.Mesh
+    u : ngsolve.GridFunction or numpy.ndarray, optional
+        Displacement; point data ``displacement`` (3-vectors, z = 0).
+    boundary : str
+        Boundary name of the crack faces.
+    arrays : MeshArrays, optional
+
+    Returns
+    -------
+    pyvista.PolyData
+        One line per segment (both faces of a crack: two lines on the same reference
+        points); only the vertices on those segments, their mesh numbers in point data
+        ``vertex``. Empty (no points, no lines) when nothing has cracked.
+    """
+    import pyvista as pv
+    a = arrays or vertex_arrays(mesh)
+    seg = a.boundary_segments(boundary)
+    used, local = np.unique(seg, return_inverse=True)
+    local = local.reshape(seg.shape)
+    if len(seg):
+        # points and lines together: PolyData(points) alone would add a vertex cell per point
+        poly = pv.PolyData(_pad3(a.points[used]),
+                           lines=np.column_stack([np.full(len(seg), 2, dtype=np.int64), local]).ravel())
+    else:
+        return pv.PolyData()          # pyvista refuses empty (0, 3) point arrays
+    poly.point_data["vertex"] = used
+    if u is not None:
+        poly.point_data["displacement"] = _pad3(_displacement(mesh, u)[used])
+    return poly
+
+
+# -- atomic files ---------------------------------------------------------------------------
+
+def _fsync_dir(folder):
+    fd = os.open(folder, os.O_RDONLY)
+    try:
+        os.fsync(fd)
+    finally:
+        os.close(fd)
+
+
+def _atomic_bytes(path, data, force):
+    """Write bytes to path through a synced temp file; refuse an existing path unless force."""
+    path = Path(path)
+    fd, tmp = tempfile.mkstemp(prefix=".tmp_ngf_", suffix=path.suffix, dir=path.parent)
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+            fh.flush()
+            os.fsync(fh.fileno())
+        _publish(tmp, path, force)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+
+
+def _publish(tmp, path, force):
+    """Rename tmp to path; without force, a link that fails if path exists (no race)."""
+    if force:
+        os.replace(tmp, path)
+    else:
+        try:
+            os.link(tmp, path)
+        except FileExistsError:
+            raise FileExistsError(f"ngfracture.output: {path} exists; pass force=True to overwrite it") from None
+        os.unlink(tmp)
+    _fsync_dir(Path(path).parent)
+
+
+def _save_vtk(obj, path, compression):
+    """Save a pyvista object through a temp file in the same folder, then rename."""
+    path = Path(path)
+    fd, tmp = tempfile.mkstemp(prefix=".tmp_ngf_", suffix=path.suffix, dir=path.parent)
+    os.close(fd)
+    try:
+        obj.save(tmp, binary=True, compression=compression)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+
+
+# -- time series ----------------------------------------------------------------------------
+
+class TimeSeriesWriter:
+    """VTK files per step plus ``.pvd`` collections (time = load parameter) in one folder.
+
+    Parameters
+    ----------
+    folder : str or pathlib.Path
+        Created if missing.
+    force : bool
+        If the folder already holds results of a writer, delete them (only the files this
+        class writes: ``step_*.vtu``, ``cracks_*.vtp``, ``results.pvd``, ``cracks.pvd``,
+        ``.tmp_ngf_*``) instead of refusing.
+    resume : bool
+        Continue the series in the folder: keep the steps up to ``last_step`` (all if None),
+        delete this writer's files of later steps, continue the collections.
+    last_step : int, optional
+        With ``resume``: the last step to keep (e.g. the step of the checkpoint resumed from).
+    compression : {'lz4', 'zlib', 'lzma', None}
+        Compression of the binary VTK arrays (lossless). lz4 by default: at 100k triangles
+        it wrote a step about 2.5 times faster than zlib for random-valued fields (1.2 to
+        1.8 times for smooth ones) for 1.5 to 3 times the size (ParaView >= 5.5 reads it);
+        zlib for the smallest files.
+
+    Attributes
+    ----------
+    steps : list of (int, float)
+        (step, time) of every step in the collection.
+
+    Raises
+    ------
+    FileExistsError
+        The folder holds results and neither ``force`` nor ``resume`` is given.
+    FileNotFoundError
+        ``resume`` on a folder without ``results.pvd``, or a step file it lists is missing.
+    ValueError
+        ``force`` together with ``resume``; ``last_step`` without ``resume``.
+    """
+
+    PVD = "results.pvd"
+    CRACK_PVD = "cracks.pvd"
+    _OWN = re.compile(r"^(step_\d{6}\.vtu|cracks_\d{6}\.vtp|results\.pvd|cracks\.pvd|\.tmp_ngf_.*)$")
+    _STEP = re.compile(r"^(?:step_(\d{6})\.vtu|cracks_(\d{6})\.vtp)$")
+
+    def __init__(self, folder, force=False, resume=False, last_step=None, compression="lz4"):
+        if force and resume:
+            raise ValueError("TimeSeriesWriter: force=True deletes results, resume=True keeps them; choose one")
+        if last_step is not None and not resume:
+            raise ValueError("TimeSeriesWriter: last_step is only meaningful with resume=True")
+        self.folder = Path(folder)
+        self.folder.mkdir(parents=True, exist_ok=True)
+        self.compression = compression
+        self.steps = []
+        own = sorted(p for p in os.listdir(self.folder) if self._OWN.match(p))
+        if resume:
+            self._resume(own, last_step)
+        elif own:
+            if not force:
+                raise FileExistsError(
+                    f"TimeSeriesWriter: {self.folder} already holds results ({own[0]}, {len(own)} "
+                    "file(s)); pass force=True to delete them or resume=True to continue")
+            for name in own:
+                os.unlink(self.folder / name)
+            _fsync_dir(self.folder)
+
+    def _resume(self, own, last_step):
+        pvd = self.folder / self.PVD
+        if not pvd.exists():
+            raise FileNotFoundError(f"TimeSeriesWriter: nothing to resume, {pvd} does not exist")
+        for step, time, _ in self._read_pvd(pvd):
+            if last_step is None or step <= last_step:
+                for name in (self._name(step), self._crack_name(step)):
+                    if not (self.folder / name).exists():
+                        raise FileNotFoundError(f"TimeSeriesWriter: {pvd} lists step {step} but "
+                                                f"{self.folder / name} is missing")
+                self.steps.append((step, time))
+        keep = {s for s, _ in self.steps}
+        for name in own:
+            m = self._STEP.match(name)
+            # later steps (and temp files of a killed run) go; the collections are rewritten
+            if (m and int(m.group(1) or m.group(2)) not in keep) or name.startswith(".tmp_ngf_"):
+                os.unlink(self.folder / name)
+        self._write_collections()
+
+    def _read_pvd(self, pvd):
+        try:
+            root = ET.parse(pvd).getroot()
+        except ET.ParseError as e:
+            raise ValueError(f"TimeSeriesWriter: {pvd} is not valid XML ({e})") from None
+        out = []
+        for ds in root.iter("DataSet"):
+            m = re.match(r"^step_(\d{6})\.vtu$", ds.get("file", ""))
+            if not m:
+                raise ValueError(f"TimeSeriesWriter: {pvd} lists {ds.get('file')!r}, not a file of this writer")
+            out.append((int(m.group(1)), float(ds.get("timestep")), ds.get("file")))
+        return out
+
+    @staticmethod
+    def _name(step):
+        return f"step_{step:06d}.vtu"
+
+    @staticmethod
+    def _crack_name(step):
+        return f"cracks_{step:06d}.vtp"
+
+    def _collection(self, name_of):
+        lines = ['<?xml version="1.0"?>',
+                 '<VTKFile type="Collection" version="0.1" byte_order="LittleEndian">',
+                 "  <Collection>"]
+        # repr: the shortest string that reads back as the same float
+        lines += [f'    <DataSet timestep="{t!r}" group="" part="0" file="{name_of(s)}"/>'
+                  for s, t in self.steps]
+        lines += ["  </Collection>", "</VTKFile>", ""]
+        return "\n".join(lines).encode()
+
+    def _write_collections(self):
+        _atomic_bytes(self.folder / self.PVD, self._collection(self._name), force=True)
+        _atomic_bytes(self.folder / self.CRACK_PVD, self._collection(self._crack_name), force=True)
+
+    def write(self, step, time, mesh, u=None, fragment=None, strain="green", point_data=None,
+              cell_data=None, crack_boundary="crack"):
+        """Write one step and update the collections.
+
+        Parameters
+        ----------
+        step : int
+            Step number (>= 0), larger than every step already written.
+        time : float
+            The load parameter: the time value in the collections.
+        mesh, u, fragment, strain, point_data, cell_data
+            As for :func:`to_pyvista`.
+        crack_boundary : str
+            Boundary name of the crack faces.
+
+        Returns
+        -------
+        (pathlib.Path, pathlib.Path)
+            The .vtu and .vtp written.
+
+        Raises
+        ------
+        ValueError
+            A step not larger than the last one (it would overwrite), a step beyond 6
+            digits, a non-finite time.
+        """
+        if isinstance(step, bool) or not isinstance(step, (int, np.integer)) or not 0 <= step <= 999999:
+            raise ValueError(f"TimeSeriesWriter.write: step must be an integer in [0, 999999], got {step!r}")
+        step = int(step)
+        if self.steps and step <= self.steps[-1][0]:
+            raise ValueError(f"TimeSeriesWriter.write: step {step} is not after the last written "
+                             f"step {self.steps[-1][0]}; steps must increase (no silent overwrite)")
+        time = float(time)
+        if not math.isfinite(time):
+            raise ValueError(f"TimeSeriesWriter.write: time must be finite, got {time!r}")
+        a = vertex_arrays(mesh)
+        vtu, vtp = self.folder / self._name(step), self.folder / self._crack_name(step)
+        for p in (vtu, vtp):
+            if p.exists():   # a file the collection does not list: never overwrite it silently
+                raise FileExistsError(f"TimeSeriesWriter.write: {p} exists but is not in the collection")
+        _save_vtk(to_pyvista(mesh, u, fragment, strain, point_data, cell_data, arrays=a), vtu,
+                  self.compression)
+        _save_vtk(cracks_to_pyvista(mesh, u, crack_boundary, arrays=a), vtp, self.compression)
+        self.steps.append((step, time))
+        self._write_collections()
+        return vtu, vtp
+
+
+# -- pictures -------------------------------------------------------------------------------
+
+class RenderError(RuntimeError):
+    """Headless rendering is impossible on this machine; the message says what is missing."""
+
+
+def _dri_drivers():
+    dirs = [d for d in os.environ.get("LIBGL_DRIVERS_PATH", "").split(":") if d]
+    dirs += glob.glob("/usr/lib/*/dri") + ["/usr/lib/dri", "/usr/lib64/dri"]
+    return [f for d in dirs for f in glob.glob(os.path.join(d, "*_dri.so"))]
+
+
+def check_headless():
+    """Make sure VTK can render without a display, or raise RenderError saying why.
+
+    With a display (``DISPLAY``/``WAYLAND_DISPLAY`` set) or off Linux nothing is checked.
+    Otherwise Mesa's EGL (``libEGL.so.1``, ``libEGL_mesa.so.0`` and a DRI driver; Debian
+    packages ``libegl1 libegl-mesa0 libgl1-mesa-dri``) or OSMesa must be present, and
+    ``VTK_DEFAULT_OPENGL_WINDOW`` is set to the matching VTK window unless already set
+    (this skips VTK's X attempt).
+
+    Raises
+    ------
+    RenderError
+    """
+    if not sys.platform.startswith("linux") or os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"):
+        return
+    missing = []
+    if not ctypes.util.find_library("EGL"):
+        missing.append("libEGL.so.1 (Debian package libegl1)")
+    if not ctypes.util.find_library("EGL_mesa"):
+        missing.append("libEGL_mesa.so.0 (libegl-mesa0)")
+    if not _dri_drivers():
+        missing.append("a Mesa DRI driver such as swrast_dri.so (libgl1-mesa-dri)")
+    if not missing:
+        os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
+    elif ctypes.util.find_library("OSMesa"):
+        os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkOSOpenGLRenderWindow")
+    else:
+        raise RenderError("ngfracture.output: headless rendering is impossible: no display and "
+                          f"missing {', '.join(missing)} (or OSMesa). On Debian/Ubuntu: "
+                          "apt-get install -y libegl1 libegl-mesa0 libgl1-mesa-dri")
+
+
+# matplotlib's tab20, dark shades first: consecutive fragment ids get different hues
+_FRAGMENT_COLOURS = ["#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2",
+                     "#7f7f7f", "#bcbd22", "#17becf", "#aec7e8", "#ffbb78", "#98df8a", "#ff9896",
+                     "#c5b0d5", "#c49c94", "#f7b6d2", "#c7c7c7", "#dbdb8d", "#9edae5"]
+
+
+def render_png(mesh, u, fragment, path, window_size=(1200, 900), scale=1.0, crack_boundary="crack",
+               line_width=2.0, force=False):
+    """A PNG of the deformed configuration coloured by fragment, crack faces drawn in black.
+
+    Parameters
+    ----------
+    mesh : ngsolve.Mesh
+    u : ngsolve.GridFunction or numpy.ndarray or None
+        Displacement (None: the reference configuration).
+    fragment : array_like of int
+        Fragment id per triangle; 20 colours, cycled.
+    path : str or pathlib.Path
+        The PNG file; its folder must exist.
+    window_size : (int, int)
+        Width and height in pixels.
+    scale : float
+        Displacement magnification.
+    crack_boundary : str
+    line_width : float
+        Width of the crack lines in pixels.
+    force : bool
+        Overwrite an existing file.
+
+    Returns
+    -------
+    pathlib.Path
+
+    Raises
+    ------
+    RenderError
+        Rendering is impossible here (missing EGL/Mesa libraries, or VTK failed); the
+        message names what is missing.
+    FileExistsError
+        ``path`` exists and not ``force``.
+    """
+    path = Path(path)
+    if path.exists() and not force:
+        raise FileExistsError(f"render_png: {path} exists; pass force=True to overwrite it")
+    check_headless()
+    import pyvista as pv
+    pv.OFF_SCREEN = True
+    a = vertex_arrays(mesh)
+    U = np.zeros((mesh.nv, 2)) if u is None else _displacement(mesh, u)
+    grid = to_pyvista(mesh, U, fragment, strain=None, arrays=a)
+    grid.points = grid.points + scale * grid.point_data["displacement"]
+    grid.cell_data["colour"] = grid.cell_data["fragment"] % 20
+    lines = cracks_to_pyvista(mesh, U, crack_boundary, arrays=a)
+    if lines.n_points:
+        lines.points = lines.points + scale * lines.point_data["displacement"]
+    plotter = None
+    try:
+        plotter = pv.Plotter(off_screen=True, window_size=[int(w) for w in window_size])
+        plotter.set_background("white")
+        plotter.add_mesh(grid, scalars="colour", cmap=_FRAGMENT_COLOURS, clim=[0, 19], n_colors=20,
+                         show_scalar_bar=False, preference="cell")
+        if lines.n_cells:
+            plotter.add_mesh(lines, color="black", line_width=line_width)
+        plotter.view_xy()
+        fd, tmp = tempfile.mkstemp(prefix=".tmp_ngf_", suffix=".png", dir=path.parent)
+        os.close(fd)
+        try:
+            img = plotter.screenshot(tmp, return_img=True)
+            if img is None or img.size == 0:
+                raise RenderError("ngfracture.output: VTK returned an empty image")
+            _publish(tmp, path, force)
+        finally:
+            if os.path.exists(tmp):
+                os.unlink(tmp)
+    except RenderError:
+        raise
+    except Exception as e:
+        raise RenderError(f"ngfracture.output: VTK could not render off-screen ({type(e).__name__}: {e}); "
+                          "headless Linux needs libegl1 libegl-mesa0 libgl1-mesa-dri") from e
+    finally:
+        if plotter is not None:
+            plotter.close()
+    return path
+
+
+def plot_fragment_sizes(areas, path, force=False, title="Fragment-size distribution"):
+    """Histogram and cumulative distribution of fragment areas, log scale (matplotlib, Agg).
+
+    Left: number of fragments per logarithmic area bin. Right: fraction of fragments with
+    area >= A (the complementary cumulative distribution), log-log.
+
+    Parameters
+    ----------
+    areas : array_like
+        Fragment areas, all finite and > 0 (e.g. ``FragmentStatistics.areas``).
+    path : str or pathlib.Path
+        Image file (format from the suffix: .png, .pdf, .svg).
+    force : bool
+        Overwrite an existing file.
+    title : str
+
+    Returns
+    -------
+    pathlib.Path
+
+    Raises
+    ------
+    ValueError
+        No areas, or an area that is not finite and positive.
+    FileExistsError
+        ``path`` exists and not ``force``.
+    """
+    from matplotlib.figure import Figure   # no pyplot: no global backend, no display
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    A = np.asarray(areas, dtype=float).ravel()
+    if A.size == 0:
+        raise ValueError("plot_fragment_sizes: no fragment areas")
+    if not np.all(np.isfinite(A) & (A > 0)):
+        raise ValueError(f"plot_fragment_sizes: areas must be finite and > 0; {np.sum(~(np.isfinite(A) & (A > 0)))} are not")
+    path = Path(path)
+    if path.exists() and not force:
+        raise FileExistsError(f"plot_fragment_sizes: {path} exists; pass force=True to overwrite it")
+    lo, hi = A.min(), A.max()
+    if hi <= lo * (1 + 1e-12):          # one size only: a bin around it
+        lo, hi = lo / 1.5, hi * 1.5
+    bins = np.logspace(np.log10(lo), np.log10(hi), max(5, min(50, int(np.sqrt(A.size)) + 1)))
+    fig = Figure(figsize=(9, 4), layout="constrained")
+    FigureCanvasAgg(fig)
+    ax1, ax2 = fig.subplots(1, 2)
+    ax1.hist(A, bins=bins, color="tab:blue", edgecolor="black", linewidth=0.5)
+    ax1.set_xscale("log")
+    ax1.set_xlabel("fragment area")
+    ax1.set_ylabel("number of fragments")
+    s = np.sort(A)
+    ax2.step(s, 1.0 - np.arange(A.size) / A.size, where="post", color="tab:red")
+    ax2.set_xscale("log")
+    ax2.set_yscale("log")
+    ax2.set_xlabel("fragment area A")
+    ax2.set_ylabel("fraction of fragments with area >= A")
+    fig.suptitle(f"{title} ({A.size} fragments)")
+    buf = io.BytesIO()
+    fig.savefig(buf, format=path.suffix.lstrip(".") or "png", dpi=120)
+    _atomic_bytes(path, buf.getvalue(), force)
+    return path
+
+
+# -- JSON summary ---------------------------------------------------------------------------
+
+def _jsonable(obj, where):
+    if isinstance(obj, dict):
+        out = {}
+        for k, v in obj.items():
+            if isinstance(k, np.generic):
+                k = k.item()
+            if not isinstance(k, (str, int, float, bool)) and k is not None:
+                raise TypeError(f"write_summary: key {where}[{k!r}] is a {type(k).__name__}, not a JSON key")
+            out[k] = _jsonable(v, f"{where}[{k!r}]")
+        return out
+    if isinstance(obj, (list, tuple)):
+        return [_jsonable(v, f"{where}[{i}]") for i, v in enumerate(obj)]
+    if isinstance(obj, np.ndarray):
+        return _jsonable(obj.tolist(), where)
+    if isinstance(obj, np.generic):
+        obj = obj.item()
+    if isinstance(obj, Path):
+        return str(obj)
+    if isinstance(obj, float) and not math.isfinite(obj):
+        raise ValueError(f"write_summary: {where} is {obj!r}, which JSON cannot hold")
+    if obj is None or isinstance(obj, (str, int, float, bool)):
+        return obj
+    raise TypeError(f"write_summary: {where} is a {type(obj).__name__}, which JSON cannot hold")
+
+
+def write_summary(path, summary, force=False):
+    """Write a dict as JSON atomically (temp file, fsync, rename), numpy types converted.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The JSON file; its folder must exist.
+    summary : dict
+        Values: numbers, strings, bools, None, lists, dicts, numpy scalars and arrays,
+        paths.
+    force : bool
+        Overwrite an existing file.
+
+    Returns
+    -------
+    pathlib.Path
+
+    Raises
+    ------
+    FileExistsError
+        ``path`` exists and not ``force`` (also when it appears while writing).
+    ValueError
+        A NaN or infinite number (named by its key path).
+    TypeError
+        A value JSON cannot hold (named by its key path).
+    """
+    if not isinstance(summary, dict):
+        raise TypeError(f"write_summary: summary must be a dict, got {type(summary).__name__}")
+    path = Path(path)
+    if path.exists() and not force:
+        raise FileExistsError(f"write_summary: {path} exists; pass force=True to overwrite it")
+    text = json.dumps(_jsonable(summary, "summary"), indent=2, allow_nan=False) + "\n"
+    _atomic_bytes(path, text.encode(), force)
+    return path
