@@ -16,6 +16,10 @@ contact      node-to-segment contact rows (selection rules, gap linearisation) a
 lshape       the L-shape manufactured solution of the paper (section 4.1), meshes, errors
 verify       convergence studies against exact solutions
 cli          the command line, python -m ngfracture
+meshio       meshes as arrays and back; separate bodies merged into one mesh
+contact_solver  equilibrium with unilateral contact: active set around the Newton solver
+output       VTK time series, crack edges, headless PNG, fragment-size plot, summary JSON
+fragments    fragment statistics (count, areas, centroids)
 """
 import ngsolve  # load NGSolve's shared libraries before the compiled add-on
 
