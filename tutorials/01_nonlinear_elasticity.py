@@ -27,10 +27,7 @@
 # - draw the deformed plate with matplotlib.
 
 # %%
-import matplotlib
-
-matplotlib.use("Agg")  # headless; in Jupyter the figures are still shown inline
-import matplotlib.pyplot as plt
+import matplotlib.pyplot as plt  # inline in Jupyter; Agg (no window) in a headless script
 import matplotlib.tri as mtri
 import ngsolve as ng
 import numpy as np
