@@ -121,7 +121,7 @@ print("timings (s):", {phase: round(t, 4) for phase, t in status.timings.items()
 
 # %% [markdown]
 # At 0.01 % stretch the models differ by terms of the order of the strain; at 30 % the
-# contraction differs by several per cent between the models. The linear model needs
+# contraction differs by tens of per cent between the models. The linear model needs
 # one iteration per load step, the nonlinear ones several.
 
 # %%
@@ -220,7 +220,7 @@ prob = setup(materials["neo-Hooke"], -1.2)
 status = prob.solve(load_steps=1)
 print(status.converged, status.reason)
 print(status.message)
-assert status.reason in ("inverted_element", "diverged"), status.reason
+assert status.reason == "inverted_element", status.reason
 assert np.all(prob.u.vec.FV().NumPy() == 0.0)
 
 # %% [markdown]
