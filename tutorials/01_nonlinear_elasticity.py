@@ -117,6 +117,8 @@ for stretch in (1e-4, 0.3):
 # %%
 status = results["neo-Hooke", 0.3][2]
 print("steps", status.steps, "iterations", status.iterations)
+print(f"last relative increment {status.increment_history[-1]:.1e}, "
+      f"last out-of-balance force {status.residual_history[-1]:.1e}")
 print("timings (s):", {phase: round(t, 4) for phase, t in status.timings.items()})
 
 # %% [markdown]
