@@ -61,7 +61,9 @@ setup(
         "pyvista",
         "matplotlib",
     ],
-    extras_require={"test": ["pytest"]},
+    # nbclient + nbformat + ipykernel: the smallest set that executes the tutorial
+    # notebooks headless (tests/test_tutorials.py); no Jupyter server or UI
+    extras_require={"test": ["pytest", "nbclient", "nbformat", "ipykernel"]},
     entry_points={"console_scripts": ["ngfracture=ngfracture.__main__:main"]},
     zip_safe=False,
 )
