@@ -10,6 +10,8 @@ NGSolve assembles the residual and the consistent tangent from the strain-energy
 density of the material (``Variation``, i.e. SymbolicEnergy); constraints are
 Lagrange-multiplier rows (constraints.py) solved as described in kkt.py.
 """
+import contextlib
+
 import numpy as np
 import ngsolve as ng
 
@@ -97,9 +99,12 @@ class ElasticProblem:
         self.mesh, self.order = mesh, order
         #: False only when every region is linear: then the stiffness is constant
         self.nonlinear = any(m.geometrically_nonlinear for m in self.materials.values())
-        self.fes = ng.VectorH1(mesh, order=order)
-        self.u = ng.GridFunction(self.fes, name="displacement")
-        self.constraints = ConstraintSet(self.fes)
+        # building the spaces is parallel inside the task manager (0.3 s at 360k dofs)
+        big = mesh.ne * order * order >= self.PARALLEL_MIN_DOFS // 2
+        with ng.TaskManager() if big else contextlib.nullcontext():
+            self.fes = ng.VectorH1(mesh, order=order)
+            self.u = ng.GridFunction(self.fes, name="displacement")
+            self.constraints = ConstraintSet(self.fes)
         self.load_factor = ng.Parameter(0.0)
         self._loads = []      # (kind, CF, region)
         self._form = None
@@ -134,6 +139,14 @@ class ElasticProblem:
         self._form = None
 
     # -- the discrete operators ----------------------------------------------------------
+    #: below this many dofs assembly runs serially: starting NGSolve's task manager costs
+    #: more than it saves (measured in a Jupyter kernel: a tutorial ran 4x slower with it)
+    PARALLEL_MIN_DOFS = 20000
+
+    def threads(self):
+        """NGSolve's task manager for problems big enough to profit from threads."""
+        return ng.TaskManager() if self.fes.ndof >= self.PARALLEL_MIN_DOFS else contextlib.nullcontext()
+
     @property
     def form(self):
         """The energy as an NGSolve BilinearForm (Variation): Apply = residual, linearisation = tangent."""
@@ -158,7 +171,7 @@ class ElasticProblem:
         """
         form = self.form
         if self.nonlinear or self._linear_K is None:
-            with ng.TaskManager():
+            with self.threads():
                 form.AssembleLinearization(self.u.vec)
             if not self.nonlinear:
                 self._linear_K = form.mat
@@ -170,7 +183,7 @@ class ElasticProblem:
                     # the energy is quadratic: its gradient at u = 0 is minus the full load vector
                     factor = self.load_factor.Get()
                     self.load_factor.Set(1.0)
-                    with ng.TaskManager():
+                    with self.threads():
                         form.Apply(zero, self._load)
                     self.load_factor.Set(factor)
         return form.mat
@@ -183,7 +196,7 @@ class ElasticProblem:
             # linear model: f - K u by one matrix-vector product instead of an assembly
             self._res.data = K * self.u.vec
             return -(self._res.FV().NumPy() + self.load_factor.Get() * self._load.FV().NumPy())
-        with ng.TaskManager():
+        with self.threads():
             form.Apply(self.u.vec, self._res)
         return -self._res.FV().NumPy().copy()
 

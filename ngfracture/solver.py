@@ -186,7 +186,7 @@ class NewtonSolver:
                 with _Timer(timings, "assemble"):
                     K = prob.tangent()
                 try:
-                    with _Timer(timings, "factorize"):
+                    with _Timer(timings, "factorize"), prob.threads():
                         kkt = ConstrainedSolver(K, rows.fixed_dofs, rows.C,
                                                 self.linear_solver, self.inverse,
                                                 modes=support.modes, pins=support.pins)
@@ -200,7 +200,7 @@ class NewtonSolver:
             du_fixed[rows.fixed_dofs] = target_fixed - u[rows.fixed_dofs]   # eq. 6
             h = target_rows - rows.C @ u
             try:
-                with _Timer(timings, "solve"):
+                with _Timer(timings, "solve"), prob.threads():
                     du, status.multipliers = kkt.solve(r, du_fixed, h)
                 if k == 0:
                     # the force scale of the step: out-of-balance plus the pull of the prescribed values
