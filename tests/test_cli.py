@@ -1,5 +1,6 @@
 """The command line: ``python -m ngfracture verify lshape ...``."""
 import json
+import os
 import subprocess
 import sys
 
@@ -48,9 +49,14 @@ def test_existing_json_needs_force(tmp_path):
     (["--variant", "free"], "invalid choice"),
     (["--gamma", "2"], "--gamma needs --mesh graded"),
 ])
-def test_bad_input_is_a_clear_error(args, message):
+def test_bad_input_is_a_clear_error(args, message, tmp_path):
+    # run outside the repository: from its root, "-m ngfracture" would import the
+    # uncompiled source tree instead of the installed package
+    env = dict(os.environ)
+    if env.get("PYTHONPATH"):
+        env["PYTHONPATH"] = os.pathsep.join(os.path.abspath(p) for p in env["PYTHONPATH"].split(os.pathsep))
     proc = subprocess.run([sys.executable, "-m", "ngfracture", "verify", "lshape", *args],
-                          capture_output=True, text=True)
+                          capture_output=True, text=True, cwd=tmp_path, env=env)
     assert proc.returncode == 2
     assert message in proc.stderr
     assert "Traceback" not in proc.stderr
