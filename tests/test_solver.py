@@ -363,3 +363,33 @@ def test_free_fragments_get_their_rigid_modes_fixed(cls):
     free_strain = math.sqrt(ng.Integrate(ng.IfPos(ng.x - 1.5, 1, 0) *
                                          ng.InnerProduct(prob.strain(), prob.strain()), mesh, order=4))
     assert free_strain < 1e-12
+
+
+@pytest.mark.parametrize("nu", [0.49, 0.499, 0.4999])
+@pytest.mark.parametrize("cls", NONLINEAR)
+def test_near_incompressible_converges_or_says_why(cls, nu):
+    """Locking makes the discrete problem stiff, never garbage: converged with finite u, or a reason."""
+    mesh = square_mesh(0.2)
+    prob = nf.ElasticProblem(mesh, cls(1.0, nu))
+    prob.add_dirichlet("left", (0.0, 0.0))
+    prob.add_dirichlet("right", (0.05, 0.0))
+    status = prob.solve(method="full", load_steps=2)
+    u = prob.u.vec.FV().NumPy()
+    assert np.all(np.isfinite(u))
+    if not status.converged:
+        # measured: neo-Hooke at 0.4999, a full Newton iterate inverts elements (lambda/mu = 5000)
+        assert status.reason == "inverted_element" and np.all(u == 0.0)
+        return
+    # equilibrium to the solver tolerance: out-of-balance tiny against the reactions
+    r = prob.out_of_balance()
+    fixed = prob.assemble_constraints().fixed_dofs
+    free = np.ones(r.size, dtype=bool)
+    free[fixed] = False
+    assert np.linalg.norm(r[free]) < 1e-8 * np.linalg.norm(r[fixed])
+
+
+def test_3d_mesh_is_refused():
+    from netgen.csg import unit_cube
+    mesh3d = ng.Mesh(unit_cube.GenerateMesh(maxh=0.5))
+    with pytest.raises(ValueError, match="2D meshes; this mesh has dimension 3"):
+        nf.ElasticProblem(mesh3d, nf.LinearElastic(1.0, 0.3))
