@@ -39,6 +39,11 @@ class MeshArrays:
                 prefix + "region_names": np.array("\n".join(self.region_names)),
                 prefix + "bc_names": np.array("\n".join(self.bc_names))}
 
+    def boundary_segments(self, name):
+        """The (m, 2) segments of the boundary called ``name`` (empty if there is none)."""
+        ids = [i for i, n in enumerate(self.bc_names, start=1) if n == name]
+        return self.segments[np.isin(self.seg_bc, ids)]
+
     @classmethod
     def from_dict(cls, d, prefix="mesh_"):
         return cls(d[prefix + "points"], d[prefix + "triangles"], d[prefix + "regions"],

@@ -42,44 +42,14 @@ from pathlib import Path
 import numpy as np
 
 from . import crack
-from .problem import check_mesh, element_vertices
+from .meshio import mesh_to_arrays
+from .problem import check_mesh
 
-__all__ = ["MeshArrays", "vertex_arrays", "element_strain", "to_pyvista", "cracks_to_pyvista",
+__all__ = ["vertex_arrays", "element_strain", "to_pyvista", "cracks_to_pyvista",
            "TimeSeriesWriter", "RenderError", "check_headless", "render_png", "plot_fragment_sizes", "write_summary"]
 
 
 # -- arrays ---------------------------------------------------------------------------------
-
-class MeshArrays:
-    """Plain arrays of a 2D mesh (reference configuration).
-
-    Attributes
-    ----------
-    points : numpy.ndarray
-        (nv, 2) vertex coordinates (a copy).
-    triangles : numpy.ndarray
-        (ne, 3) 0-based vertex numbers, int64.
-    regions : numpy.ndarray
-        (ne,) 0-based material region of every triangle; names in ``region_names``.
-    region_names : list of str
-    segments : numpy.ndarray
-        (ns, 2) 0-based vertex numbers of the boundary segments (domain on the left).
-    segment_boundary : numpy.ndarray
-        (ns,) 0-based boundary number of every segment; names in ``boundary_names``.
-    boundary_names : list of str
-    """
-
-    def __init__(self, points, triangles, regions, region_names, segments, segment_boundary,
-                 boundary_names):
-        self.points, self.triangles, self.regions = points, triangles, regions
-        self.region_names, self.segments = region_names, segments
-        self.segment_boundary, self.boundary_names = segment_boundary, boundary_names
-
-    def boundary_segments(self, name):
-        """The (m, 2) segments of the boundary called ``name`` (empty if there is none)."""
-        ids = [i for i, n in enumerate(self.boundary_names) if n == name]
-        return self.segments[np.isin(self.segment_boundary, ids)]
-
 
 def vertex_arrays(mesh):
     """Reference coordinates, triangles, regions and named boundary segments of a mesh.
@@ -91,8 +61,9 @@ def vertex_arrays(mesh):
 
     Returns
     -------
-    MeshArrays
-        Crack faces are ``arrays.boundary_segments("crack")``.
+    ngfracture.meshio.MeshArrays
+        Regions and boundary numbers are 1-based into their name lists; crack faces are
+        ``arrays.boundary_segments("crack")``.
 
     Raises
     ------
@@ -100,15 +71,7 @@ def vertex_arrays(mesh):
         Not a 2D NGSolve triangle mesh.
     """
     check_mesh(mesh)
-    ngmesh = mesh.ngmesh
-    tri = element_vertices(mesh)
-    regions = ngmesh.Elements2D().NumPy()["index"].astype(np.int32) - 1
-    seg = ngmesh.Elements1D().NumPy()
-    return MeshArrays(points=ngmesh.Coordinates()[:, :2].copy(), triangles=tri, regions=regions,
-                      region_names=list(mesh.GetMaterials()),
-                      segments=seg["nodes"][:, :2].astype(np.int64) - 1,
-                      segment_boundary=seg["index"].astype(np.int32) - 1,
-                      boundary_names=list(mesh.GetBoundaries()))
+    return mesh_to_arrays(mesh)
 
 
 def _displacement(mesh, u):
@@ -213,7 +176,7 @@ def to_pyvista(mesh, u=None, fragment=None, strain="green", point_data=None, cel
     cells = np.column_stack([np.full(ne, 3, dtype=np.int64), a.triangles]).ravel()
     grid = pv.UnstructuredGrid(cells, np.full(ne, pv.CellType.TRIANGLE, dtype=np.uint8),
                                _pad3(a.points))
-    grid.cell_data["region"] = a.regions
+    grid.cell_data["region"] = a.regions - 1     # 0-based index into region_names
     grid.field_data["region_names"] = np.array(a.region_names if a.region_names else [""])
     if fragment is not None:
         f = np.asarray(fragment)
