@@ -12,9 +12,8 @@ configuration are available by passing the vertex displacement.
 import math
 
 import numpy as np
-import scipy.sparse as sp
-from scipy.sparse.csgraph import connected_components
 
+from . import rigid
 from ._ngfracture import ElementAreas
 from .problem import check_mesh, element_vertices
 
@@ -38,12 +37,9 @@ def fragment_ids(mesh):
     """
     check_mesh(mesh)
     T = element_vertices(mesh)
-    ne, nv = len(T), mesh.nv
-    # bipartite triangle-vertex graph: two triangles are connected iff they share a vertex
-    rows = np.repeat(np.arange(ne), 3)
-    A = sp.coo_matrix((np.ones(3 * ne), (rows, ne + T.ravel())), shape=(ne + nv, ne + nv))
-    _, labels = connected_components(A, directed=False)
-    labels = labels[:ne]
+    # pieces of the vertex graph; a triangle belongs to the piece of any of its vertices
+    _, comp = rigid.pieces(T, mesh.nv)
+    labels = comp[T[:, 0]]
     _, first = np.unique(labels, return_index=True)
     # relabel by smallest triangle: order components by the first triangle they contain
     order = np.argsort(first)
