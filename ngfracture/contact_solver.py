@@ -14,6 +14,7 @@ At the end the Kuhn-Tucker conditions of eq. 8 hold to the solver tolerance:
 g_N >= 0 up to ``penetration_tol``, lambda <= 0, and lambda g_N = 0 (active rows have
 g_N = 0, released ones carry no force).
 """
+import time
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -21,6 +22,7 @@ import scipy.sparse as sp
 
 from . import contact
 from .collision import detect_collisions
+from .crack import vertex_displacement
 from .meshio import mesh_to_arrays
 from .solver import SolveStatus
 
@@ -109,21 +111,18 @@ class ContactSolver:
         self.options["fix_free_modes"] = True
 
     def _geometry(self):
+        """Mesh arrays, fragment per triangle, and the fixed dofs (all, and in the P1 layout).
+
+        None of it changes while the problem is solved on one mesh: computed once per solve.
+        """
         prob = self.problem
         arrays = mesh_to_arrays(prob.mesh)
-        nv, n = prob.mesh.nv, prob.fes.ndof // 2
-        U = prob.u.vec.FV().NumPy().reshape(2, n)[:, :nv].T.copy()
         _, comp = prob.fragments()
         fragment = comp[arrays.triangles[:, 0]]
-        return arrays, U, fragment
-
-    def _fixed_p1(self):
-        """Fixed dofs of the problem in the P1 layout of the contact rows (vertex dofs only)."""
-        prob = self.problem
         nv, n = prob.mesh.nv, prob.fes.ndof // 2
         fixed = prob.assemble_constraints().fixed_dofs
         v, c = fixed % n, fixed // n
-        return (c * nv + v)[v < nv]
+        return arrays, fragment, fixed, (c * nv + v)[v < nv]
 
     def _contact_offset(self):
         offset = 0
@@ -135,7 +134,6 @@ class ContactSolver:
 
     def solve(self):
         """Solve for equilibrium with contact; returns a ContactResult."""
-        import time
         prob = self.problem
         prob.constraints.clear_rows(LABEL)
         t0 = time.perf_counter()
@@ -149,14 +147,14 @@ class ContactSolver:
             # one uncracked body cannot touch itself: no collision work at all
             result.converged, result.reason = True, "converged"
             return result
-        fixed = self._fixed_p1()
+        arrays, fragment, fixed_all, fixed = self._geometry()
         released = set()
         previous = None
         nv, n = prob.mesh.nv, prob.fes.ndof // 2
         for rnd in range(1, self.max_rounds + 1):
             result.rounds = rnd
             t0 = time.perf_counter()
-            arrays, U, fragment = self._geometry()
+            U = vertex_displacement(prob.u)
             cs = contact.contact_constraints(arrays.points, U, arrays.triangles, arrays.segments,
                                              fragment=fragment, tol=self.tol, fixed_dofs=fixed,
                                              rtol=self.rank_tol)
@@ -192,7 +190,7 @@ class ContactSolver:
             # adhesive beyond rounding: relative to the largest force the constraints carry
             r = prob.out_of_balance()
             scale = max(float(np.abs(lam).max(initial=0.0)),
-                        float(np.linalg.norm(r[prob.assemble_constraints().fixed_dofs])), 1e-300)
+                        float(np.linalg.norm(r[fixed_all])), 1e-300)
             adhesive = np.flatnonzero(lam > 1e-10 * scale)
             if adhesive.size:
                 released.update(keys[i] for i in adhesive)
@@ -273,8 +271,7 @@ def _clip_half_plane(poly, a, b):
 def fragment_overlap_area(problem):
     """Total overlap area between triangles of the current configuration (0 if none)."""
     arrays = mesh_to_arrays(problem.mesh)
-    nv, n = problem.mesh.nv, problem.fes.ndof // 2
-    U = problem.u.vec.FV().NumPy().reshape(2, n)[:, :nv].T
+    U = vertex_displacement(problem.u)
     _, comp = problem.fragments()
     fragment = comp[arrays.triangles[:, 0]]
     pairs = detect_collisions(arrays.points, U, arrays.triangles, boundary_edges=arrays.segments,

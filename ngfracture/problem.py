@@ -17,6 +17,7 @@ import ngsolve as ng
 
 from . import rigid
 from .constraints import ConstraintSet
+from .crack import vertex_displacement
 from .materials import Material
 from .solver import NewtonSolver
 
@@ -210,9 +211,8 @@ class ElasticProblem:
 
     def support(self, rows):
         """The rigid modes that single-dof rows leave free, with pins to factorise around them."""
-        n = self.fes.ndof // 2
-        x = self._points + self.u.vec.FV().NumPy().reshape(2, n)[:, :self.mesh.nv].T
-        return rigid.analyse_support(x, self._elements, n, self.fes.ndof, rows.fixed_dofs)
+        x = self._points + vertex_displacement(self.u)
+        return rigid.analyse_support(x, self._elements, self.fes.ndof // 2, self.fes.ndof, rows.fixed_dofs)
 
     def floating_bodies(self, rows, support=None):
         """A message naming the pieces whose rigid-body modes no constraint fixes ('' if none).
