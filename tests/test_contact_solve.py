@@ -100,3 +100,11 @@ def test_overlap_area_of_two_triangles():
     # intersection: the triangle (0.5,0), (1,0), (0.5,0.5), area 1/8
     assert overlap_area(x, tris, np.array([[0, 1]])) == pytest.approx(0.125, rel=1e-15)
 
+
+
+def test_unsettled_active_set_is_a_reason_not_a_result():
+    """One round cannot confirm the set: the solver says so instead of claiming convergence."""
+    mesh, prob = pressed_blocks()
+    result = ContactSolver(prob, tol=0.02, max_rounds=1).solve()
+    assert not result.converged and result.reason == "active_set"
+    assert result.rounds == 1 and len(result.history) == 1
