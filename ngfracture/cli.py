@@ -2,10 +2,11 @@
 
 Commands
 --------
+run      a fracture simulation of one of the paper's scenes (``run plate ...``)
 verify   convergence studies against exact solutions (``verify lshape ...``)
 
 Each command is one ``_add_<command>(subparsers)`` function that registers its
-parser and sets ``func``; a ``run`` command (scenes) plugs in the same way.
+parser and sets ``func``.
 """
 import argparse
 import json
@@ -71,6 +72,79 @@ def _positive_float(text):
     if not (math.isfinite(value) and value > 0):
         raise argparse.ArgumentTypeError(f"must be a finite number > 0, got {text}")
     return value
+
+
+def _add_run(subparsers):
+    from . import scenes
+
+    p = subparsers.add_parser(
+        "run", help="a fracture simulation of one of the paper's scenes",
+        description="Run a quasi-static fracture simulation under load control (paper section "
+                    "4.2): increase the prescribed deformation step by step, split overstrained "
+                    "vertices, relax at fixed load until no new crack appears. Writes a VTK time "
+                    "series (results.pvd, cracks.pvd), checkpoints, summary.json, final.png and "
+                    "fragment_sizes.png into the output folder. Exit status 0 when the run ends "
+                    "normally, 1 when a step fails after all retries (the last good state is "
+                    "written), 2 on bad input.")
+    p.add_argument("scene", choices=sorted(scenes.SCENES),
+                   help="; ".join(f"{k}: {v.__doc__.splitlines()[0].rstrip('.')}"
+                                  for k, v in sorted(scenes.SCENES.items())))
+    p.add_argument("--maxh", type=_positive_float, default=None,
+                   help="mesh size (default: the scene's, about the paper's resolution)")
+    p.add_argument("--steps", type=_int_at_least(1), default=200,
+                   help="at most this many accepted load steps (default 200)")
+    p.add_argument("--load-max", type=_positive_float, default=None,
+                   help="final value of the load parameter (default: the scene's)")
+    p.add_argument("--out", metavar="DIR", default=None,
+                   help="output folder (default out/SCENE); refused if it holds results, "
+                        "unless --force or --resume")
+    p.add_argument("--force", action="store_true",
+                   help="replace the results in DIR (only files ngfracture writes are removed)")
+    p.add_argument("--resume", action="store_true",
+                   help="continue the run in DIR from its newest checkpoint; the result equals "
+                        "an uninterrupted run")
+    p.add_argument("--pictures", choices=["final", "every", "none"], default="final",
+                   help="PNG of the final state (default), of every step, or none")
+    p.add_argument("--contact", choices=["auto", "never"], default="auto",
+                   help="auto: contact from the first crack on (from the start for separate "
+                        "bodies); never: no contact rows (overlap is still measured)")
+    p.add_argument("--quiet", action="store_true", help="no progress line")
+    p.set_defaults(func=_run_run)
+
+
+def _progress_line(info):
+    sys.stderr.write(f"\rstep {info['step']:4d}  load {info['x']:.4e}  split vertices "
+                     f"{info['split_vertices']:6d}  fragments {info['fragments']:4d}  "
+                     f"{info['seconds']:7.1f} s")
+    sys.stderr.flush()
+
+
+def _run_run(args):
+    from . import scenes
+    from .simulation import Simulation, StepControl
+
+    if args.force and args.resume:
+        raise ValueError("--force and --resume exclude each other")
+    out = args.out if args.out is not None else os.path.join("out", args.scene)
+    options = {} if args.maxh is None else {"maxh": args.maxh}
+    scene = scenes.SCENES[args.scene](**options)
+    if args.load_max is not None:
+        scene.load_max = args.load_max
+        scene.parameters["load_max"] = args.load_max
+    sim = Simulation(scene, StepControl(max_steps=args.steps), out=out, force=args.force,
+                     resume=args.resume, pictures=args.pictures, contact=args.contact,
+                     progress=None if args.quiet else _progress_line)
+    result = sim.run()
+    if not args.quiet:
+        sys.stderr.write("\n")
+    s = result.summary
+    print(f"{scene.name}: {s['n_steps']} steps, {s['n_split_vertices']} split vertices, crack length "
+          f"{s['crack_length']:.4g}, {s['n_fragments']} fragments, {s['timings']['wall']:.1f} s; "
+          f"{result.reason}: {result.message}")
+    print(f"results in {out}/ (results.pvd, cracks.pvd, summary.json, final.png)")
+    if not result.ok:
+        raise RuntimeError(result.message)
+    return 0
 
 
 def _add_verify(subparsers):
@@ -150,6 +224,7 @@ def build_parser():
         prog="ngfracture",
         description="ngfracture: brittle fracture by node splitting, an NGSolve plugin.")
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+    _add_run(subparsers)
     _add_verify(subparsers)
     return parser
 
@@ -167,11 +242,13 @@ def main(argv=None):
     int
         Exit status: 0 on success, 2 on bad input, 1 on a failed computation.
     """
+    from .checkpoint import CheckpointError
+
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
         return args.func(args)
-    except (ValueError, FileExistsError) as exc:
+    except (ValueError, FileExistsError, CheckpointError) as exc:
         parser.exit(2, f"{parser.prog} {args.command}: error: {exc}\n")
     except RuntimeError as exc:
         print(f"{parser.prog} {args.command}: failed: {exc}", file=sys.stderr)

@@ -22,6 +22,7 @@ This is exact when K R = 0, i.e. for pieces free of initial stress.
 Failures are reported, never returned as numbers: a factorisation that produces
 NaN/inf or does not solve its own system is ``SingularSystem``.
 """
+import contextlib
 import warnings
 
 import numpy as np
@@ -41,6 +42,25 @@ def to_scipy(mat):
     """An NGSolve sparse matrix as a scipy CSR matrix (a copy)."""
     vals, cols, rows = mat.CSR()
     return sp.csr_matrix((np.array(vals), np.array(cols), np.array(rows)), shape=(mat.height, mat.width))
+
+
+@contextlib.contextmanager
+def reproducible_threads():
+    """One NGSolve thread while factorising, for results that repeat to the last bit.
+
+    NGSolve's sparse Cholesky factorises in parallel with a summation order that varies
+    between runs: two factorisations of the same matrix gave solutions differing in the
+    last bit (3e-16 relative), enough to change a crack pattern or a resumed run. With one
+    thread it is bitwise reproducible; on the 2-core machine it was not slower
+    (1.87-1.90 s against 1.89-2.13 s at 145k P1 dofs). Must be entered outside a
+    TaskManager context (its thread count is fixed when it starts).
+    """
+    before = ng.GetNumThreads()
+    ng.SetNumThreads(1)
+    try:
+        yield
+    finally:
+        ng.SetNumThreads(before)
 
 
 class ConstrainedSolver:
@@ -85,7 +105,8 @@ class ConstrainedSolver:
         self.gmres_tol = gmres_tol
         self._tmp = K.CreateColVector()
         if linear_solver == "direct":
-            self._inv = K.Inverse(factor_dofs, inverse=inverse)
+            with reproducible_threads():
+                self._inv = K.Inverse(factor_dofs, inverse=inverse)
             self._checked = False
         else:
             Kff = to_scipy(K)[self.factor_free][:, self.factor_free].tocsc()

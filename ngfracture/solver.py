@@ -186,7 +186,8 @@ class NewtonSolver:
                 with _Timer(timings, "assemble"):
                     K = prob.tangent()
                 try:
-                    with _Timer(timings, "factorize"), prob.threads():
+                    # not inside prob.threads(): the factorisation runs on one thread (kkt.py)
+                    with _Timer(timings, "factorize"):
                         kkt = ConstrainedSolver(K, rows.fixed_dofs, rows.C,
                                                 self.linear_solver, self.inverse,
                                                 modes=support.modes, pins=support.pins)

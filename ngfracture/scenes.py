@@ -1,0 +1,108 @@
+"""The paper's scenes (section 4.2) as functions that return a Scene.
+
+Each is short on purpose: copy one, change the geometry, material or loading, and
+pass it to :class:`ngfracture.simulation.Simulation`.
+
+* :func:`plate`: a square glass plate with small notches on the top and bottom edges,
+  pulled apart by gliding conditions on the left and right sides.
+* :func:`disk`: a brittle disk with a hole around a softer, separate core whose inner
+  boundary expands; contact passes the expansion on; the inner part of the disk
+  breaks into grains while the outer ring stays whole.
+* :func:`disintegration`: the same disk expanded further, until it falls apart.
+"""
+import math
+
+import ngsolve as ng
+from netgen.geom2d import SplineGeometry
+
+from .materials import StVenantKirchhoff
+from .simulation import Scene
+
+#: the paper's glass: E = 5 GPa, nu = 0.18, critical principal strain 1.3817e-4
+GLASS = dict(E=5e9, nu=0.18, critical=1.3817e-4)
+
+
+def _positive(name, value):
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0:
+        raise ValueError(f"{name} must be a finite number > 0, got {value!r}")
+    return float(value)
+
+
+def notched_plate_mesh(maxh=0.034, width=1.0, height=1.0, notch_depth=0.04, notch_width=0.02,
+                       notch_maxh=None):
+    """A rectangle with a V-notch in the middle of the top and of the bottom edge.
+
+    Boundaries: ``left``, ``right``, ``top``, ``bottom`` (the notches belong to top and
+    bottom); region ``plate``. Near the notch tips the mesh size is ``notch_maxh``
+    (default: a quarter of the notch depth, at most maxh).
+
+    Returns
+    -------
+    ngsolve.Mesh
+    """
+    for name, v in (("maxh", maxh), ("width", width), ("height", height), ("notch_depth", notch_depth),
+                    ("notch_width", notch_width)):
+        _positive(name, v)
+    if notch_depth >= height / 2 or notch_width >= width:
+        raise ValueError(f"the notches (depth {notch_depth}, width {notch_width}) do not fit "
+                         f"the {width} x {height} plate")
+    hn = min(maxh, notch_depth / 4) if notch_maxh is None else _positive("notch_maxh", notch_maxh)
+    geo = SplineGeometry()
+    c, w = width / 2, notch_width / 2
+    corners = [(0, 0), (c - w, 0), (c, notch_depth), (c + w, 0), (width, 0), (width, height),
+               (c + w, height), (c, height - notch_depth), (c - w, height), (0, height)]
+    tips = {2, 7}
+    pts = [geo.AppendPoint(x, y, maxh=hn) if i in tips else geo.AppendPoint(x, y)
+           for i, (x, y) in enumerate(corners)]
+    names = ["bottom"] * 4 + ["right"] + ["top"] * 4 + ["left"]
+    for i, bc in enumerate(names):
+        near_tip = i in (1, 2, 6, 7)
+        geo.Append(["line", pts[i], pts[(i + 1) % len(pts)]], bc=bc, leftdomain=1, rightdomain=0,
+                   **({"maxh": hn} if near_tip else {}))
+    geo.SetMaterial(1, "plate")
+    return ng.Mesh(geo.GenerateMesh(maxh=maxh))
+
+
+def plate(maxh=0.034, strain_max=1e-3, dx=None, material=None, critical=GLASS["critical"]):
+    """The plate under tension of paper section 4.2 (Fig. 8).
+
+    A 1 x 1 plate of glass (E = 5 GPa, nu = 0.18, plane stress, St Venant-Kirchhoff)
+    with a notch of depth 0.04 in the middle of the top and bottom edges. The left and
+    right sides glide: u_x = -x/2 and +x/2, u_y free (the one rigid mode this leaves,
+    vertical translation, is held by a multiplier row). x is the total extension.
+
+    Parameters
+    ----------
+    maxh : float
+        Mesh size; the default gives triangles of area about 0.0005 as in the paper
+        (minimum angle about 30 degrees from netgen's quality meshing).
+    strain_max : float
+        Final mean strain x / width (the run stops earlier once broken through).
+    dx : float, optional
+        First increment of x; default a tenth of the uncracked failure extension.
+    material : Material, optional
+    critical : float
+        Critical principal strain.
+
+    Returns
+    -------
+    Scene
+    """
+    maxh, strain_max = _positive("maxh", maxh), _positive("strain_max", strain_max)
+    mesh = notched_plate_mesh(maxh)
+    material = material if material is not None else StVenantKirchhoff(GLASS["E"], GLASS["nu"], plane="stress")
+    dx = _positive("dx", dx) if dx is not None else critical / 10
+
+    def apply_load(prob, x):
+        prob.add_dirichlet("left", -x / 2, component="x")
+        prob.add_dirichlet("right", x / 2, component="x")
+
+    return Scene(name="plate", mesh=mesh, material=material, critical=critical, apply_load=apply_load,
+                 load_max=strain_max, dx=dx, contact_tol=1e-3 * maxh, stop_when_unloaded=True,
+                 parameters={"maxh": maxh, "strain_max": strain_max, "dx": dx, "critical": critical,
+                             "E": material.E, "nu": material.nu, "model": type(material).__name__,
+                             "notch_depth": 0.04, "notch_width": 0.02})
+
+
+#: the scenes of ``python -m ngfracture run``
+SCENES = {"plate": plate}

@@ -1,0 +1,654 @@
+"""Quasi-static fracture simulations under load control (paper section 4.2, made robust).
+
+One load step, from an accepted state (mesh, displacement, load parameter x)::
+
+    1. x_try = x + dx; solve at x_try (modified Newton; contact once there are cracks
+       or separate bodies; free fragments held on their rigid modes);
+    2. find the overstrained vertices and split them (one crack pass);
+       if the pass split more than ``max_new_cracks`` vertices and dx can still be
+       cut: go back to the saved state and retry with dx * cut;
+    3. relax at fixed x_try: solve on the split mesh, split again, until a pass
+       splits nothing (the energy release through crack formation);
+    4. accept: write the step, checkpoint, x = x_try; after ``grow_after`` steps in a
+       row without a crack, dx = min(dx * grow, dx_max).
+
+A failed solve (diverged, NaN, singular, inverted element, contact set that does not
+settle) anywhere in the step cuts dx and retries from the saved state; after
+``max_retries`` failures in a row the run stops with the last good state written and
+a reason.  The run ends when x reaches the scene's ``load_max``, after ``max_steps``
+steps, or, for scenes that ask for it, once the body is broken through (the elastic
+energy has fallen below ``unloaded_fraction`` of its peak after cracks appeared).
+
+Where the paper is vague, we chose:
+
+* A "crack" in the step-control rule is a split vertex (a new crack-face node) of the
+  first pass after the increment; cracks that run at fixed load during relaxation
+  are the physical answer to that load and are not limited.
+* The criterion is the paper's nodal principal strain (Green-Lagrange, averaged from
+  the elements around a vertex) against a critical strain per material region;
+  regions without a critical strain never crack.  Vertices are compared by their
+  strain divided by their critical strain, so one pass serves several materials.
+* Every accepted state goes through the checkpoint's mesh representation (arrays and
+  back) whether or not it is written, so a resumed run continues from bitwise the
+  same mesh and displacement as the uninterrupted one.
+* External work is the trapezoidal sum of reaction forces times the increments of
+  the prescribed displacements; relaxation at fixed load does no work, so
+  work - elastic energy is the energy released by cracking.
+"""
+import math
+import time
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+import ngsolve as ng
+
+from . import checkpoint
+from .contact_solver import ContactSolver, fragment_overlap_area
+from .crack import StrainCriterion, split_by_tensor, transfer
+from .fragments import FragmentStatistics
+from .materials import Material
+from .meshio import MeshArrays, mesh_from_arrays, mesh_to_arrays
+from .problem import ElasticProblem
+
+PHASES = ("solve", "strain", "split", "rebuild", "collision", "contact", "output")
+
+
+@dataclass
+class Scene:
+    """Everything that defines a fracture simulation except the step control.
+
+    Parameters
+    ----------
+    name : str
+        Shown in outputs and stored in checkpoints (a resume must match it).
+    mesh : ngsolve.Mesh
+        The undamaged body (or bodies) in the reference configuration.
+    material : Material or dict of str -> Material
+        One material, or one per material region.
+    critical : float or dict of str -> float
+        Critical principal strain (> 0), or one per region; a region missing from the
+        dict (or given None) never cracks.
+    apply_load : callable(problem, x)
+        Adds the constraints (and loads) for the deformation parameter ``x`` to a fresh
+        ElasticProblem on the current mesh. Boundary names survive cracking; crack faces
+        are named ``crack``.
+    load_max : float
+        The deformation parameter at which the run ends (> 0).
+    dx : float
+        First increment of x (> 0).
+    contact_tol : float
+        Precision threshold of collision detection and contact selection (a length).
+    contact : bool
+        Solve with contact from the start (separate bodies); otherwise contact starts
+        with the first crack.
+    stop_when_unloaded : bool
+        End the run once the body is broken through (elastic energy below
+        ``unloaded_fraction`` of its peak after cracks appeared).
+    parameters : dict
+        The numbers that define the scene, copied into summary.json.
+    """
+    name: str
+    mesh: object
+    material: object
+    critical: object
+    apply_load: Callable
+    load_max: float
+    dx: float
+    contact_tol: float
+    contact: bool = False
+    stop_when_unloaded: bool = False
+    parameters: dict = field(default_factory=dict)
+
+    def validate(self):
+        """Raise ValueError naming the first bad field (before any work)."""
+        if not isinstance(self.name, str) or not self.name:
+            raise ValueError(f"Scene.name must be a non-empty string, got {self.name!r}")
+        for key in ("load_max", "dx", "contact_tol"):
+            v = getattr(self, key)
+            low_ok = v >= 0 if key == "contact_tol" else v > 0
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or not low_ok:
+                raise ValueError(f"Scene {self.name!r}: {key} must be a finite number "
+                                 f"{'>= 0' if key == 'contact_tol' else '> 0'}, got {v!r}")
+        if not callable(self.apply_load):
+            raise ValueError(f"Scene {self.name!r}: apply_load must be callable(problem, x)")
+        regions = set(self.mesh.GetMaterials())
+        crit = self.critical if isinstance(self.critical, dict) else {r: self.critical for r in regions}
+        for region, c in crit.items():
+            if region not in regions:
+                raise ValueError(f"Scene {self.name!r}: critical strain given for region {region!r}, "
+                                 f"which is not in the mesh; its regions are {sorted(regions)}")
+            if c is not None and (isinstance(c, bool) or not isinstance(c, (int, float))
+                                  or not math.isfinite(c) or c <= 0):
+                raise ValueError(f"Scene {self.name!r}: critical strain of region {region!r} must be a "
+                                 f"finite number > 0 (or None: never cracks), got {c!r}")
+        if not any(c is not None for c in crit.values()):
+            raise ValueError(f"Scene {self.name!r}: no region can crack (every critical strain is None)")
+        if not isinstance(self.material, (Material, dict)):
+            raise ValueError(f"Scene {self.name!r}: material must be a Material or a dict of them")
+        return crit
+
+
+@dataclass
+class StepControl:
+    """Adaptive load increments (paper 4.2): cut on too many cracks or a failure, grow when quiet.
+
+    Parameters
+    ----------
+    max_new_cracks : int
+        Split vertices allowed in the first crack pass after an increment (paper: 2).
+    cut : float
+        dx is multiplied by this after too many cracks or a failed solve (0 < cut < 1).
+    grow : float
+        dx is multiplied by this after ``grow_after`` crack-free steps in a row (> 1).
+    grow_after : int
+    dx_min, dx_max : float or None
+        Bounds of dx; default ``dx / 64`` and ``8 dx`` of the scene's first dx.
+    max_steps : int
+        Accepted steps at most.
+    max_retries : int
+        Failed attempts in a row before the run stops.
+    max_relax_passes : int
+        Crack passes at fixed load at most (a bound, not a tuning knob).
+    method : {"modified", "full"}
+        Newton variant (paper: modified, tangent factorised once per load step).
+    tol : float
+        Newton tolerance of eq. 7.
+    maxit : int
+        Newton iterations per solve.
+    unloaded_fraction : float
+        See Scene.stop_when_unloaded.
+    """
+    max_new_cracks: int = 2
+    cut: float = 0.5
+    grow: float = 1.5
+    grow_after: int = 2
+    dx_min: float = None
+    dx_max: float = None
+    max_steps: int = 200
+    max_retries: int = 6
+    max_relax_passes: int = 500
+    method: str = "modified"
+    tol: float = 1e-10
+    maxit: int = 60
+    unloaded_fraction: float = 1e-3
+
+    def validate(self, dx):
+        if self.dx_min is None:
+            self.dx_min = dx / 64
+        if self.dx_max is None:
+            self.dx_max = 8 * dx
+        checks = [("max_new_cracks", self.max_new_cracks >= 0), ("cut", 0 < self.cut < 1),
+                  ("grow", self.grow >= 1), ("grow_after", self.grow_after >= 1),
+                  ("dx_min", 0 < self.dx_min <= dx), ("dx_max", self.dx_max >= dx),
+                  ("max_steps", self.max_steps >= 1), ("max_retries", self.max_retries >= 0),
+                  ("max_relax_passes", self.max_relax_passes >= 1),
+                  ("method", self.method in ("modified", "full")), ("tol", 0 < self.tol < 1),
+                  ("maxit", self.maxit >= 1), ("unloaded_fraction", 0 < self.unloaded_fraction < 1)]
+        for name, ok in checks:
+            if not ok:
+                raise ValueError(f"StepControl.{name} = {getattr(self, name)!r} is out of range")
+
+
+class StepFailed(Exception):
+    """A solve inside a step failed; carries the reason for the retry logic."""
+
+    def __init__(self, reason, message):
+        super().__init__(f"{reason}: {message}")
+        self.reason, self.message = reason, message
+
+
+@dataclass
+class State:
+    """An accepted state: everything a resume needs."""
+    arrays: MeshArrays
+    u: np.ndarray            # P1 displacement vector, VectorH1 layout
+    x: float
+    dx: float
+    step: int
+    quiet: int               # crack-free steps in a row
+    work: float              # external work so far
+    reactions: np.ndarray    # reaction at the fixed dofs, for the work of the next step
+    fixed_values: np.ndarray
+    fixed_dofs: np.ndarray
+    peak_energy: float
+    history: list            # one dict per accepted step
+
+
+def round_trip(mesh):
+    """The mesh through its checkpoint representation (arrays and back)."""
+    arrays = mesh_to_arrays(mesh)
+    return arrays, mesh_from_arrays(arrays)
+
+
+class Simulation:
+    """A fracture simulation under load control, with outputs and checkpoints.
+
+    Parameters
+    ----------
+    scene : Scene
+    control : StepControl, optional
+    out : path, optional
+        Output folder: VTK time series, checkpoints, summary.json, pictures. None: no files.
+    force : bool
+        Replace earlier results in ``out`` (only files this code writes are removed).
+    resume : bool
+        Continue from the newest checkpoint in ``out``.
+    pictures : {"final", "every", "none"}
+        PNG of the final state, of every step, or none.
+    checkpoint_every : int
+        Write a checkpoint after every this many accepted steps (and at the end).
+    progress : callable(dict), optional
+        Called after every accepted step with step, x, cracks, fragments, seconds.
+    contact : {"auto", "never"}
+        "auto": contact from the first crack on (or from the start for separate bodies);
+        "never": no contact rows at all (faster where pieces only separate; the summary's
+        ``max_overlap_area`` still measures any overlap).
+
+    Raises
+    ------
+    ValueError
+        A bad scene, step control or option, before any work.
+    FileExistsError
+        ``out`` holds results and neither ``force`` nor ``resume`` is given.
+    checkpoint.CheckpointError
+        ``resume`` with a damaged, foreign or mismatching checkpoint.
+    """
+
+    def __init__(self, scene, control=None, out=None, force=False, resume=False, pictures="final",
+                 checkpoint_every=1, progress=None, contact="auto"):
+        self.scene = scene
+        self.critical = scene.validate()
+        self.control = control if control is not None else StepControl()
+        self.control.validate(scene.dx)
+        if pictures not in ("final", "every", "none"):
+            raise ValueError(f"pictures must be 'final', 'every' or 'none', got {pictures!r}")
+        if contact not in ("auto", "never"):
+            raise ValueError(f"contact must be 'auto' or 'never', got {contact!r}")
+        self.contact = contact
+        if force and resume:
+            raise ValueError("force and resume exclude each other")
+        if isinstance(checkpoint_every, bool) or not isinstance(checkpoint_every, int) or checkpoint_every < 1:
+            raise ValueError(f"checkpoint_every must be an integer >= 1, got {checkpoint_every!r}")
+        self.out = Path(out) if out is not None else None
+        self.force, self.resume, self.pictures = force, resume, pictures
+        self.checkpoint_every = checkpoint_every
+        self.progress = progress
+        self.timings = dict.fromkeys(PHASES, 0.0)
+        self.newton_iterations = []
+        self.writer = None
+        self._resumed_state = None
+        #: math.fsum of the triangle areas; splitting keeps every triangle and coordinate,
+        #: so the final area must equal it to the last bit
+        self.area_initial = FragmentStatistics(scene.mesh).total_area
+        if self.out is not None:
+            self._prepare_output()
+
+    # -- output folder ---------------------------------------------------------------------
+    OWN_PATTERNS = ("step_*.vtu", "cracks_*.vtp", "results.pvd", "cracks.pvd", "checkpoint_*.npz",
+                    "summary.json", "final.png", "step_*.png", "fragment_sizes.png")
+
+    def _own_files(self):
+        return sorted({p for pat in self.OWN_PATTERNS for p in self.out.glob(pat)})
+
+    def _prepare_output(self):
+        from .output import TimeSeriesWriter
+        if self.out.exists() and not self.out.is_dir():
+            raise FileExistsError(f"output folder {self.out} exists and is not a folder")
+        own = self._own_files() if self.out.exists() else []
+        if self.resume:
+            arrays, header = checkpoint.latest(self.out)
+            self._resumed_state = self._state_from_checkpoint(arrays, header)
+            self.writer = TimeSeriesWriter(self.out, resume=True, last_step=self._resumed_state.step)
+            for p in self.out.glob("step_*.png"):   # pictures of steps after the checkpoint
+                if int(p.stem.split("_")[1]) > self._resumed_state.step:
+                    p.unlink()
+            return
+        if own and not self.force:
+            raise FileExistsError(f"output folder {self.out} already holds results ({own[0].name}, ...); "
+                                  f"use force to replace them or resume to continue")
+        self.out.mkdir(parents=True, exist_ok=True)
+        for p in own:
+            p.unlink()
+        self.writer = TimeSeriesWriter(self.out)
+
+    # -- the physics of one configuration ------------------------------------------------------
+    def _problem(self, mesh, x, u=None):
+        t0 = time.perf_counter()
+        prob = ElasticProblem(mesh, self.scene.material, order=1)
+        self.scene.apply_load(prob, x)
+        if u is not None:
+            prob.u.vec.FV().NumPy()[:] = u
+        self.timings["rebuild"] += time.perf_counter() - t0
+        return prob
+
+    def _needs_contact(self, mesh):
+        if self.contact == "never":
+            return False
+        return self.scene.contact or "crack" in mesh.GetBoundaries()
+
+    def _equilibrium(self, prob):
+        """Solve; raise StepFailed with the reason if it does not converge."""
+        c = self.control
+        options = dict(method=c.method, tol=c.tol, maxit=c.maxit)
+        if self._needs_contact(prob.mesh):
+            solver = ContactSolver(prob, tol=self.scene.contact_tol)   # its tol: detection threshold
+            solver.options.update(options)                              # Newton's tol, method, maxit
+            result = solver.solve()
+            self.timings["solve"] += result.timings["solve"]
+            self.timings["contact"] += result.timings["contact"] - result.timings.get("collision", 0.0)
+            self.timings["collision"] += result.timings.get("collision", 0.0)
+            status = result.status
+            self._iterations += status.iterations
+            if not result.converged:
+                raise StepFailed(result.reason, status.message if result.reason == status.reason
+                                 else f"contact active set did not settle in {result.rounds} rounds")
+            return status
+        t0 = time.perf_counter()
+        status = prob.solve(fix_free_modes=True, **options)
+        self.timings["solve"] += time.perf_counter() - t0
+        self._iterations += status.iterations
+        if not status.converged:
+            raise StepFailed(status.reason, status.message)
+        return status
+
+    def _normalised_strain(self, prob):
+        """Vertex strain tensors divided by the vertex's critical strain (0: cannot crack)."""
+        t0 = time.perf_counter()
+        mesh = prob.mesh
+        tensors = StrainCriterion(1.0).vertex_tensor(mesh, prob.u)
+        arrays = self._arrays_of(mesh)
+        names = arrays.region_names
+        inv = np.array([0.0] + [1.0 / self.critical[n] if self.critical.get(n) is not None else 0.0
+                                for n in names])
+        # a vertex takes the smallest critical strain of its triangles (the weakest material)
+        scale = np.zeros(mesh.nv)
+        np.maximum.at(scale, arrays.triangles.ravel(), np.repeat(inv[arrays.regions], 3))
+        self.timings["strain"] += time.perf_counter() - t0
+        return tensors * scale[:, None]
+
+    def _arrays_of(self, mesh):
+        if getattr(self, "_arrays_cache", (None, None))[0] is not mesh:
+            self._arrays_cache = (mesh, mesh_to_arrays(mesh))
+        return self._arrays_cache[1]
+
+    def _crack_pass(self, prob):
+        """One splitting pass; returns (new problem or None, number of split vertices)."""
+        tensors = self._normalised_strain(prob)
+        t0 = time.perf_counter()
+        res = split_by_tensor(prob.mesh, tensors, 1.0)
+        self.timings["split"] += time.perf_counter() - t0 - sum(res.timings.get(k, 0.0) for k in ("netgen", "ngsolve_mesh"))
+        self.timings["rebuild"] += res.timings.get("netgen", 0.0) + res.timings.get("ngsolve_mesh", 0.0)
+        if res.nsplit == 0:
+            return None, 0
+        self._split_positions.append(res.record["position"][np.diff(res.record["new_offsets"]) > 0])
+        u = transfer(prob.u, res)
+        return self._problem(res.mesh, self._x_try, u.vec.FV().NumPy()), res.nsplit
+
+    # -- one load step ----------------------------------------------------------------------------
+    def _attempt(self, state, dx):
+        """Try the step x + dx from an accepted state; returns (problem, first-pass cracks, total cracks).
+
+        Raises StepFailed on a failed solve and returns None for too many cracks.
+        """
+        self._x_try = state.x + dx
+        self._split_positions = []      # per pass: reference positions of the vertices split
+        prob = self._problem(self._mesh, self._x_try, state.u)
+        self._equilibrium(prob)
+        new_prob, first = self._crack_pass(prob)
+        c = self.control
+        if first > c.max_new_cracks and dx * c.cut >= c.dx_min:
+            return None
+        total, passes = first, 0
+        while new_prob is not None:
+            passes += 1
+            if passes > c.max_relax_passes:
+                raise StepFailed("relaxation", f"cracks still grow after {c.max_relax_passes} passes at fixed load")
+            prob = new_prob
+            self._equilibrium(prob)
+            new_prob, n = self._crack_pass(prob)
+            total += n
+        return prob, first, total
+
+    def _accept(self, state, prob, dx, first, total):
+        arrays, mesh = round_trip(prob.mesh)
+        u = prob.u.vec.FV().NumPy().copy()
+        prob = self._problem(mesh, self._x_try, u)   # the state as a resume would see it
+        rows = prob.assemble_constraints()
+        reactions = -prob.out_of_balance()[rows.fixed_dofs]
+        # work of the reactions over the increment (trapezoid; the dofs of the last accepted
+        # state keep their numbers through the increment, cracks come later at fixed load)
+        same = (len(state.fixed_dofs) == 0 or
+                (len(rows.fixed_dofs) >= len(state.fixed_dofs)))
+        dwork = 0.0
+        if len(state.fixed_dofs) and same:
+            pos = {int(d): i for i, d in enumerate(rows.fixed_dofs)}
+            idx = np.array([pos.get(int(d), -1) for d in state.fixed_dofs])
+            ok = idx >= 0
+            r_new = reactions[idx[ok]]
+            dg = rows.fixed_values[idx[ok]] - state.fixed_values[ok]
+            dwork = float(0.5 * np.dot(state.reactions[ok] + r_new, dg))
+        energy = float(prob.energy())
+        stats = FragmentStatistics(mesh)
+        crack_len = crack_length(arrays)
+        quiet = state.quiet + 1 if total == 0 else 0
+        new_dx = dx
+        if quiet >= self.control.grow_after:
+            new_dx, quiet = min(dx * self.control.grow, self.control.dx_max), 0
+        record = {"step": state.step + 1, "x": self._x_try, "dx": dx, "new_cracks_first_pass": int(first),
+                  "split_vertices": int(total), "elastic_energy": energy, "external_work": state.work + dwork,
+                  "released_energy": state.work + dwork - energy, "crack_length": crack_len,
+                  "fragments": int(stats.count), "newton_iterations": int(self._iterations),
+                  "retries": int(self._retries), "relax_passes": max(len(self._split_positions) - 1, 0)}
+        if first and not any(h["split_vertices"] for h in state.history):
+            # where cracking began: the vertices split by the first pass that split any
+            record["initiation"] = self._split_positions[0].tolist()
+        new = State(arrays=arrays, u=u, x=self._x_try, dx=new_dx, step=state.step + 1, quiet=quiet,
+                    work=state.work + dwork, reactions=reactions, fixed_values=rows.fixed_values.copy(),
+                    fixed_dofs=rows.fixed_dofs.copy(), peak_energy=max(state.peak_energy, energy),
+                    history=state.history + [record])
+        return new, prob, mesh, stats
+
+    # -- the run ----------------------------------------------------------------------------------
+    def _initial_state(self):
+        arrays, mesh = round_trip(self.scene.mesh)
+        prob = self._problem(mesh, 0.0)
+        rows = prob.assemble_constraints()
+        return State(arrays=arrays, u=np.zeros(prob.fes.ndof), x=0.0, dx=float(self.scene.dx), step=0,
+                     quiet=0, work=0.0, reactions=np.zeros(len(rows.fixed_dofs)),
+                     fixed_values=rows.fixed_values.copy(), fixed_dofs=rows.fixed_dofs.copy(),
+                     peak_energy=0.0, history=[])
+
+    def run(self):
+        """Run to the end; returns a RunResult (``ok``, ``reason``, ``summary``)."""
+        t_start = time.perf_counter()
+        if self._resumed_state is not None:
+            state = self._resumed_state
+            self._mesh = mesh_from_arrays(state.arrays)
+        else:
+            state = self._initial_state()
+            self._mesh = mesh_from_arrays(state.arrays)
+            if self.writer is not None:
+                self._write_step(state, self._problem(self._mesh, 0.0, state.u), FragmentStatistics(self._mesh))
+                self._checkpoint(state)
+        area_initial = self.area_initial
+        reason, message = "load_max", "reached the final load"
+        c = self.control
+        prob, stats = None, None
+        while True:
+            if state.x >= self.scene.load_max * (1 - 1e-12):
+                break
+            if state.step >= c.max_steps:
+                reason, message = "max_steps", f"stopped after {c.max_steps} steps"
+                break
+            if self.scene.stop_when_unloaded and state.history and state.history[-1]["crack_length"] > 0 and \
+                    state.history[-1]["elastic_energy"] < c.unloaded_fraction * state.peak_energy:
+                reason, message = "broken", "the body is broken through (elastic energy released)"
+                break
+            dx = min(state.dx, self.scene.load_max - state.x)
+            self._retries, failure = 0, None
+            while True:
+                self._iterations = 0
+                try:
+                    attempt = self._attempt(state, dx)
+                except StepFailed as err:
+                    failure = err
+                    attempt = "failed"
+                if attempt is None:            # too many cracks at once: smaller increment
+                    dx *= c.cut
+                    continue
+                if attempt == "failed":
+                    self._retries += 1
+                    if self._retries > c.max_retries or dx * c.cut < c.dx_min:
+                        break
+                    dx *= c.cut
+                    continue
+                break
+            if attempt == "failed":
+                reason = "failed"
+                message = (f"step {state.step + 1} at x = {state.x + dx:.6g} failed {self._retries} time(s); "
+                           f"last reason {failure.reason}: {failure.message}")
+                break
+            prob, first, total = attempt
+            state, prob, self._mesh, stats = self._accept(state, prob, dx, first, total)
+            if total:
+                state.dx = dx            # a step that cracked keeps its (possibly cut) increment
+            self.newton_iterations.append(state.history[-1]["newton_iterations"])
+            if self.writer is not None:
+                self._write_step(state, prob, stats)
+                if state.step % self.checkpoint_every == 0:
+                    self._checkpoint(state)
+            if self.progress is not None:
+                self.progress({"step": state.step, "x": state.x, "split_vertices": sum(h["split_vertices"] for h in state.history),
+                               "fragments": state.history[-1]["fragments"], "seconds": time.perf_counter() - t_start})
+        if prob is None:
+            prob = self._problem(self._mesh, state.x, state.u)
+            stats = FragmentStatistics(self._mesh)
+        if self.writer is not None and state.step % self.checkpoint_every != 0:
+            self._checkpoint(state)
+        summary = self._summary(state, prob, stats, area_initial, reason, message,
+                                time.perf_counter() - t_start)
+        if self.out is not None:
+            self._final_outputs(state, prob, stats, summary)
+        return RunResult(ok=reason in ("load_max", "max_steps", "broken"), reason=reason, message=message,
+                         summary=summary, problem=prob, state=state)
+
+    def _summary(self, state, prob, stats, area_initial, reason, message, wall):
+        hist = state.history
+        overlap = fragment_overlap_area(prob) if stats.count > 1 or self.scene.contact else 0.0
+        return {
+            "scene": self.scene.name, "parameters": self.scene.parameters,
+            "control": {k: v for k, v in asdict(self.control).items()},
+            "reason": reason, "message": message,
+            "n_steps": state.step, "load": state.x,
+            "n_split_vertices": int(sum(h["split_vertices"] for h in hist)),
+            "crack_length": crack_length(state.arrays),
+            "n_fragments": int(stats.count), "fragment_areas": stats.areas.tolist(),
+            "area_initial": area_initial, "area_final": stats.total_area,
+            "max_overlap_area": overlap,
+            "n_vertices": int(prob.mesh.nv), "n_triangles": int(prob.mesh.ne),
+            "crack_initiation": next((h["initiation"] for h in hist if "initiation" in h), []),
+            "energy": [{k: h[k] for k in ("step", "x", "elastic_energy", "external_work", "released_energy")}
+                       for h in hist],
+            "newton_iterations": [h["newton_iterations"] for h in hist],
+            "history": hist,
+            "timings": {**{k: round(v, 6) for k, v in self.timings.items()}, "wall": round(wall, 6)},
+        }
+
+    # -- files ---------------------------------------------------------------------------------------
+    def _write_step(self, state, prob, stats):
+        t0 = time.perf_counter()
+        self.writer.write(state.step, state.x, prob.mesh, prob.u, stats.fragment)
+        if self.pictures == "every":
+            from .output import render_png
+            render_png(prob.mesh, prob.u, stats.fragment, self.out / f"step_{state.step:06d}.png")
+        self.timings["output"] += time.perf_counter() - t0
+
+    def _checkpoint(self, state):
+        t0 = time.perf_counter()
+        arrays = {**state.arrays.as_dict(), "u": state.u, "reactions": state.reactions,
+                  "fixed_values": state.fixed_values, "fixed_dofs": state.fixed_dofs}
+        meta = {"scene": self.scene.name, "parameters": self.scene.parameters,
+                "x": state.x, "dx": state.dx, "step": state.step, "quiet": state.quiet, "work": state.work,
+                "peak_energy": state.peak_energy, "history": state.history,
+                "area_initial": self.area_initial,
+                "timings": self.timings, "newton_iterations": self.newton_iterations}
+        checkpoint.write(self.out, state.step, arrays, meta)
+        self.timings["output"] += time.perf_counter() - t0
+
+    def _state_from_checkpoint(self, arrays, header):
+        meta = header.get("meta", header)
+        if meta.get("scene") != self.scene.name or meta.get("parameters") != _jsonish(self.scene.parameters):
+            raise checkpoint.CheckpointError(
+                f"{self.out}: the checkpoint is of scene {meta.get('scene')!r} with parameters "
+                f"{meta.get('parameters')!r}, not {self.scene.name!r} with {self.scene.parameters!r}")
+        self.area_initial = meta["area_initial"]
+        self.timings.update(meta.get("timings", {}))
+        self.newton_iterations = list(meta.get("newton_iterations", []))
+        return State(arrays=MeshArrays.from_dict(arrays), u=arrays["u"], x=meta["x"], dx=meta["dx"],
+                     step=meta["step"], quiet=meta["quiet"], work=meta["work"], reactions=arrays["reactions"],
+                     fixed_values=arrays["fixed_values"], fixed_dofs=arrays["fixed_dofs"],
+                     peak_energy=meta["peak_energy"], history=meta["history"])
+
+    def _final_outputs(self, state, prob, stats, summary):
+        from .output import RenderError, plot_fragment_sizes, render_png, write_summary
+        t0 = time.perf_counter()
+        pictures = {}
+        if self.pictures != "none":
+            try:
+                render_png(prob.mesh, prob.u, stats.fragment, self.out / "final.png")
+                pictures["final"] = "final.png"
+            except RenderError as err:
+                pictures["final_error"] = str(err)
+        plot_fragment_sizes(stats.areas, self.out / "fragment_sizes.png", force=True)
+        pictures["fragment_sizes"] = "fragment_sizes.png"
+        self.timings["output"] += time.perf_counter() - t0
+        summary["timings"]["output"] = round(self.timings["output"], 6)
+        summary["pictures"] = pictures
+        write_summary(self.out / "summary.json", summary, force=True)
+
+
+def _jsonish(obj):
+    """obj as it comes back from a JSON round trip (tuples -> lists)."""
+    import json
+    return json.loads(json.dumps(obj))
+
+
+@dataclass
+class RunResult:
+    """How a simulation ended.
+
+    Attributes
+    ----------
+    ok : bool
+        True when the run reached its end (final load, step limit, broken through).
+    reason : str
+        "load_max", "max_steps", "broken" or "failed".
+    message : str
+    summary : dict
+        What summary.json holds.
+    problem : ElasticProblem
+        The last accepted state.
+    state : State
+    """
+    ok: bool
+    reason: str
+    message: str
+    summary: dict
+    problem: object
+    state: object
+
+    def __bool__(self):
+        return self.ok
+
+
+def crack_length(arrays):
+    """Length of the crack in the reference configuration: half the crack-face length."""
+    if "crack" not in arrays.bc_names:
+        return 0.0
+    segs = arrays.boundary_segments("crack")
+    if len(segs) == 0:
+        return 0.0
+    d = arrays.points[segs[:, 0]] - arrays.points[segs[:, 1]]
+    return 0.5 * math.fsum(np.hypot(d[:, 0], d[:, 1]))
