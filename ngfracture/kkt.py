@@ -132,9 +132,15 @@ class ConstrainedSolver:
             S = 0.5 * (S + S.T)
             G = (Cf @ self._R).toarray()
             coarse = np.block([[S, -G], [-G.T, np.zeros((self.k, self.k))]])
+            # equilibrate, so that the pivot test does not depend on units: S ~ 1/E while
+            # G ~ 1 (measured: E = 5e9 made a regular system look singular, ratio 3e-13)
+            d = np.diag(S)
+            d = np.where(d > 0, 1.0 / np.sqrt(np.where(d > 0, d, 1.0)), 1.0)
+            gn = np.linalg.norm(d[:, None] * G, axis=0)
+            self._scale = np.concatenate([d, np.where(gn > 0, 1.0 / np.where(gn > 0, gn, 1.0), 1.0)])
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", sla.LinAlgWarning)   # judged by the pivots below
-                self._coarse = sla.lu_factor(coarse)
+                self._coarse = sla.lu_factor(self._scale[:, None] * coarse * self._scale[None, :])
             pivots = np.abs(np.diag(self._coarse[0]))
             if not np.all(np.isfinite(pivots)) or pivots.min() <= 1e-12 * pivots.max():
                 raise SingularSystem(f"the {self.m} general constraint rows are (nearly) linearly dependent "
@@ -197,7 +203,7 @@ class ConstrainedSolver:
         if self.m:
             hf = h - self.C[:, ~self.free] @ du_fixed[~self.free]
             rhs = np.concatenate([self._Cf @ x0 - hf, -(self._R.T @ qf)])
-            sol = sla.lu_solve(self._coarse, rhs)
+            sol = self._scale * sla.lu_solve(self._coarse, self._scale * rhs)
             lam, alpha = sol[:self.m], sol[self.m:]
             x0 = x0 - self._Z @ lam + self._R @ alpha
         du[self.free] = x0
