@@ -104,5 +104,95 @@ def plate(maxh=0.034, strain_max=1e-3, dx=None, material=None, critical=GLASS["c
                              "notch_depth": 0.04, "notch_width": 0.02})
 
 
+def cored_disk_mesh(maxh=0.04, radius=1.0, hole=0.25, core_inner=0.125):
+    """A disk with a hole, and a core ring filling the hole, as two separate bodies.
+
+    Regions ``disk`` (hole < r < radius) and ``core`` (core_inner < r < hole). The two
+    share no vertex: the interface circle is meshed once and the core gets its own copies
+    of the interface vertices (:func:`ngfracture.meshio.separate_region`), so contact
+    alone couples them. Boundaries: ``outer``, ``hole`` (the disk's side of the
+    interface), ``core_surface`` (the core's side), ``core_inner``.
+
+    Returns
+    -------
+    ngsolve.Mesh
+    """
+    from .meshio import separate_region
+    for name, v in (("maxh", maxh), ("radius", radius), ("hole", hole), ("core_inner", core_inner)):
+        _positive(name, v)
+    if not core_inner < hole < radius:
+        raise ValueError(f"need core_inner < hole < radius, got {core_inner}, {hole}, {radius}")
+    geo = SplineGeometry()
+    geo.AddCircle((0, 0), radius, leftdomain=1, rightdomain=0, bc="outer")
+    geo.AddCircle((0, 0), hole, leftdomain=2, rightdomain=1, bc="hole")
+    geo.AddCircle((0, 0), core_inner, leftdomain=0, rightdomain=2, bc="core_inner")
+    geo.SetMaterial(1, "disk")
+    geo.SetMaterial(2, "core")
+    mesh = ng.Mesh(geo.GenerateMesh(maxh=maxh))
+    return separate_region(mesh, "core", boundary="hole", region_boundary="core_surface")
+
+
+def disk(maxh=0.04, expansion=None, dx=None, core_stiffness=0.1, name="disk"):
+    """A brittle disk with a hole around an expanding softer core (paper Fig. 9).
+
+    The disk (radius 1, hole radius 0.25) is the paper's glass (St Venant-Kirchhoff,
+    plane strain); the core ring (radii 0.125 to 0.25) is ``core_stiffness`` times as stiff
+    and never cracks. The core's inner boundary moves radially outward by x; frictionless
+    contact passes the expansion on to the disk. Free modes (the disk's rotation) are held
+    by multiplier rows. By default x runs to 12 times the expansion that first cracks an
+    intact disk (radial cracks grow from the hole, the inner part breaks into grains, the
+    outer ring stays whole).
+
+    Parameters
+    ----------
+    maxh : float
+        Mesh size.
+    expansion : float, optional
+        Final radial displacement of the core's inner boundary.
+    dx : float, optional
+        First increment of x.
+    core_stiffness : float
+        Young's modulus of the core relative to the disk's (> 0).
+    name : str
+
+    Returns
+    -------
+    Scene
+    """
+    maxh, core_stiffness = _positive("maxh", maxh), _positive("core_stiffness", core_stiffness)
+    hole, core_inner, c = 0.25, 0.125, GLASS["critical"]
+    # the first crack: the hole's hoop strain u_r / r reaches the critical strain, so
+    # u_r(hole) ~ c hole; the softer core ring is squeezed too: about 1.5 times that at its inside
+    first = 1.5 * c * hole
+    expansion = _positive("expansion", expansion) if expansion is not None else 12 * first
+    dx = _positive("dx", dx) if dx is not None else first / 5
+    glass = StVenantKirchhoff(GLASS["E"], GLASS["nu"], plane="strain")
+    core = StVenantKirchhoff(core_stiffness * GLASS["E"], 0.3, plane="strain")
+
+    def apply_load(prob, x):
+        prob.add_dirichlet("core_inner", ng.CF((x * ng.x / core_inner, x * ng.y / core_inner)))
+
+    return Scene(name=name, mesh=cored_disk_mesh(maxh, 1.0, hole, core_inner),
+                 material={"disk": glass, "core": core}, critical={"disk": c}, apply_load=apply_load,
+                 load_max=expansion, dx=dx, contact_tol=1e-3 * maxh, contact=True,
+                 parameters={"maxh": maxh, "expansion": expansion, "dx": dx, "critical": c,
+                             "E": glass.E, "nu": glass.nu, "core_E": core.E, "core_nu": core.nu,
+                             "radius": 1.0, "hole": hole, "core_inner": core_inner})
+
+
+def disintegration(maxh=0.04, expansion=None, dx=None, core_stiffness=0.1):
+    """The disk of :func:`disk` expanded until it falls apart (paper Fig. 10).
+
+    Same scene with three times the final expansion.
+
+    Returns
+    -------
+    Scene
+    """
+    first = GLASS["critical"] * 0.25 * 1.5
+    expansion = expansion if expansion is not None else 36 * first
+    return disk(maxh, expansion, dx, core_stiffness, name="disintegration")
+
+
 #: the scenes of ``python -m ngfracture run``
-SCENES = {"plate": plate}
+SCENES = {"plate": plate, "disk": disk, "disintegration": disintegration}
