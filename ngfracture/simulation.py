@@ -288,7 +288,8 @@ class Simulation:
 
     # -- output folder ---------------------------------------------------------------------
     OWN_PATTERNS = ("step_*.vtu", "cracks_*.vtp", "results.pvd", "cracks.pvd", "checkpoint_*.npz",
-                    "summary.json", "final.png", "step_*.png", "fragment_sizes.png")
+                    "summary.json", "final.png", "step_*.png", "fragment_sizes.png",
+                    ".checkpoint_*.tmp")
 
     def _own_files(self):
         return sorted({p for pat in self.OWN_PATTERNS for p in self.out.glob(pat)})
@@ -305,6 +306,8 @@ class Simulation:
             for p in self.out.glob("step_*.png"):   # pictures of steps after the checkpoint
                 if int(p.stem.split("_")[1]) > self._resumed_state.step:
                     p.unlink()
+            for p in self.out.glob(".checkpoint_*.tmp"):   # a checkpoint write that was killed
+                p.unlink()
             return
         if own and not self.force:
             raise FileExistsError(f"output folder {self.out} already holds results ({own[0].name}, ...); "

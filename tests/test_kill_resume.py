@@ -1,0 +1,119 @@
+"""A run killed with SIGKILL at any moment resumes to the result of an uninterrupted run.
+
+The runs are real processes (``python -c`` calling the CLI's ``main``) killed with
+SIGKILL. One case kills during a checkpoint write: the child announces the write on
+stdout from inside ``os.replace`` (wrapped in the checkpoint module only) and sleeps
+there; the kill lands between the fsync'ed temporary file and the rename.
+The sweep over random moments is marked slow (``pytest -m slow``).
+"""
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+import pyvista as pv
+
+ARGS = ["run", "plate", "--maxh", "0.06", "--quiet", "--pictures", "none", "--contact", "never"]
+
+CHILD = """
+import os, sys, time
+from ngfracture import checkpoint
+from ngfracture.cli import main
+real = os.replace
+slow = int(sys.argv[1])
+class Replace:
+    calls = 0
+def replace(src, dst):
+    Replace.calls += 1
+    if Replace.calls == slow:
+        print("WRITING", flush=True)
+        time.sleep(30)
+    return real(src, dst)
+if slow > 0:
+    checkpoint.os = type(os)("os_wrapped")
+    checkpoint.os.__dict__.update(os.__dict__)
+    checkpoint.os.replace = replace
+sys.exit(main(sys.argv[2:]))
+"""
+
+
+def _env():
+    env = dict(os.environ)
+    if env.get("PYTHONPATH"):
+        env["PYTHONPATH"] = os.pathsep.join(os.path.abspath(p) for p in env["PYTHONPATH"].split(os.pathsep))
+    return env
+
+
+def _start(out, cwd, slow=0, resume=False):
+    cmd = [sys.executable, "-c", CHILD, str(slow), *ARGS, "--out", str(out)] + (["--resume"] if resume else [])
+    return subprocess.Popen(cmd, cwd=cwd, env=_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+
+
+def _finish(proc):
+    out, err = proc.communicate(timeout=600)
+    assert proc.returncode == 0, err
+    return out
+
+
+def _compare(a, b):
+    sa, sb = (json.loads((d / "summary.json").read_text()) for d in (a, b))
+    for key in sb:
+        if key not in ("timings",):
+            assert sa[key] == sb[key], key
+    n = sb["n_steps"]
+    for name in (f"step_{n:06d}.vtu", f"cracks_{n:06d}.vtp"):
+        ga, gb = pv.read(a / name), pv.read(b / name)
+        assert np.array_equal(ga.points, gb.points), name
+        for k in gb.point_data:
+            assert np.array_equal(ga.point_data[k], gb.point_data[k]), (name, k)
+        for k in gb.cell_data:
+            assert np.array_equal(ga.cell_data[k], gb.cell_data[k]), (name, k)
+    ra, rb = pv.get_reader(str(a / "results.pvd")), pv.get_reader(str(b / "results.pvd"))
+    assert ra.time_values == rb.time_values
+
+
+@pytest.fixture(scope="module")
+def reference(tmp_path_factory):
+    d = tmp_path_factory.mktemp("reference")
+    _finish(_start(d / "run", d))
+    return d / "run"
+
+
+def test_kill_during_a_checkpoint_write_resumes_to_the_same_result(reference, tmp_path):
+    out = tmp_path / "run"
+    proc = _start(out, tmp_path, slow=3)        # the third rename is inside a checkpoint write
+    line = proc.stdout.readline()
+    assert line.strip() == "WRITING", proc.stderr.read()
+    proc.send_signal(signal.SIGKILL)
+    proc.wait()
+    assert any(p.name.startswith(".checkpoint_") for p in out.iterdir())   # the half-done write
+    _finish(_start(out, tmp_path, resume=True))
+    assert not any(p.name.startswith(".checkpoint_") for p in out.iterdir())
+    _compare(out, reference)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("seed", range(5))
+def test_kill_at_a_random_moment_resumes_to_the_same_result(reference, tmp_path, seed):
+    total = json.loads((reference / "summary.json").read_text())["timings"]["wall"]
+    delay = 1.5 + np.random.default_rng(seed).random() * total     # interpreter start-up ~1.5 s
+    out = tmp_path / "run"
+    proc = _start(out, tmp_path)
+    time.sleep(delay)
+    proc.send_signal(signal.SIGKILL)
+    proc.wait()
+    if not (out.exists() and any(p.name.startswith("checkpoint_") for p in out.iterdir())):
+        # killed before the first checkpoint: a resume is refused clearly, a fresh run works
+        proc = _start(out, tmp_path, resume=True)
+        _, err = proc.communicate(timeout=600)
+        assert proc.returncode == 2 and "no checkpoint" in err, err
+        _finish(subprocess.Popen([sys.executable, "-c", CHILD, "0", *ARGS, "--out", str(out), "--force"],
+                                 cwd=tmp_path, env=_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                 text=True))
+    else:
+        _finish(_start(out, tmp_path, resume=True))
+    _compare(out, reference)
