@@ -13,9 +13,10 @@ One load step, from an accepted state (mesh, displacement, load parameter x)::
        row without a crack, dx = min(dx * grow, dx_max).
 
 A failed solve (diverged, NaN, singular, inverted element, contact set that does not
-settle) anywhere in the step cuts dx and retries from the saved state; after
-``max_retries`` failures in a row the run stops with the last good state written and
-a reason.  The run ends when x reaches the scene's ``load_max``, after ``max_steps``
+settle) sends the step back to the saved state: a failure of the increment solve is
+retried with the same target in twice as many Newton load steps (the load path does not
+change), a failure at fixed load after a split with dx * cut; after ``max_retries``
+failures the run stops with the last good state written and a reason.  The run ends when x reaches the scene's ``load_max``, after ``max_steps``
 steps, or, for scenes that ask for it, once the body is broken through (the elastic
 energy has fallen below ``unloaded_fraction`` of its peak after cracks appeared).
 
@@ -193,11 +194,11 @@ class StepControl:
 
 
 class StepFailed(Exception):
-    """A solve inside a step failed; carries the reason for the retry logic."""
+    """A solve inside a step failed: its reason, and the phase ("increment" or "relaxation")."""
 
-    def __init__(self, reason, message):
-        super().__init__(f"{reason}: {message}")
-        self.reason, self.message = reason, message
+    def __init__(self, reason, phase, message):
+        super().__init__(f"{reason} ({phase}): {message}")
+        self.reason, self.phase, self.message = reason, phase, message
 
 
 @dataclass
@@ -332,10 +333,10 @@ class Simulation:
             return False
         return self.scene.contact or "crack" in mesh.GetBoundaries()
 
-    def _equilibrium(self, prob):
-        """Solve; raise StepFailed with the reason if it does not converge."""
+    def _equilibrium(self, prob, phase, substeps=1):
+        """Solve in ``substeps`` load steps; raise StepFailed(reason, phase) if it does not converge."""
         c = self.control
-        options = dict(method=c.method, tol=c.tol, maxit=c.maxit)
+        options = dict(method=c.method, tol=c.tol, maxit=c.maxit, load_steps=substeps)
         if self._needs_contact(prob.mesh):
             solver = ContactSolver(prob, tol=self.scene.contact_tol)   # its tol: detection threshold
             solver.options.update(options)                              # Newton's tol, method, maxit
@@ -347,7 +348,7 @@ class Simulation:
             status = result.status
             self._iterations += status.iterations
             if not result.converged:
-                raise StepFailed(result.reason, status.message if result.reason == status.reason
+                raise StepFailed(result.reason, phase, status.message if result.reason == status.reason
                                  else f"contact active set did not settle in {result.rounds} rounds")
             return status
         t0 = time.perf_counter()
@@ -356,7 +357,7 @@ class Simulation:
         self.timings["linear"] += status.timings["factorize"] + status.timings["solve"]
         self._iterations += status.iterations
         if not status.converged:
-            raise StepFailed(status.reason, status.message)
+            raise StepFailed(status.reason, phase, status.message)
         return status
 
     def _normalised_strain(self, prob):
@@ -393,7 +394,7 @@ class Simulation:
         return self._problem(res.mesh, self._x_try, u.vec.FV().NumPy()), res.nsplit
 
     # -- one load step ----------------------------------------------------------------------------
-    def _attempt(self, state, dx):
+    def _attempt(self, state, dx, substeps=1):
         """Try the step x + dx from an accepted state; returns (problem, first-pass cracks, total cracks).
 
         Raises StepFailed on a failed solve and returns None for too many cracks.
@@ -401,7 +402,7 @@ class Simulation:
         self._x_try = state.x + dx
         self._split_positions = []      # per pass: reference positions of the vertices split
         prob = self._problem(self._mesh, self._x_try, state.u)
-        self._equilibrium(prob)
+        self._equilibrium(prob, "increment", substeps)
         new_prob, first = self._crack_pass(prob)
         c = self.control
         if first > c.max_new_cracks and dx * c.cut >= c.dx_min:
@@ -410,9 +411,9 @@ class Simulation:
         while new_prob is not None:
             passes += 1
             if passes > c.max_relax_passes:
-                raise StepFailed("relaxation", f"cracks still grow after {c.max_relax_passes} passes at fixed load")
+                raise StepFailed("relaxation", "relaxation", f"cracks still grow after {c.max_relax_passes} passes at fixed load")
             prob = new_prob
-            self._equilibrium(prob)
+            self._equilibrium(prob, "relaxation")
             new_prob, n = self._crack_pass(prob)
             total += n
         return prob, first, total
@@ -446,7 +447,8 @@ class Simulation:
                   "split_vertices": int(total), "elastic_energy": energy, "external_work": state.work + dwork,
                   "released_energy": state.work + dwork - energy, "crack_length": crack_len,
                   "fragments": int(stats.count), "newton_iterations": int(self._iterations),
-                  "retries": int(self._retries), "relax_passes": max(len(self._split_positions) - 1, 0)}
+                  "retries": int(self._retries), "failures": list(self._failures),
+                  "substeps": int(self._substeps), "relax_passes": max(len(self._split_positions) - 1, 0)}
         if first and not any(h["split_vertices"] for h in state.history):
             # where cracking began: the vertices split by the first pass that split any
             record["initiation"] = self._split_positions[0].tolist()
@@ -465,6 +467,39 @@ class Simulation:
                      quiet=0, work=0.0, reactions=np.zeros(len(rows.fixed_dofs)),
                      fixed_values=rows.fixed_values.copy(), fixed_dofs=rows.fixed_dofs.copy(),
                      peak_energy=0.0, history=[])
+
+    def _step(self, state, dx):
+        """Attempts of one step until one is accepted: (attempt, dx, None) or (None, dx, last failure).
+
+        Too many cracks: dx * cut. A failed solve of the increment: the same target in twice
+        as many substeps (load steps of the Newton solver, no crack pass between them), so
+        a passing trouble does not change the load path. A failed solve at fixed load
+        (relaxation on a split mesh): dx * cut, substeps reset. Every attempt starts from
+        the saved state: nothing of a failed attempt is kept.
+        """
+        c = self.control
+        self._retries, self._failures, substeps = 0, [], 1
+        while True:
+            self._iterations = 0
+            try:
+                attempt = self._attempt(state, dx, substeps)
+            except StepFailed as err:
+                self._retries += 1
+                self._failures.append(err.reason)
+                if self._retries > c.max_retries:
+                    return None, dx, err
+                if err.phase == "increment":
+                    substeps *= 2
+                elif dx * c.cut >= c.dx_min:
+                    dx, substeps = dx * c.cut, 1
+                else:
+                    return None, dx, err
+                continue
+            if attempt is None:            # too many cracks at once: smaller increment
+                dx *= c.cut
+                continue
+            self._substeps = substeps
+            return attempt, dx, None
 
     def run(self):
         """Run to the end; returns a RunResult (``ok``, ``reason``, ``summary``)."""
@@ -493,25 +528,8 @@ class Simulation:
                 reason, message = "broken", "the body is broken through (elastic energy released)"
                 break
             dx = min(state.dx, self.scene.load_max - state.x)
-            self._retries, failure = 0, None
-            while True:
-                self._iterations = 0
-                try:
-                    attempt = self._attempt(state, dx)
-                except StepFailed as err:
-                    failure = err
-                    attempt = "failed"
-                if attempt is None:            # too many cracks at once: smaller increment
-                    dx *= c.cut
-                    continue
-                if attempt == "failed":
-                    self._retries += 1
-                    if self._retries > c.max_retries or dx * c.cut < c.dx_min:
-                        break
-                    dx *= c.cut
-                    continue
-                break
-            if attempt == "failed":
+            attempt, dx, failure = self._step(state, dx)
+            if attempt is None:
                 reason = "failed"
                 message = (f"step {state.step + 1} at x = {state.x + dx:.6g} failed {self._retries} time(s); "
                            f"last reason {failure.reason}: {failure.message}")
