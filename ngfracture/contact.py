@@ -116,9 +116,20 @@ class ContactConstraints:
     def __len__(self):
         return len(self.g)
 
+    @classmethod
+    def stack(cls, parts):
+        """The rows of several ContactConstraints (same number of dofs), in order."""
+        fields = ("slave", "a", "c", "master_tri", "slave_tri", "pair", "xi", "normal",
+                  "dist", "angle")
+        return cls(*(np.concatenate([getattr(p, f) for p in parts]) for f in fields),
+                   C=sp.vstack([p.C for p in parts]).tocsr(),
+                   g=np.concatenate([p.g for p in parts]))
+
     def subset(self, rows):
         """The constraints ``rows`` (an index array or boolean mask), C and g included."""
         rows = np.asarray(rows)
+        if rows.dtype != bool:
+            rows = rows.astype(np.int64)
         return ContactConstraints(
             *(getattr(self, f)[rows] for f in
               ("slave", "a", "c", "master_tri", "slave_tri", "pair", "xi", "normal",

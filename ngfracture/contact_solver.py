@@ -23,7 +23,8 @@ import scipy.sparse as sp
 from . import contact
 from .collision import detect_collisions
 from .crack import vertex_displacement
-from .meshio import mesh_to_arrays
+from .meshio import mesh_to_arrays, orient_segments
+from .seams import KINK_ANGLE, find_seams, seam_constraints
 from .solver import SolveStatus
 
 LABEL = "contact"
@@ -99,7 +100,8 @@ class ContactSolver:
         Passed to ``problem.solve`` (method, tol, maxit, ...).
     """
 
-    def __init__(self, problem, tol, penetration_tol=None, max_rounds=20, rank_tol=1e-5, **solve_options):
+    def __init__(self, problem, tol, penetration_tol=None, max_rounds=20, rank_tol=1e-5,
+                 kink_angle=KINK_ANGLE, **solve_options):
         if not np.isfinite(tol) or tol < 0:
             raise ValueError(f"contact detection tol must be finite and >= 0, got {tol!r}")
         self.problem = problem
@@ -107,6 +109,7 @@ class ContactSolver:
         self.penetration_tol = 1e-10 * max(self.tol, 1e-300) if penetration_tol is None else penetration_tol
         self.max_rounds = max_rounds
         self.rank_tol = rank_tol
+        self.kink_angle = kink_angle
         self.options = dict(solve_options)
         self.options["fix_free_modes"] = True
 
@@ -117,6 +120,7 @@ class ContactSolver:
         """
         prob = self.problem
         arrays = mesh_to_arrays(prob.mesh)
+        arrays.segments = orient_segments(arrays.triangles, arrays.segments)
         _, comp = prob.fragments()
         fragment = comp[arrays.triangles[:, 0]]
         nv, n = prob.mesh.nv, prob.fes.ndof // 2
@@ -131,6 +135,24 @@ class ContactSolver:
                 return offset
             offset += C.shape[0]
         return offset
+
+    def _node_to_segment(self, arrays, fragment, U, seams, matched):
+        """Rules 1-4 rows at X + U that the seams do not cover, with their keys."""
+        X, T, E = arrays.points, arrays.triangles, arrays.segments
+        pairs = detect_collisions(X, U, T, boundary_edges=E, fragment=fragment, tol=self.tol)
+        if len(pairs) == 0:
+            return contact._no_constraints(len(X)), []
+        cs = contact.select_contacts(X, U, T, E, pairs, tol=self.tol)
+        keep = reachable(cs, U, self.tol)
+        # a twin of a seam talks to the other lip through its seam rows only
+        cid = seams.copy_id
+        seam_edge = np.array([(min(a, c), max(a, c)) in seams.seam_edge
+                              for a, c in zip(cs.a.tolist(), cs.c.tolist())], dtype=bool)
+        own = (cid[cs.a] == cid[cs.slave]) | (cid[cs.c] == cid[cs.slave])
+        keep &= ~(matched[cs.slave] & (seam_edge | own))
+        cs = cs.subset(np.flatnonzero(keep))
+        keys = [("n",) + k for k in zip(cs.slave.tolist(), cs.a.tolist(), cs.c.tolist())]
+        return cs, keys
 
     def solve(self):
         """Solve for equilibrium with contact; returns a ContactResult."""
@@ -147,32 +169,53 @@ class ContactSolver:
             # one uncracked body cannot touch itself: no collision work at all
             result.converged, result.reason = True, "converged"
             return result
+        t0 = time.perf_counter()
         arrays, fragment, fixed_all, fixed = self._geometry()
-        released = set()
-        previous = None
+        seams = find_seams(arrays.points, arrays.segments)
         nv, n = prob.mesh.nv, prob.fes.ndof // 2
+        result.timings["contact"] += time.perf_counter() - t0
+        seam_rows, seam_keys = None, []
+        n2s, n2s_keys = contact._no_constraints(nv), []
+        active, lam = [], {}     # keys imposed in the last solve, and their multipliers
         for rnd in range(1, self.max_rounds + 1):
             result.rounds = rnd
             t0 = time.perf_counter()
             U = vertex_displacement(prob.u)
-            cs = contact.contact_constraints(arrays.points, U, arrays.triangles, arrays.segments,
-                                             fragment=fragment, tol=self.tol, fixed_dofs=fixed,
-                                             rtol=self.rank_tol)
-            cs = cs.subset(np.flatnonzero(reachable(cs, U, self.tol)))
-            keys = [tuple(k) for k in np.stack([cs.slave, cs.a, cs.c], axis=1).tolist()]
-            # a released row stays released unless its node penetrates again
-            keep = np.array([k not in released or d < -self.penetration_tol
-                             for k, d in zip(keys, cs.dist)], dtype=bool)
-            cs = cs.subset(np.flatnonzero(keep))
-            keys = [k for k, kp in zip(keys, keep) if kp]
-            penetration = float(max(0.0, -cs.dist.min())) if len(cs) else 0.0
-            result.constraints, result.max_penetration = cs, penetration
+            if seam_rows is None:
+                # built once, at the predicted configuration, and frozen for this solve
+                seam_rows, k = seam_constraints(seams, arrays.points, U, kink_angle=self.kink_angle)
+                seam_keys = [("s",) + tuple(r) for r in k.tolist()]
+                matched = np.zeros(nv, dtype=bool)
+                matched[seam_rows.slave] = matched[seam_rows.a] = True
+            # node-to-segment rows: a row keeps the linearisation it was found with while
+            # it is active or detected again; new ones are linearised here
+            found, found_keys = self._node_to_segment(arrays, fragment, U, seams, matched)
+            known, found_set = set(n2s_keys), set(found_keys)
+            old = [i for i, k in enumerate(n2s_keys) if k in lam or k in found_set]
+            new = [i for i, k in enumerate(found_keys) if k not in known]
+            n2s = contact.ContactConstraints.stack([n2s.subset(old), found.subset(new)])
+            n2s_keys = [n2s_keys[i] for i in old] + [found_keys[i] for i in new]
+            pool = contact.ContactConstraints.stack([seam_rows, n2s])
+            keys = seam_keys + n2s_keys
+            gap = pool.C @ U.T.ravel() + pool.g
+            # primal-dual active set: an active row stays while it pushes (lambda <= 0),
+            # an inactive one enters when its node penetrates
+            want = np.array([(lam[k] <= 0.0) if k in lam else (g < -self.penetration_tol)
+                             for k, g in zip(keys, gap)], dtype=bool)
+            want = np.flatnonzero(want)
+            kept = want[contact.independent_rows(pool.C[want], fixed_dofs=fixed, rtol=self.rank_tol)] \
+                if want.size else want
+            dependent = np.setdiff1d(want, kept)
+            other = np.setdiff1d(np.arange(len(keys)), dependent)
+            penetration = float(max(0.0, -gap[other].min(initial=0.0)))
+            result.history.append((len(kept), penetration))
             result.timings["contact"] += time.perf_counter() - t0
-            result.history.append((len(keys), penetration))
-            if previous is not None and set(keys) == previous and penetration <= self.penetration_tol:
+            if set(keys[i] for i in kept) == set(lam):
                 result.converged, result.reason = True, "converged"
+                result.max_penetration = penetration
                 return result
-            previous = set(keys)
+            cs = pool.subset(kept)
+            cs.dist = gap[kept]
             prob.constraints.clear_rows(LABEL)
             if len(cs):
                 # active: the linearised gap closes, C u + g = 0
@@ -185,17 +228,16 @@ class ContactSolver:
                 result.reason = status.reason
                 return result
             offset = self._contact_offset()
-            lam = status.multipliers[offset:offset + len(cs)]
-            result.multipliers = lam
+            multipliers = status.multipliers[offset:offset + len(cs)]
             # adhesive beyond rounding: relative to the largest force the constraints carry
             r = prob.out_of_balance()
-            scale = max(float(np.abs(lam).max(initial=0.0)),
+            scale = max(float(np.abs(multipliers).max(initial=0.0)),
                         float(np.linalg.norm(r[fixed_all])), 1e-300)
-            adhesive = np.flatnonzero(lam > 1e-10 * scale)
-            if adhesive.size:
-                released.update(keys[i] for i in adhesive)
-                result.released += adhesive.size
-                previous = None   # the set changes: solve again
+            rounded = np.where(np.abs(multipliers) <= 1e-10 * scale, 0.0, multipliers)
+            result.released += int(np.count_nonzero(rounded > 0))
+            lam = {keys[i]: x for i, x in zip(kept.tolist(), rounded.tolist())}
+            result.constraints, result.multipliers = cs, multipliers
+            result.max_penetration = penetration
         result.reason = "active_set"
         return result
 
