@@ -7,7 +7,9 @@ Pipeline for one (predicted) configuration::
     keep = independent_rows(cs.C, fixed_dofs=dirichlet_dofs)  # pivoted QR
     C, g = cs.C[keep], cs.g[keep]
 
-or :func:`contact_constraints` for all of it.
+or :func:`contact_constraints` for all of it. Where two lips coincide in the reference
+configuration (crack faces, split interfaces) ContactSolver uses the node-to-node rows of
+:mod:`ngfracture.seams` instead: there rules 1-4 have no stable answer.
 
 Dof layout: component-blocked, as NGSolve's P1 ``VectorH1``: the dof of component ``comp``
 (0 = x, 1 = y) of vertex ``v`` is ``comp * nv + v`` (x dofs 0..nv-1, then y dofs nv..2nv-1).

@@ -14,6 +14,8 @@ import ngfracture as nf
 from ngfracture.collision import boundary_edge_mask
 from ngfracture.contact_solver import ContactSolver, _space_columns, fragment_overlap_area
 from ngfracture.crack import split_by_tensor
+from ngfracture.meshio import mesh_to_arrays
+from ngfracture.seams import find_seams, seam_constraints
 
 
 def plate_mesh(maxh, cuts=()):
@@ -74,8 +76,9 @@ def test_pressed_plate_with_zigzag_crack_settles():
 
     The gap is linearised at the predicted configuration (paper eq. 13/14), so the true
     overlap of the solved configuration is second order in the displacement: measured
-    8.6e-9, 8.5e-11, 8.5e-13 for d = 1e-3, 1e-4, 1e-5; one averaged row per node instead
-    of the two facet rows at kinks gives 8.9e-6 and 8.9e-7 for d = 1e-3, 1e-4 (first order).
+    3.9e-8, 3.6e-10, 3.6e-12 for d = 1e-3, 1e-4, 1e-5 (6 rounds each); one averaged row per
+    node instead of the two facet rows at kinks (kink_angle=pi) gives 4.1e-6 and 4.1e-7 for
+    d = 1e-3, 1e-4 (first order).
     """
     h = 0.1
     res = crack_bands(plate_mesh(h), [(0, 1.0)], 0.6 * h)
@@ -103,6 +106,15 @@ def test_straight_crack_across_uniaxial_compression_is_invisible():
     assert res.nfragments == 2
     crack = res.mesh.ngmesh.Coordinates()[res.crack_segments.ravel(), 0]
     assert np.all(crack == 1.0)
+    # the seam: every crack segment lies on a lip segment; one row per twin pair (the
+    # crack is straight: merged rows, facet -1, except at its two ends on the boundary,
+    # which have one facet), normal along x, zero gap
+    a = mesh_to_arrays(res.mesh)
+    seams = find_seams(a.points, a.segments)
+    assert len(seams) == len(res.crack_segments)
+    rows, keys = seam_constraints(seams, a.points, np.zeros_like(a.points))
+    assert len(rows) == res.nsplit and np.count_nonzero(keys[:, 2] >= 0) == 2
+    assert np.allclose(np.abs(rows.normal), [1.0, 0.0], atol=1e-15, rtol=0) and np.all(rows.dist == 0)
     prob = pressed(res.mesh, d)
     result = ContactSolver(prob, tol=0.1 * h).solve()
     assert result.converged and result.rounds <= 3, (result.reason, result.history)
@@ -203,7 +215,6 @@ def rings_errors(maxh, delta=1e-3, E_core=1.0, E_disk=10.0, nu=0.3):
 
 def test_separate_region_gives_coincident_copies():
     mesh = rings_mesh(0.2)
-    from ngfracture.meshio import mesh_to_arrays
     a = mesh_to_arrays(mesh)
     iface, surf = a.boundary_segments("interface"), a.boundary_segments("core_surface")
     assert len(iface) == len(surf) > 20
