@@ -13,10 +13,12 @@ crack        nodal strain criterion and node splitting with a netgen rebuild (C+
 collision    exact orient2d, grid broad phase and exact narrow phase on numpy arrays
 contact      node-to-segment contact rows (selection rules, gap linearisation) and
              redundancy removal by rank-revealing QR
+seams        node-to-node contact rows across coincident lips (cracks, split interfaces)
 lshape       the L-shape manufactured solution of the paper (section 4.1), meshes, errors
 verify       convergence studies against exact solutions
 cli          the command line, python -m ngfracture
-meshio       meshes as arrays and back; separate bodies merged into one mesh
+meshio       meshes as arrays and back; separate bodies merged into one mesh or
+             one region detached from the others
 contact_solver  equilibrium with unilateral contact: active set around the Newton solver
 output       VTK time series, crack edges, headless PNG, fragment-size plot, summary JSON
 fragments    fragment statistics (count, areas, centroids)

@@ -7,7 +7,9 @@ Pipeline for one (predicted) configuration::
     keep = independent_rows(cs.C, fixed_dofs=dirichlet_dofs)  # pivoted QR
     C, g = cs.C[keep], cs.g[keep]
 
-or :func:`contact_constraints` for all of it.
+or :func:`contact_constraints` for all of it. Where two lips coincide in the reference
+configuration (crack faces, split interfaces) ContactSolver uses the node-to-node rows of
+:mod:`ngfracture.seams` instead: there rules 1-4 have no stable answer.
 
 Dof layout: component-blocked, as NGSolve's P1 ``VectorH1``: the dof of component ``comp``
 (0 = x, 1 = y) of vertex ``v`` is ``comp * nv + v`` (x dofs 0..nv-1, then y dofs nv..2nv-1).
@@ -116,9 +118,20 @@ class ContactConstraints:
     def __len__(self):
         return len(self.g)
 
+    @classmethod
+    def stack(cls, parts):
+        """The rows of several ContactConstraints (same number of dofs), in order."""
+        fields = ("slave", "a", "c", "master_tri", "slave_tri", "pair", "xi", "normal",
+                  "dist", "angle")
+        return cls(*(np.concatenate([getattr(p, f) for p in parts]) for f in fields),
+                   C=sp.vstack([p.C for p in parts]).tocsr(),
+                   g=np.concatenate([p.g for p in parts]))
+
     def subset(self, rows):
         """The constraints ``rows`` (an index array or boolean mask), C and g included."""
         rows = np.asarray(rows)
+        if rows.dtype != bool:
+            rows = rows.astype(np.int64)
         return ContactConstraints(
             *(getattr(self, f)[rows] for f in
               ("slave", "a", "c", "master_tri", "slave_tri", "pair", "xi", "normal",

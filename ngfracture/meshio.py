@@ -1,8 +1,10 @@
 """2D meshes as plain arrays and back, and separate bodies merged into one mesh.
 
 Checkpoints store a mesh as arrays; scenes with several bodies (a disk and its core)
-mesh each body with netgen and merge them into one mesh whose bodies share no
-vertex, so that only contact couples them.  Building goes through netgen's bulk
+either mesh each body with netgen and merge them into one mesh whose bodies share no
+vertex (``merge_meshes``), or mesh them together as regions of one netgen mesh and give
+one region its own copies of the interface vertices (``separate_region``): the bodies
+then share no vertex but their interface nodes coincide, so only contact couples them.  Building goes through netgen's bulk
 ``AddPoints`` / ``AddElements`` (vectorised, no per-element Python loop).
 
 Arrays (all 0-based):
@@ -155,3 +157,98 @@ def merge_meshes(*meshes):
         offset += p.points.shape[0]
     return mesh_from_arrays(MeshArrays(np.vstack(pts), np.vstack(tris), np.concatenate(regs),
                                        region_names, np.vstack(segs), np.concatenate(sbc), bc_names))
+
+
+def orient_segments(triangles, segments):
+    """Segments turned so that their triangle lies on their left.
+
+    netgen orients the boundary of a hole (and an interface segment) with the domain on
+    its right; the contact code needs the convention of the module docstring.
+
+    Parameters
+    ----------
+    triangles : numpy.ndarray of int, shape (ne, 3)
+        Counter-clockwise triangles.
+    segments : numpy.ndarray of int, shape (ns, 2)
+
+    Returns
+    -------
+    numpy.ndarray of int, shape (ns, 2)
+        A copy; segments whose reverse is a triangle edge are reversed, the others kept.
+    """
+    T = np.asarray(triangles, dtype=np.int64)
+    S = np.array(segments, dtype=np.int64).reshape(-1, 2)
+    half = set(zip(*T[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2).T.tolist()))
+    flip = np.array([(p, q) not in half and (q, p) in half for p, q in S.tolist()], dtype=bool)
+    S[flip] = S[flip, ::-1]
+    return S
+
+
+def separate_region(mesh, region, boundary="interface", region_boundary=None):
+    """The mesh with the triangles of ``region`` detached from the rest.
+
+    Every vertex that a triangle of ``region`` shares with a triangle of another region
+    gets a copy (same coordinates, numbered from nv on in increasing order of the
+    original) used by the ``region`` triangles only. The edges the two sides shared
+    become boundary on both sides: segments named ``boundary`` on the other side and
+    ``region_boundary`` (default ``region + "_surface"``) on the region's side, each
+    with its own triangle on the left. Segments that lay on those edges (netgen's
+    interface segments) are replaced; all other segments are turned to have their
+    triangle on the left (:func:`orient_segments`). Triangles keep their order.
+
+    Parameters
+    ----------
+    mesh : ngsolve.Mesh
+        2D triangle mesh with counter-clockwise triangles.
+    region : str
+        Material name of the body to detach.
+    boundary, region_boundary : str
+        Names of the new boundaries on the two sides.
+
+    Returns
+    -------
+    ngsolve.Mesh
+
+    Raises
+    ------
+    ValueError
+        If the mesh has no region ``region`` or it touches no other region.
+    """
+    a = mesh_to_arrays(mesh)
+    region_boundary = region_boundary or f"{region}_surface"
+    ids = [i for i, name in enumerate(a.region_names, start=1) if name == region]
+    if not ids:
+        raise ValueError(f"separate_region: no region {region!r}; the regions are {a.region_names}")
+    inside = np.isin(a.regions, ids)
+    T, nv = a.triangles, a.points.shape[0]
+    shared = np.intersect1d(T[inside].ravel(), T[~inside].ravel())
+    if shared.size == 0:
+        raise ValueError(f"separate_region: region {region!r} shares no vertex with another region")
+    copy = np.arange(nv)
+    copy[shared] = nv + np.arange(shared.size)
+    tris = T.copy()
+    tris[inside] = copy[T[inside]]
+
+    def half_edges(t):                        # directed edges, their triangle on the left
+        return t[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2)
+    h_in, h_out = half_edges(T[inside]), half_edges(T[~inside])
+    key_out = set(zip(h_out[:, 0].tolist(), h_out[:, 1].tolist()))
+    common = np.array([(p, q) in key_out for p, q in zip(h_in[:, 1].tolist(), h_in[:, 0].tolist())],
+                      dtype=bool)
+    edges = h_in[common]                      # region side, original numbering
+    drop = set(map(tuple, np.sort(edges, axis=1).tolist()))
+    old = np.array([tuple(s) not in drop for s in np.sort(a.segments, axis=1).tolist()], dtype=bool)
+    names = list(a.bc_names)
+    for name in (boundary, region_boundary):
+        if name not in names:
+            names.append(name)
+    # the region's own boundary segments use its copies
+    own = set(map(tuple, np.sort(h_in, axis=1).tolist()))
+    kept = a.segments[old]
+    mine = np.array([tuple(e) in own for e in np.sort(kept, axis=1).tolist()], dtype=bool)
+    kept = np.where(mine[:, None], copy[kept], kept)
+    segments = np.vstack([orient_segments(tris, kept), edges[:, ::-1], copy[edges]])
+    seg_bc = np.concatenate([a.seg_bc[old], np.full(len(edges), names.index(boundary) + 1),
+                             np.full(len(edges), names.index(region_boundary) + 1)])
+    return mesh_from_arrays(MeshArrays(np.vstack([a.points, a.points[shared]]), tris, a.regions,
+                                       a.region_names, segments, seg_bc, names))

@@ -5,7 +5,9 @@ import pytest
 from netgen.geom2d import SplineGeometry
 
 from ngfracture import ElementAreas
-from ngfracture.meshio import MeshArrays, merge_meshes, mesh_from_arrays, mesh_to_arrays
+from ngfracture.collision import boundary_edge_mask
+from ngfracture.meshio import (MeshArrays, merge_meshes, mesh_from_arrays, mesh_to_arrays,
+                             separate_region)
 from conftest import square_mesh, two_region_bar_mesh
 
 
@@ -47,3 +49,28 @@ def test_bad_arrays_are_refused():
     bad = MeshArrays(a.points * np.nan, a.triangles, a.regions, a.region_names, a.segments, a.seg_bc, a.bc_names)
     with pytest.raises(ValueError, match="finite"):
         mesh_from_arrays(bad)
+
+
+def test_separate_region_detaches_a_body_with_coincident_copies():
+    """The stiff half of the bar gets its own copies of the x = 1 vertices (the interface
+    ends on the outer boundary: the stiff side's top and bottom segments use the copies)."""
+    mesh = two_region_bar_mesh(0.25)
+    a = mesh_to_arrays(mesh)
+    on_x1 = np.flatnonzero(a.points[:, 0] == 1.0)
+    s = separate_region(mesh, "stiff")
+    b = mesh_to_arrays(s)
+    assert s.nv == mesh.nv + len(on_x1) and s.ne == mesh.ne
+    assert np.array_equal(b.points[mesh.nv:], a.points[on_x1])
+    assert np.array_equal(b.regions, a.regions)
+    stiff = b.regions == b.region_names.index("stiff") + 1
+    assert not set(b.triangles[stiff].ravel()) & set(b.triangles[~stiff].ravel())
+    # both sides are boundary: the same edges reversed, each with its triangle on the left
+    iface, surf = b.boundary_segments("interface"), b.boundary_segments("stiff_surface")
+    assert len(iface) == len(surf) == len(on_x1) - 1
+    assert np.all(b.points[iface][:, :, 0] == 1.0)
+    assert sorted(map(tuple, b.points[iface].reshape(-1, 4).tolist())) == \
+        sorted(map(tuple, b.points[surf[:, ::-1]].reshape(-1, 4).tolist()))
+    assert boundary_edge_mask(b.triangles, b.segments).sum() == len(b.segments)
+    assert np.array_equal(ElementAreas(s), ElementAreas(mesh))
+    with pytest.raises(ValueError, match="no region"):
+        separate_region(mesh, "glass")
