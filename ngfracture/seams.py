@@ -16,8 +16,8 @@ rows 27 to 31 in a period-4 cycle). Across a seam we therefore use node-to-node 
 twins, identified by the node pair and the facet, so the set of candidate rows is the same in
 every round of a solve:
 
-* one row per facet end: g = n_f . (x_b2 - x_b) >= 0, b on side A, b2 its twin on side B,
-  n_f the unit normal of facet f pointing from A to B. At a straight node the rows of its
+* one row per facet end: g = n_f . (x_b2 - x_b) >= 0 for twins b, b2 (b the lower
+  vertex number), n_f the unit normal of facet f pointing from b's lip to b2's. At a straight node the rows of its
   two facets coincide and become one row with the mean normal. At a kink (reference facet
   normals more than ``kink_angle`` apart) both rows stay: together they are the exact
   non-penetration condition of the two polygonal lips for small relative motion (the twin
@@ -124,11 +124,12 @@ def seam_constraints(seams, points, displacement, kink_angle=KINK_ANGLE, slip=SL
     Returns
     -------
     rows : ContactConstraints
-        slave = b2 (side B), a = c = b (side A), xi = 1, normal from A to B, dist the gap
-        at the given configuration; master_tri, slave_tri and pair are -1.
+        a = c = the lower-numbered twin (master), slave = the other, xi = 1, normal from
+        the master's lip towards the slave's, dist the gap at the given configuration;
+        master_tri, slave_tri and pair are -1.
     keys : numpy.ndarray of int, shape (m, 3)
-        (b, b2, facet) identifying each row; facet is -1 for the merged row of a straight
-        node. The same seams give the same keys in every configuration.
+        (master, slave, facet) identifying each row; facet is -1 for the merged row of a
+        straight node. The same seams give the same keys in every configuration.
     """
     X = np.asarray(points, dtype=np.float64)
     x = X + np.asarray(displacement, dtype=np.float64)
