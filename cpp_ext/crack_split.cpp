@@ -292,9 +292,10 @@ namespace ngfracture
     finish();
   }
 
-  void CrackSplitter :: Run (const int * order, const double * dirs, int n)
+  void CrackSplitter :: Run (const int * order, const double * dirs, int n, bool skip_neighbours)
   {
     int nv_start = NV();
+    std::vector<char> waits(skip_neighbours ? nv_start : 0, 0);
     for (int i = 0; i < n; i++)
       {
         int v = order[i];
@@ -305,7 +306,14 @@ namespace ngfracture
         if (!std::isfinite(d[0]) || !std::isfinite(d[1]) || (d[0] == 0 && d[1] == 0))
           throw std::invalid_argument("ngfracture: direction of vertex " + std::to_string(v) +
                                       " is zero or not finite");
+        if (skip_neighbours && waits[v]) continue;
+        int nv_before = NV();
         ProcessVertex(v, d);
+        if (skip_neighbours && NV() > nv_before)
+          // the triangles around v in the input mesh: their vertices wait for the next pass
+          for (int k = star_off[v]; k < star_off[v+1]; k++)
+            for (int j = 0; j < 3; j++)
+              waits[parent[trigs[3*star_data[k] + j]]] = 1;
       }
   }
 

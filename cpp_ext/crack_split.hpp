@@ -40,7 +40,9 @@ namespace ngfracture
 
     // Process vertices in the given order; dirs[2*i], dirs[2*i+1] is the maximum strain
     // direction of order[i]. Vertices created during the pass are not processed.
-    void Run (const int * order, const double * dirs, int n);
+    // skip_neighbours: a vertex that shares a triangle with one split earlier in this
+    // pass is skipped (its strain predates that split; it is judged again next pass).
+    void Run (const int * order, const double * dirs, int n, bool skip_neighbours = false);
 
     // After Run: segments of the new mesh and the fragments.
     void Finish ();

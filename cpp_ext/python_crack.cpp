@@ -149,7 +149,8 @@ Returns
         R"doc(Indices with value > critical, by decreasing value, ties by increasing index.)doc");
 
   m.def("CrackSplit",
-        [] (shared_ptr<netgen::Mesh> ngmesh, iarray vertices, darray directions, std::string crack_name)
+        [] (shared_ptr<netgen::Mesh> ngmesh, iarray vertices, darray directions, std::string crack_name,
+            bool skip_neighbours)
         {
           auto t0 = std::chrono::steady_clock::now();
           MeshArrays a = ExtractArrays(*ngmesh);
@@ -160,7 +161,7 @@ Returns
             throw Exception("ngfracture.CrackSplit: directions must have shape (len(vertices), 2) = (" +
                             ToString(n) + ", 2)");
           CrackSplitter split(a.points.data(), a.nv, a.trigs.data(), a.ne, a.segs.data(), a.ns);
-          split.Run(vertices.data(), directions.data(), int(n));
+          split.Run(vertices.data(), directions.data(), int(n), skip_neighbours);
           split.Finish();
           auto t1 = std::chrono::steady_clock::now();
           auto newmesh = RebuildMesh(*ngmesh, split, crack_name);
@@ -188,6 +189,7 @@ Returns
           return res;
         },
         py::arg("ngmesh"), py::arg("vertices"), py::arg("directions"), py::arg("crack_name") = "crack",
+        py::arg("skip_neighbours") = false,
         R"doc(Split vertices of a 2D netgen mesh along the edges most orthogonal to a direction.
 
 Low-level: use ngfracture.crack.split_vertices.
@@ -202,6 +204,8 @@ directions : numpy.ndarray
     Shape (len(vertices), 2), maximum strain direction of each vertex.
 crack_name : str
     Boundary name of the new boundary segments.
+skip_neighbours : bool
+    Skip a vertex that shares a triangle with a vertex split earlier in this pass.
 
 Returns
 -------

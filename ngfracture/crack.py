@@ -295,7 +295,7 @@ class SplitResult:
         return len(self.parent) - int(self.record["nv_old"])
 
 
-def split_vertices(mesh, vertices, directions, crack_name="crack"):
+def split_vertices(mesh, vertices, directions, crack_name="crack", skip_neighbours=False):
     """Split vertices along the edges most orthogonal to given directions (rules 1-2b).
 
     Parameters
@@ -308,11 +308,16 @@ def split_vertices(mesh, vertices, directions, crack_name="crack"):
         Shape (len(vertices), 2): maximum strain direction of each vertex (any length > 0).
     crack_name : str
         Boundary name of the new crack faces.
+    skip_neighbours : bool
+        Skip a vertex that shares a triangle with a vertex split earlier in the pass: its
+        strain predates that split, which relieves it; it is judged again after the
+        next equilibrium. (False: every listed vertex is processed, the paper's pass.)
 
     Returns
     -------
     SplitResult
-        ``mesh`` is the input mesh itself when no vertex was split.
+        ``mesh`` is the input mesh itself when no vertex was split; ``record`` lists
+        only the vertices processed.
         ``record`` holds numpy arrays: ``vertex`` (processed vertices), ``rule`` (bit
         flags, :func:`rule_names`), ``position`` (their coordinates), ``direction``,
         ``edges`` (k, 2) cut edges (processed vertex, far end) in the numbering at cut time,
@@ -335,7 +340,7 @@ def split_vertices(mesh, vertices, directions, crack_name="crack"):
         raise ValueError("ngfracture.crack: a vertex appears twice in the processing order")
     if not np.all(np.isfinite(d)) or np.any(np.all(d == 0, axis=1)):
         raise ValueError("ngfracture.crack: directions must be finite and nonzero")
-    r = _C.CrackSplit(mesh.ngmesh, v, d, crack_name)
+    r = _C.CrackSplit(mesh.ngmesh, v, d, crack_name, bool(skip_neighbours))
     t0 = time.perf_counter()
     # nothing split: keep the very same mesh, so callers keep their spaces and factorisations
     newmesh = mesh if len(r["parent"]) == mesh.nv else ngsolve.Mesh(r["ngmesh"])
@@ -414,7 +419,7 @@ def transfer(u, result):
     return gf
 
 
-def split_by_tensor(mesh, tensors, critical, crack_name="crack"):
+def split_by_tensor(mesh, tensors, critical, crack_name="crack", skip_neighbours=False):
     """One splitting pass from a vertex tensor field supplied by the caller.
 
     Parameters
@@ -425,6 +430,8 @@ def split_by_tensor(mesh, tensors, critical, crack_name="crack"):
     critical : float
         Finite, > 0; vertices whose largest principal value exceeds it are split.
     crack_name : str
+    skip_neighbours : bool
+        See :func:`split_vertices`.
 
     Returns
     -------
@@ -443,7 +450,7 @@ def split_by_tensor(mesh, tensors, critical, crack_name="crack"):
         raise ValueError(f"ngfracture.crack: tensor field must have shape ({mesh.nv}, 3), got {t.shape}")
     values, dirs = principal(t)
     order = _C.CrackSelect(values, c)
-    res = split_vertices(mesh, order, dirs[order], crack_name)
+    res = split_vertices(mesh, order, dirs[order], crack_name, skip_neighbours)
     res.record["principal"] = values[order]
     return res
 
