@@ -3,7 +3,7 @@
 ``validate_mesh(mesh)`` raises :class:`MeshError` (a ValueError) naming the first
 offending vertex, edge or triangle, and warns (:class:`MeshQualityWarning`) about
 poor but usable triangles.  ElasticProblem and crack_step call it on every mesh they
-are given, so it is vectorised numpy, O(ne log ne): about 2% of one linear solve at
+are given, so it is vectorised numpy, O(ne log ne): about 3% of one linear solve at
 100k triangles (``benchmarks/meshcheck.py``).
 
 What counts as a bad mesh
@@ -139,11 +139,12 @@ def _arrays(mesh):
 
 def _cross_and_longest(P, T):
     """Twice the signed area of every triangle and its longest squared edge length."""
-    a, b, c = P[T[:, 0]], P[T[:, 1]], P[T[:, 2]]
-    ab, ac, bc = b - a, c - a, c - b
-    cross = ab[:, 0] * ac[:, 1] - ab[:, 1] * ac[:, 0]
-    longest2 = np.maximum(np.maximum(np.einsum("ij,ij->i", ab, ab), np.einsum("ij,ij->i", ac, ac)),
-                          np.einsum("ij,ij->i", bc, bc))
+    X, Y = P[:, 0][T], P[:, 1][T]
+    ux, uy = X[:, 1] - X[:, 0], Y[:, 1] - Y[:, 0]
+    vx, vy = X[:, 2] - X[:, 0], Y[:, 2] - Y[:, 0]
+    wx, wy = X[:, 2] - X[:, 1], Y[:, 2] - Y[:, 1]
+    cross = ux * vy - uy * vx
+    longest2 = np.maximum(np.maximum(ux * ux + uy * uy, vx * vx + vy * vy), wx * wx + wy * wy)
     return cross, longest2
 
 
@@ -155,15 +156,16 @@ def _check_manifold(P, T, count):
     vertex with two or more is a bow-tie (a ring plus a chain needs overlapping triangles).
     """
     nv = P.shape[0]
-    e = np.sort(np.concatenate([T[:, [0, 1]], T[:, [1, 2]], T[:, [2, 0]]]), axis=1)
-    keys, per_edge = np.unique(e[:, 0] * nv + e[:, 1], return_counts=True)
-    bad = np.flatnonzero(per_edge > 2)
+    a, b = T.ravel(), T[:, [1, 2, 0]].ravel()
+    keys = np.sort(np.minimum(a, b) * nv + np.maximum(a, b))     # every edge once per triangle
+    same = keys[1:] == keys[:-1]
+    bad = np.unique(keys[1:-1][same[1:] & same[:-1]])             # edges in three or more
     if bad.size:
-        k = keys[bad[0]]
-        raise MeshError(f"mesh: edge ({k // nv}, {k % nv}) is shared by {per_edge[bad[0]]} triangles "
-                        f"(non-manifold)" + _more(bad))
-    inner = keys[per_edge == 2]
-    shared = np.bincount(np.concatenate([inner // nv, inner % nv]), minlength=nv)
+        k = bad[0]
+        n = int(np.sum(keys == k))
+        raise MeshError(f"mesh: edge ({k // nv}, {k % nv}) is shared by {n} triangles (non-manifold)" + _more(bad))
+    inner = keys[1:][same]                                      # edges shared by two triangles
+    shared = np.bincount(inner // nv, minlength=nv) + np.bincount(inner % nv, minlength=nv)
     chains = count - shared
     bad = np.flatnonzero(chains >= 2)
     if bad.size:
