@@ -299,6 +299,9 @@ class SplitResult:
 def split_vertices(mesh, vertices, directions, crack_name="crack"):
     """Split vertices along the edges most orthogonal to given directions (rules 1-2b).
 
+    The mesh itself is not checked here (crack_step and split_by_tensor run
+    meshcheck.validate_mesh first); the engine keeps a valid mesh valid.
+
     Parameters
     ----------
     mesh : ngsolve.Mesh

@@ -82,9 +82,9 @@ def test_coincident_vertices_inside_a_body_are_an_error():
 def test_coincident_vertices_on_boundaries_are_accepted():
     """Touching bodies (segments on both faces), merged meshes and crack lips share points."""
     validate_mesh(two_halves(interface_segments=True))
-    geo_a, geo_b = square_mesh(0.5), square_mesh(0.5)
-    merged = merge_meshes(geo_a, geo_b)          # two identical squares on top of each other
-    assert merged.nv == 2 * geo_a.nv
+    body = square_mesh(0.5)
+    merged = merge_meshes(body, body)            # two identical squares on top of each other
+    assert merged.nv == 2 * body.nv
     validate_mesh(merged)
     # a crack pass: the lips coincide in the reference configuration
     mesh = square_mesh(0.2)
