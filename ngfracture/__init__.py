@@ -19,6 +19,7 @@ verify       convergence studies against exact solutions
 cli          the command line, python -m ngfracture
 meshio       meshes as arrays and back; separate bodies merged into one mesh or
              one region detached from the others
+meshcheck    is a mesh fit for use: bad meshes are a MeshError naming the culprit, slivers a warning
 contact_solver  equilibrium with unilateral contact: active set around the Newton solver
 output       VTK time series, crack edges, headless PNG, fragment-size plot, summary JSON
 fragments    fragment statistics (count, areas, centroids)
@@ -26,6 +27,7 @@ fragments    fragment statistics (count, areas, centroids)
 import ngsolve  # load NGSolve's shared libraries before the compiled add-on
 
 from ._ngfracture import ElementAreas, VertexAverage
+from .meshcheck import MeshError, MeshQualityWarning, validate_mesh
 from .materials import LinearElastic, NeoHookean, StVenantKirchhoff, lame_parameters, make_material
 from .problem import ElasticProblem
 from .solver import SolveStatus

@@ -181,7 +181,8 @@ class ConstraintSet:
         Raises
         ------
         ValueError
-            If two conditions prescribe different values on one dof.
+            If two conditions prescribe different values on one dof, or the single-dof
+            rows prescribe every dof (nothing left to solve for).
         """
         n = self.fes.ndof // 2
         pieces = []   # (dofs, values, source), merged below
@@ -209,6 +210,11 @@ class ConstraintSet:
         for dofs, vals, source in pieces:
             self._merge(values, dofs, vals, source, 1e-10 * scale)
         dofs = np.array(sorted(values), dtype=np.int64)
+        if dofs.size == self.fes.ndof:
+            sources = list(dict.fromkeys(source for _, _, source in pieces))
+            named = "; ".join(sources[:5]) + (f"; and {len(sources) - 5} more" if len(sources) > 5 else "")
+            raise ValueError(f"the constraints leave no free dof: {named} prescribe all "
+                             f"{dofs.size} dofs, there is nothing to solve for")
         vals = np.array([values[d][0] for d in dofs], dtype=float)
         if self.rows:
             C = sp.vstack([r[0] for r in self.rows]).tocsr()

@@ -60,6 +60,7 @@ import numpy as np
 import ngsolve
 
 from . import _ngfracture as _C
+from .meshcheck import validate_mesh
 
 __all__ = [
     "RULE_1", "RULE_1A", "RULE_1B", "RULE_2", "RULE_2A", "RULE_2B", "RULE_TIP", "RULE_NONE",
@@ -298,6 +299,9 @@ class SplitResult:
 def split_vertices(mesh, vertices, directions, crack_name="crack", skip_neighbours=False):
     """Split vertices along the edges most orthogonal to given directions (rules 1-2b).
 
+    The mesh itself is not checked here (crack_step and split_by_tensor run
+    meshcheck.validate_mesh first); the engine keeps a valid mesh valid.
+
     Parameters
     ----------
     mesh : ngsolve.Mesh
@@ -441,15 +445,21 @@ def split_by_tensor(mesh, tensors, critical, crack_name="crack", skip_neighbours
     Raises
     ------
     ValueError
-        Wrong tensor shape, NaN values, critical <= 0 or NaN, non-2D mesh.
+        Wrong tensor shape, NaN values, critical <= 0 or NaN, non-2D mesh; ``MeshError``
+        (a ValueError) on a bad mesh (meshcheck.py).
     """
     _check_mesh(mesh)
     c = _check_critical(critical)
     t = np.asarray(tensors, dtype=float)
     if t.shape != (mesh.nv, 3):
         raise ValueError(f"ngfracture.crack: tensor field must have shape ({mesh.nv}, 3), got {t.shape}")
-    values, dirs = principal(t)
-    order = _C.CrackSelect(values, c)
+    validate_mesh(mesh)
+    return _split_pass(mesh, t, c, crack_name, skip_neighbours)
+
+
+def _split_pass(mesh, tensors, critical, crack_name, skip_neighbours=False):
+    values, dirs = principal(tensors)
+    order = _C.CrackSelect(values, critical)
     res = split_vertices(mesh, order, dirs[order], crack_name, skip_neighbours)
     res.record["principal"] = values[order]
     return res
@@ -483,7 +493,7 @@ def crack_step(mesh, u, critical=None, measure="green", criterion=None, crack_na
     Raises
     ------
     ValueError, TypeError
-        Bad mesh, field or threshold, before any work.
+        Bad mesh (``MeshError``, see meshcheck.py), field or threshold, before any work.
     """
     _check_mesh(mesh)
     if criterion is None:
@@ -498,5 +508,11 @@ def crack_step(mesh, u, critical=None, measure="green", criterion=None, crack_na
     else:
         raise TypeError("ngfracture.crack.crack_step: u must be an ngsolve.GridFunction; "
                         "use split_by_tensor for plain arrays")
-    res = split_by_tensor(mesh, criterion.vertex_tensor(mesh, u), criterion.critical, crack_name)
+    c = _check_critical(criterion.critical)
+    validate_mesh(mesh)
+    tensors = np.asarray(criterion.vertex_tensor(mesh, u), dtype=float)
+    if tensors.shape != (mesh.nv, 3):
+        raise ValueError(f"ngfracture.crack: the criterion's tensor field must have shape ({mesh.nv}, 3), "
+                         f"got {tensors.shape}")
+    res = _split_pass(mesh, tensors, c, crack_name)
     return res.mesh, transfer(u, res), res

@@ -13,6 +13,7 @@ reduction that is exact in the small-strain limit (documented choice: the
 exact plane-stress neo-Hooke needs a local solve for F33).
 """
 import math
+import numbers
 
 import ngsolve as ng
 
@@ -42,7 +43,7 @@ def lame_parameters(E, nu, plane="strain"):
         If a parameter is not finite or out of range, or plane is unknown.
     """
     for name, value in (("E", E), ("nu", nu)):
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
+        if isinstance(value, bool) or not isinstance(value, numbers.Real):
             raise ValueError(f"material parameter {name} must be a number, got {value!r}")
         if not math.isfinite(value):
             raise ValueError(f"material parameter {name} must be finite, got {value!r}")

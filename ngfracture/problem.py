@@ -19,6 +19,7 @@ from . import rigid
 from .constraints import ConstraintSet
 from .crack import vertex_displacement
 from .materials import Material
+from .meshcheck import validate_mesh
 from .solver import NewtonSolver
 
 
@@ -89,11 +90,17 @@ class ElasticProblem:
     Raises
     ------
     ValueError
-        On an invalid mesh, material or order.
+        On an invalid material or order; ``MeshError`` (a ValueError) on a bad mesh,
+        see meshcheck.py.
+
+    Warns
+    -----
+    MeshQualityWarning
+        If the mesh has slivers (meshcheck.SLIVER_ASPECT).
     """
 
     def __init__(self, mesh, material, order=1):
-        check_mesh(mesh)
+        arrays = validate_mesh(mesh)
         self.materials = region_materials(mesh, material)
         if isinstance(order, bool) or not isinstance(order, int) or order < 1:
             raise ValueError(f"order must be an integer >= 1, got {order!r}")
@@ -109,8 +116,8 @@ class ElasticProblem:
         self.load_factor = ng.Parameter(0.0)
         self._loads = []      # (kind, CF, region)
         self._form = None
-        self._elements = element_vertices(mesh)
-        self._points = mesh.ngmesh.Coordinates()[:, :2].copy()
+        self._elements = arrays.triangles
+        self._points = arrays.points
 
     # -- set-up ---------------------------------------------------------------------
     def add_dirichlet(self, boundaries, value=(0.0, 0.0), component=None):

@@ -1,5 +1,6 @@
 """Material parameters and constraint input are validated before any assembly."""
 import math
+import re
 
 import ngsolve as ng
 import numpy as np
@@ -9,15 +10,34 @@ import ngfracture as nf
 from conftest import square_mesh
 
 
-@pytest.mark.parametrize("E, nu, word", [
-    (float("nan"), 0.3, "finite"), (float("inf"), 0.3, "finite"), (1.0, float("nan"), "finite"),
-    (0.0, 0.3, "E must be > 0"), (-1.0, 0.3, "E must be > 0"),
-    (1.0, 0.5, "nu"), (1.0, 0.7, "nu"), (1.0, -1.0, "nu"), (1.0, -1.5, "nu"), ("1", 0.3, "number"),
+NAN, INF = float("nan"), float("inf")
+
+
+@pytest.mark.parametrize("E, nu, message", [
+    (NAN, 0.3, "material parameter E must be finite, got nan"),
+    (INF, 0.3, "material parameter E must be finite, got inf"),
+    (-INF, 0.3, "material parameter E must be finite, got -inf"),
+    (1.0, NAN, "material parameter nu must be finite, got nan"),
+    (1.0, INF, "material parameter nu must be finite, got inf"),
+    (0.0, 0.3, "Young's modulus E must be > 0, got 0.0"),
+    (-1.0, 0.3, "Young's modulus E must be > 0, got -1.0"),
+    (1.0, 0.5, "Poisson's ratio nu must satisfy -1 < nu < 0.5, got 0.5"),
+    (1.0, 0.7, "Poisson's ratio nu must satisfy -1 < nu < 0.5, got 0.7"),
+    (1.0, -1.0, "Poisson's ratio nu must satisfy -1 < nu < 0.5, got -1.0"),
+    (1.0, -1.5, "Poisson's ratio nu must satisfy -1 < nu < 0.5, got -1.5"),
+    ("1", 0.3, "material parameter E must be a number, got '1'"),
+    (1.0, None, "material parameter nu must be a number, got None"),
 ])
+@pytest.mark.parametrize("plane", ["strain", "stress"])
 @pytest.mark.parametrize("cls", [nf.LinearElastic, nf.StVenantKirchhoff, nf.NeoHookean])
-def test_invalid_material_parameters_are_rejected(cls, E, nu, word):
-    with pytest.raises(ValueError, match=word):
-        cls(E, nu)
+def test_invalid_material_parameters_are_rejected(cls, plane, E, nu, message):
+    with pytest.raises(ValueError, match="^" + re.escape(message) + "$"):
+        cls(E, nu, plane=plane)
+
+
+def test_numpy_numbers_are_valid_parameters():
+    m = nf.NeoHookean(np.int64(5), np.float32(0.25), plane="stress")
+    assert (m.E, m.nu) == (5.0, 0.25)
 
 
 def test_lame_parameters_plane_strain_and_stress():
