@@ -44,7 +44,7 @@ def faulty_scene(base, x_fault, fault, on_split_mesh=False):
 
 @pytest.fixture(scope="module")
 def undisturbed():
-    return Simulation(scenes.plate(maxh=0.06), contact="never").run()
+    return Simulation(scenes.plate(maxh=0.06)).run()
 
 
 @pytest.mark.parametrize("fault", ["nan", "inverted", "diverged"])
@@ -53,7 +53,7 @@ def test_failed_increment_is_retried_and_the_result_is_unchanged(undisturbed, fa
     k = next(i for i, h in enumerate(ref["history"]) if h["split_vertices"])   # the step that cracks
     x_fault = ref["history"][k]["x"]
     scene, injected = faulty_scene(scenes.plate(maxh=0.06), x_fault, fault)
-    result = Simulation(scene, contact="never").run()
+    result = Simulation(scene).run()
     assert injected["done"] and result.ok, result.message
     s = result.summary
     failed = s["history"][k]
@@ -75,7 +75,7 @@ def test_failed_relaxation_leaks_no_split(undisturbed):
     x_fault = ref["history"][k]["x"]
     base = scenes.plate(maxh=0.06)
     scene, injected = faulty_scene(base, x_fault, "nan", on_split_mesh=True)
-    result = Simulation(scene, contact="never").run()
+    result = Simulation(scene).run()
     assert injected["done"] and result.ok, result.message
     hist = result.summary["history"]
     # the step that met the fault was retried with a smaller increment from the saved state

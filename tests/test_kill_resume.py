@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 import pyvista as pv
 
-ARGS = ["run", "plate", "--maxh", "0.06", "--quiet", "--pictures", "none", "--contact", "never"]
+ARGS = ["run", "plate", "--maxh", "0.06", "--quiet", "--pictures", "none"]
 
 CHILD = """
 import os, sys, time
