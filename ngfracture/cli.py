@@ -131,7 +131,7 @@ def _run_run(args):
     if args.load_max is not None:
         scene.load_max = args.load_max
         scene.parameters["load_max"] = args.load_max
-    sim = Simulation(scene, StepControl(max_steps=args.steps), out=out, force=args.force,
+    sim = Simulation(scene, StepControl(**{**scene.control, "max_steps": args.steps}), out=out, force=args.force,
                      resume=args.resume, pictures=args.pictures, contact=args.contact,
                      progress=None if args.quiet else _progress_line)
     result = sim.run()

@@ -132,7 +132,7 @@ def cored_disk_mesh(maxh=0.04, radius=1.0, hole=0.25, core_inner=0.125):
     return separate_region(mesh, "core", boundary="hole", region_boundary="core_surface")
 
 
-def disk(maxh=0.04, expansion=None, dx=None, core_stiffness=0.1, name="disk"):
+def disk(maxh=0.04, expansion=None, dx=None, core_stiffness=0.1, name="disk", confined=True):
     """A brittle disk with a hole around an expanding softer core (paper Fig. 9).
 
     The disk (radius 1, hole radius 0.25) is the paper's glass (St Venant-Kirchhoff,
@@ -171,11 +171,15 @@ def disk(maxh=0.04, expansion=None, dx=None, core_stiffness=0.1, name="disk"):
 
     def apply_load(prob, x):
         prob.add_dirichlet("core_inner", ng.CF((x * ng.x / core_inner, x * ng.y / core_inner)))
+        if confined:
+            prob.add_dirichlet("outer", (0.0, 0.0))
 
     return Scene(name=name, mesh=cored_disk_mesh(maxh, 1.0, hole, core_inner),
                  material={"disk": glass, "core": core}, critical={"disk": c}, apply_load=apply_load,
                  load_max=expansion, dx=dx, contact_tol=1e-3 * maxh, contact=True,
+                 control={"max_new_cracks": 8},
                  parameters={"maxh": maxh, "expansion": expansion, "dx": dx, "critical": c,
+                             "confined": confined,
                              "E": glass.E, "nu": glass.nu, "core_E": core.E, "core_nu": core.nu,
                              "radius": 1.0, "hole": hole, "core_inner": core_inner})
 

@@ -90,6 +90,9 @@ class Scene:
         ``unloaded_fraction`` of its peak after cracks appeared).
     parameters : dict
         The numbers that define the scene, copied into summary.json.
+    control : dict
+        StepControl settings this scene needs (e.g. more cracks per increment where
+        many start at once by symmetry); explicit StepControl arguments override them.
     """
     name: str
     mesh: object
@@ -102,6 +105,7 @@ class Scene:
     contact: bool = False
     stop_when_unloaded: bool = False
     parameters: dict = field(default_factory=dict)
+    control: dict = field(default_factory=dict)
 
     def validate(self):
         """Raise ValueError naming the first bad field (before any work)."""
@@ -270,7 +274,7 @@ class Simulation:
                  checkpoint_every=1, progress=None, contact="auto"):
         self.scene = scene
         self.critical = scene.validate()
-        self.control = control if control is not None else StepControl()
+        self.control = control if control is not None else StepControl(**scene.control)
         self.control.validate(scene.dx)
         if pictures not in ("final", "every", "none"):
             raise ValueError(f"pictures must be 'final', 'every' or 'none', got {pictures!r}")
