@@ -598,7 +598,8 @@ class Simulation:
         self.writer.write(state.step, state.x, prob.mesh, prob.u, stats.fragment)
         if self.pictures == "every":
             from .output import render_png
-            render_png(prob.mesh, prob.u, stats.fragment, self.out / f"step_{state.step:06d}.png")
+            render_png(prob.mesh, prob.u, stats.fragment, self.out / f"step_{state.step:06d}.png",
+                       scale=self._picture_scale(state))
         self.timings["output"] += time.perf_counter() - t0
 
     def _checkpoint(self, state):
@@ -627,14 +628,22 @@ class Simulation:
                      fixed_values=arrays["fixed_values"], fixed_dofs=arrays["fixed_dofs"],
                      peak_energy=meta["peak_energy"], history=meta["history"])
 
+    def _picture_scale(self, state):
+        """Magnification that shows the largest displacement as 2% of the body's size."""
+        size = float(np.ptp(state.arrays.points, axis=0).max())
+        umax = float(np.abs(state.u).max(initial=0.0))
+        return 0.02 * size / umax if umax > 0 else 1.0
+
     def _final_outputs(self, state, prob, stats, summary):
         from .output import RenderError, plot_fragment_sizes, render_png, write_summary
         t0 = time.perf_counter()
         pictures = {}
         if self.pictures != "none":
             try:
-                render_png(prob.mesh, prob.u, stats.fragment, self.out / "final.png")
+                scale = self._picture_scale(state)
+                render_png(prob.mesh, prob.u, stats.fragment, self.out / "final.png", scale=scale)
                 pictures["final"] = "final.png"
+                pictures["displacement_scale"] = scale
             except RenderError as err:
                 pictures["final_error"] = str(err)
         plot_fragment_sizes(stats.areas, self.out / "fragment_sizes.png", force=True)
