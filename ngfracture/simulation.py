@@ -539,7 +539,9 @@ class Simulation:
                     state.history[-1]["elastic_energy"] < c.unloaded_fraction * state.peak_energy:
                 reason, message = "broken", "the body is broken through (elastic energy released)"
                 break
-            dx = min(state.dx, self.scene.load_max - state.x)
+            remaining = self.scene.load_max - state.x
+            # no sliver of a last step: a remainder below dx_min joins this one
+            dx = remaining if remaining - state.dx < c.dx_min else state.dx
             attempt, dx, failure = self._step(state, dx)
             if attempt is None:
                 reason = "failed"
