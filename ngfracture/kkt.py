@@ -23,6 +23,7 @@ Failures are reported, never returned as numbers: a factorisation that produces
 NaN/inf or does not solve its own system is ``SingularSystem``.
 """
 import contextlib
+import time
 import warnings
 
 import numpy as np
@@ -63,8 +64,136 @@ def reproducible_threads():
         ng.SetNumThreads(before)
 
 
+class EliminatedFactor:
+    """K^+: the stiffness without fixed dofs and pins, factorised once, for many solves.
+
+    Kept between the constrained solves of one load (contact rounds, modified Newton):
+    building a ConstrainedSolver on it costs only the solves for the Schur complement of
+    the new general rows. It also remembers K^+ c for the rows c of the last Schur
+    complement, so rows kept from one round to the next cost no solve.
+
+    Parameters
+    ----------
+    K : ngsolve.SparseMatrix
+        Tangent stiffness on all dofs (kept as given; do not reassemble it while in use).
+    fixed_dofs, pins : numpy.ndarray
+        Dofs left out of the factorisation.
+    linear_solver, inverse, gmres_tol
+        See ConstrainedSolver.
+
+    Attributes
+    ----------
+    seconds : float
+        Time spent factorising and in triangular solves (or GMRES) so far.
+    """
+
+    def __init__(self, K, fixed_dofs, pins=None, linear_solver="direct", inverse="sparsecholesky",
+                 gmres_tol=1e-12):
+        if linear_solver not in LINEAR_SOLVERS:
+            raise ValueError(f"linear_solver must be one of {LINEAR_SOLVERS}, got {linear_solver!r}")
+        t0 = time.perf_counter()
+        self.K = K
+        self.ndof = K.height
+        self.fixed_dofs = np.asarray(fixed_dofs, dtype=np.int64)
+        self.pins = np.zeros(0, dtype=np.int64) if pins is None else np.asarray(pins, dtype=np.int64)
+        self.free = np.ones(self.ndof, dtype=bool)
+        self.free[self.fixed_dofs] = False
+        self.factor_free = self.free.copy()
+        self.factor_free[self.pins] = False
+        self.linear_solver = linear_solver
+        self.gmres_tol = gmres_tol
+        self._tmp = K.CreateColVector()
+        self._columns = {}        # row key -> K^+ row^T, for the rows of the last Schur complement
+        if linear_solver == "direct":
+            factor_dofs = ng.BitArray(self.ndof)
+            factor_dofs.Set()
+            for d in np.flatnonzero(~self.factor_free).tolist():
+                factor_dofs.Clear(d)
+            with reproducible_threads():
+                self._inv = K.Inverse(factor_dofs, inverse=inverse)
+            self._checked = False
+        else:
+            Kff = to_scipy(K)[self.factor_free][:, self.factor_free].tocsc()
+            self._Kff = Kff
+            try:
+                ilu = spla.spilu(Kff, drop_tol=1e-5, fill_factor=20, permc_spec="MMD_AT_PLUS_A")
+            except RuntimeError as err:
+                raise SingularSystem(f"ILU factorisation failed: {err}") from None
+            self._precond = spla.LinearOperator(Kff.shape, ilu.solve)
+        self.seconds = time.perf_counter() - t0
+
+    def matches(self, fixed_dofs, pins):
+        """True if this factorisation leaves out exactly these fixed dofs and pins."""
+        return np.array_equal(self.fixed_dofs, fixed_dofs) and np.array_equal(self.pins, pins)
+
+    def solve(self, B):
+        """X = K^+ B for a full-length right-hand side (ndof,) or a block (ndof, m).
+
+        Entries of B at fixed dofs and pins are ignored; X is zero there. Checked: the
+        factorisation must solve its own system.
+        """
+        t0 = time.perf_counter()
+        single = B.ndim == 1
+        B = B[:, None] if single else B
+        X = np.zeros(B.shape)
+        if B.shape[1] == 0:
+            return X[:, 0] if single else X
+        if self.linear_solver == "gmres":
+            for j in range(B.shape[1]):
+                x, info = spla.gmres(self._Kff, B[self.factor_free, j], M=self._precond, rtol=self.gmres_tol,
+                                     atol=0.0, restart=200, maxiter=50)
+                if info != 0 or not np.all(np.isfinite(x)):
+                    raise SingularSystem(f"GMRES did not converge (info={info})")
+                X[self.factor_free, j] = x
+        else:
+            # one multi-vector solve instead of a Python loop over columns
+            rhs = ng.MultiVector(self._tmp, B.shape[1])
+            for j in range(B.shape[1]):
+                rhs[j].FV().NumPy()[:] = B[:, j]
+            out = ng.MultiVector(self._tmp, B.shape[1])
+            out[:] = self._inv * rhs
+            for j in range(B.shape[1]):
+                X[:, j] = out[j].FV().NumPy()
+            if not np.all(np.isfinite(X)):
+                raise SingularSystem("the factorised stiffness produced NaN/inf: singular (a floating body?)")
+            if not self._checked:
+                self._check(B, X)
+        self.seconds += time.perf_counter() - t0
+        return X[:, 0] if single else X
+
+    def _check(self, B, X):
+        """One residual check per factorisation: sparse Cholesky of a singular or
+        indefinite matrix can return finite garbage."""
+        j = int(np.argmax(np.abs(B[self.factor_free]).sum(axis=0)))
+        b = B[self.factor_free, j]
+        if not np.any(b):
+            return
+        self._tmp.FV().NumPy()[:] = X[:, j]
+        r = (self.K * self._tmp).Evaluate().FV().NumPy()[self.factor_free] - b
+        rel = np.linalg.norm(r) / np.linalg.norm(b)
+        if not rel < 1e-6:
+            raise SingularSystem(f"the factorised stiffness does not solve its system (relative residual {rel:.1e}): singular or indefinite")
+        self._checked = True
+
+    def columns(self, C):
+        """Z = K^+ C^T (ndof, m); rows met in the last call are not solved again."""
+        C = sp.csr_matrix(C)
+        keys = [C.indices[s:e].tobytes() + C.data[s:e].tobytes() for s, e in zip(C.indptr[:-1], C.indptr[1:])]
+        Z = np.zeros((self.ndof, len(keys)))
+        new = []
+        for i, key in enumerate(keys):
+            if key in self._columns:
+                Z[:, i] = self._columns[key]
+            else:
+                new.append(i)
+        if new:
+            Z[:, new] = self.solve(C[new].T.toarray())
+        self._columns = {key: Z[:, i] for i, key in enumerate(keys)}
+        return Z
+
+
 class ConstrainedSolver:
-    """Factorises the eliminated KKT system once; solves it for many right-hand sides.
+    """Solves the eliminated KKT system for many right-hand sides.
 
     Parameters
     ----------
@@ -79,6 +208,10 @@ class ConstrainedSolver:
         "gmres": the paper's ILU-preconditioned GMRES (slow; for comparison).
     inverse : str
         NGSolve direct solver for "direct" ("sparsecholesky", "umfpack", "pardiso").
+    modes, pins : see rigid.Support.
+    factor : EliminatedFactor, optional
+        A factorisation of K for the same fixed dofs and pins to reuse (then K, the
+        solver options and the factorisation cost nothing here).
 
     Raises
     ------
@@ -87,50 +220,28 @@ class ConstrainedSolver:
     """
 
     def __init__(self, K, fixed_dofs, C, linear_solver="direct", inverse="sparsecholesky", gmres_tol=1e-12,
-                 modes=None, pins=None):
-        if linear_solver not in LINEAR_SOLVERS:
-            raise ValueError(f"linear_solver must be one of {LINEAR_SOLVERS}, got {linear_solver!r}")
-        self.K = K
-        self.ndof = K.height
-        pins = np.zeros(0, dtype=np.int64) if pins is None else np.asarray(pins, dtype=np.int64)
-        self.free = np.ones(self.ndof, dtype=bool)
-        self.free[fixed_dofs] = False
-        self.factor_free = self.free.copy()
-        self.factor_free[pins] = False
-        factor_dofs = ng.BitArray(self.ndof)
-        factor_dofs.Set()
-        for d in np.flatnonzero(~self.factor_free).tolist():
-            factor_dofs.Clear(d)
-        self.linear_solver = linear_solver
-        self.gmres_tol = gmres_tol
-        self._tmp = K.CreateColVector()
-        if linear_solver == "direct":
-            with reproducible_threads():
-                self._inv = K.Inverse(factor_dofs, inverse=inverse)
-            self._checked = False
-        else:
-            Kff = to_scipy(K)[self.factor_free][:, self.factor_free].tocsc()
-            self._Kff = Kff
-            try:
-                ilu = spla.spilu(Kff, drop_tol=1e-5, fill_factor=20, permc_spec="MMD_AT_PLUS_A")
-            except RuntimeError as err:
-                raise SingularSystem(f"ILU factorisation failed: {err}") from None
-            self._precond = spla.LinearOperator(Kff.shape, ilu.solve)
+                 modes=None, pins=None, factor=None):
+        if factor is None:
+            factor = EliminatedFactor(K, fixed_dofs, pins, linear_solver, inverse, gmres_tol)
+        elif not factor.matches(np.asarray(fixed_dofs, dtype=np.int64),
+                                np.zeros(0, dtype=np.int64) if pins is None else np.asarray(pins, dtype=np.int64)):
+            raise ValueError("the factorisation to reuse was made for other fixed dofs or pins")
+        self.factor = factor
+        self.K, self.ndof, self.free = factor.K, factor.ndof, factor.free
+        self._tmp = factor.K.CreateColVector()
         self.C = sp.csr_matrix(C)
         self.m = self.C.shape[0]
-        self._R = (sp.csr_matrix(modes)[self.free] if modes is not None and modes.shape[1]
-                   else sp.csr_matrix((int(self.free.sum()), 0)))
+        # all vectors below are full length: zero at fixed dofs (R, Z) and pins (Z)
+        self._R = (sp.csr_matrix(modes) if modes is not None and modes.shape[1]
+                   else sp.csr_matrix((self.ndof, 0)))
         self.k = self._R.shape[1]
         if self.k and not self.m:
             raise SingularSystem(f"{self.k} rigid-body mode(s) are held by no constraint (floating body)")
         if self.m:
-            Cf = self.C[:, self.free]
-            self._Cf = Cf
-            self._Z = np.column_stack([self._solve_free(np.asarray(Cf[i].todense()).ravel())
-                                       for i in range(self.m)])
-            S = Cf @ self._Z
+            self._Z = factor.columns(self.C)
+            S = self.C @ self._Z
             S = 0.5 * (S + S.T)
-            G = (Cf @ self._R).toarray()
+            G = (self.C @ self._R).toarray()
             coarse = np.block([[S, -G], [-G.T, np.zeros((self.k, self.k))]])
             # equilibrate, so that the pivot test does not depend on units: S ~ 1/E while
             # G ~ 1 (measured: E = 5e9 made a regular system look singular, ratio 3e-13)
@@ -145,35 +256,6 @@ class ConstrainedSolver:
             if not np.all(np.isfinite(pivots)) or pivots.min() <= 1e-12 * pivots.max():
                 raise SingularSystem(f"the {self.m} general constraint rows are (nearly) linearly dependent "
                                      f"or leave rigid modes free: coarse pivot ratio {pivots.min() / pivots.max():.2e}")
-
-    def _solve_free(self, rhs_free):
-        """x_f = K^+ rhs_f (pinned dofs get 0), checked: the factorisation must solve its own system."""
-        rhs = rhs_free[self.factor_free[self.free]]
-        if self.linear_solver == "gmres":
-            x, info = spla.gmres(self._Kff, rhs, M=self._precond, rtol=self.gmres_tol,
-                                 atol=0.0, restart=200, maxiter=50)
-            if info != 0 or not np.all(np.isfinite(x)):
-                raise SingularSystem(f"GMRES did not converge (info={info})")
-        else:
-            full = np.zeros(self.ndof)
-            full[self.factor_free] = rhs
-            self._tmp.FV().NumPy()[:] = full
-            xv = (self._inv * self._tmp).Evaluate()
-            x = xv.FV().NumPy()[self.factor_free].copy()
-            if not np.all(np.isfinite(x)):
-                raise SingularSystem("the factorised stiffness produced NaN/inf: singular (a floating body?)")
-            if not self._checked and np.any(rhs):
-                # One residual check per factorisation: sparse Cholesky of a singular or
-                # indefinite matrix can return finite garbage.
-                xv.FV().NumPy()[~self.factor_free] = 0.0
-                r = (self.K * xv).Evaluate().FV().NumPy()[self.factor_free] - rhs
-                rel = np.linalg.norm(r) / np.linalg.norm(rhs)
-                if not rel < 1e-6:
-                    raise SingularSystem(f"the factorised stiffness does not solve its system (relative residual {rel:.1e}): singular or indefinite")
-                self._checked = True
-        out = np.zeros(rhs_free.size)
-        out[self.factor_free[self.free]] = x
-        return out
 
     def solve(self, r, du_fixed, h):
         """Solve the eliminated KKT system.
@@ -193,18 +275,17 @@ class ConstrainedSolver:
         lam : numpy.ndarray (m,)
             Multipliers of the general rows.
         """
-        self._tmp.FV().NumPy()[:] = du_fixed
-        q = r - (self.K * self._tmp).Evaluate().FV().NumPy()
+        q = r
+        if np.any(du_fixed):
+            self._tmp.FV().NumPy()[:] = du_fixed
+            q = r - (self.K * self._tmp).Evaluate().FV().NumPy()
         self.last_load_norm = float(np.linalg.norm(q[self.free]))
-        qf = q[self.free]
-        x0 = self._solve_free(qf)
-        du = du_fixed.copy()
+        du = du_fixed + self.factor.solve(q)
         lam = np.zeros(self.m)
         if self.m:
-            hf = h - self.C[:, ~self.free] @ du_fixed[~self.free]
-            rhs = np.concatenate([self._Cf @ x0 - hf, -(self._R.T @ qf)])
+            rhs = np.concatenate([self.C @ du - h, -(self._R.T @ q)])
             sol = self._scale * sla.lu_solve(self._coarse, self._scale * rhs)
             lam, alpha = sol[:self.m], sol[self.m:]
-            x0 = x0 - self._Z @ lam + self._R @ alpha
-        du[self.free] = x0
+            du -= self._Z @ lam
+            du += self._R @ alpha
         return du, lam

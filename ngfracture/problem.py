@@ -65,6 +65,12 @@ def region_materials(mesh, material):
     return dict(material)
 
 
+def _double_areas(x, elements):
+    """Twice the signed area of every triangle."""
+    a, b, c = x[elements[:, 0]], x[elements[:, 1]], x[elements[:, 2]]
+    return (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0])
+
+
 class ElasticProblem:
     """Geometrically nonlinear 2D elasticity on a mesh, with Lagrange-multiplier constraints.
 
@@ -118,6 +124,7 @@ class ElasticProblem:
         self._form = None
         self._elements = arrays.triangles
         self._points = arrays.points
+        self._reference_areas = None
 
     # -- set-up ---------------------------------------------------------------------
     def add_dirichlet(self, boundaries, value=(0.0, 0.0), component=None):
@@ -252,7 +259,14 @@ class ElasticProblem:
         return ""
 
     def min_det_F(self):
-        """Smallest det F per element over vertices, edge midpoints and centroid."""
+        """Smallest det F per element (P1: exact; else over vertices, edge midpoints and centroid)."""
+        if self.order == 1:
+            # F is constant on a P1 triangle: det F = current area / reference area
+            # (numpy on vertex positions: 1.7 ms -> 0.2 ms per check on the plate)
+            if self._reference_areas is None:
+                self._reference_areas = _double_areas(self._points, self._elements)
+            x = self._points + vertex_displacement(self.u)
+            return _double_areas(x, self._elements) / self._reference_areas
         pts = [(0, 0), (1, 0), (0, 1), (0.5, 0), (0.5, 0.5), (0, 0.5), (1 / 3, 1 / 3)]
         ir = ng.IntegrationRule(pts, [0.0] * len(pts))
         F = ng.Id(2) + ng.Grad(self.u)
@@ -281,7 +295,7 @@ class ElasticProblem:
         return self.mesh.MaterialCF({name: make(m) for name, m in self.materials.items()})
 
     def solve(self, method="modified", load_steps=1, tol=1e-10, maxit=50, linear_solver="direct",
-              inverse="sparsecholesky", fix_free_modes=False):
+              inverse="sparsecholesky", fix_free_modes=False, tangent=None):
         """Solve for equilibrium with the current constraints and loads.
 
         Parameters
@@ -300,6 +314,9 @@ class ElasticProblem:
         fix_free_modes : bool
             Hold free fragments by multiplier rows on their unheld rigid modes
             instead of reporting them as floating bodies.
+        tangent : solver.SavedTangent, optional
+            A factorised tangent to reuse at this load, or to leave this solve's in
+            (contact rounds at a fixed load).
 
         Returns
         -------
@@ -313,5 +330,5 @@ class ElasticProblem:
             On invalid options or constraints (unknown boundary, conflicting values).
         """
         solver = NewtonSolver(self, method=method, tol=tol, maxit=maxit, linear_solver=linear_solver,
-                              inverse=inverse, fix_free_modes=fix_free_modes)
+                              inverse=inverse, fix_free_modes=fix_free_modes, tangent=tangent)
         return solver.solve(load_steps)

@@ -19,7 +19,7 @@ import scipy.sparse as sp
 
 from . import rigid
 from .constraints import ConstraintRows
-from .kkt import ConstrainedSolver, SingularSystem
+from .kkt import ConstrainedSolver, EliminatedFactor, SingularSystem
 
 METHODS = ("modified", "full")
 REASONS = ("converged", "max_iterations", "diverged", "nan", "singular", "inverted_element")
@@ -46,7 +46,8 @@ class SolveStatus:
     residual_history : list of float
         Euclidean norm of the free out-of-balance force after every iteration.
     timings : dict
-        Seconds per phase: assemble, factorize, solve, residual, checks.
+        Seconds per phase: assemble, factorize (with the Schur complement), solve,
+        residual, checks.
     multipliers : numpy.ndarray
         Lagrange multipliers of the general rows at the end (the forces -C^T lam
         they exert on the dofs); empty without general rows.
@@ -68,6 +69,41 @@ class SolveStatus:
     def fail(self, reason, message):
         self.converged, self.reason, self.message = False, reason, message
         return self
+
+
+def _copy(K):
+    """A copy of an NGSolve sparse matrix (same sparsity)."""
+    copy = K.CreateMatrix()
+    copy.AsVector().data = K.AsVector()
+    return copy
+
+
+class SavedTangent:
+    """A factorised tangent kept for further solves at the same load (contact rounds).
+
+    The paper's modified Newton factorises the tangent once per load step; a contact
+    round, which only changes the general rows, is not a new load step. A solve given an
+    empty SavedTangent leaves its last factorisation here (modified Newton, or any method
+    on a linear model, whose tangent is constant); a solve given a filled one for the same
+    fixed dofs uses it instead of assembling and factorising, and rebuilds only the Schur
+    complement of its general rows. Its rigid modes and pins stay those of the
+    configuration the tangent was assembled at, where K R = 0 holds.
+
+    Attributes
+    ----------
+    fixed_dofs : numpy.ndarray or None
+    support : rigid.Support or None
+    factor : kkt.EliminatedFactor or None
+    residual : (numpy.ndarray, float, numpy.ndarray) or None
+        (u, load factor, out-of-balance there) at the end of the last solve: the next solve
+        at the same state starts from it without assembling it again.
+    """
+
+    def __init__(self):
+        self.fixed_dofs = self.support = self.factor = self.residual = None
+
+    def holds(self, fixed_dofs):
+        return self.fixed_dofs is not None and np.array_equal(self.fixed_dofs, fixed_dofs)
 
 
 class _Timer:
@@ -102,10 +138,12 @@ class NewtonSolver:
     fix_free_modes : bool
         Fix the rigid modes that no constraint holds (free fragments) by multiplier
         rows that stop them from drifting; otherwise such a body is reported as floating.
+    tangent : SavedTangent, optional
+        Reuse its factorisation, or leave this solve's in it (see SavedTangent).
     """
 
     def __init__(self, problem, method="modified", tol=1e-10, maxit=50, linear_solver="direct",
-                 inverse="sparsecholesky", divergence_factor=1e4, fix_free_modes=False):
+                 inverse="sparsecholesky", divergence_factor=1e4, fix_free_modes=False, tangent=None):
         if method not in METHODS:
             raise ValueError(f"method must be one of {METHODS}, got {method!r}")
         if not (isinstance(tol, (int, float)) and 0 < tol < 1):
@@ -117,6 +155,7 @@ class NewtonSolver:
         self.linear_solver, self.inverse = linear_solver, inverse
         self.divergence_factor = divergence_factor
         self.fix_free_modes = fix_free_modes
+        self.tangent = tangent
 
     def solve(self, load_steps=1):
         """Bring the problem from its current state to the prescribed constraint values.
@@ -132,9 +171,14 @@ class NewtonSolver:
             raise ValueError(f"load_steps must be a positive integer, got {load_steps!r}")
         prob = self.problem
         status = SolveStatus()
+        saved = self.tangent
+        # a saved tangent is valid for every iterate of modified Newton; full Newton needs
+        # the tangent of each iterate unless the model is linear
+        reusable = saved is not None and (self.method == "modified" or not prob.nonlinear)
         with _Timer(status.timings, "checks"):
             rows = prob.assemble_constraints()
-            support = prob.support(rows)
+            reuse = reusable and saved.holds(rows.fixed_dofs)
+            support = saved.support if reuse else prob.support(rows)
             if self.fix_free_modes:
                 rows = self._hold_free_modes(rows, support)
             floating = prob.floating_bodies(rows, support)
@@ -149,15 +193,27 @@ class NewtonSolver:
             prob.load_factor.Set(start_load + t * (1.0 - start_load))
             target_fixed = start_fixed + t * (rows.fixed_values - start_fixed)
             target_rows = start_rows + t * (rows.g - start_rows)
-            saved = u.copy()
-            self._load_step(rows, support, target_fixed, target_rows, status)
+            start = u.copy()
+            factor = self._load_step(rows, support, target_fixed, target_rows, status,
+                                     saved.factor if reuse else None)
+            if reusable and not reuse and factor is not None:
+                saved.fixed_dofs, saved.support, saved.factor = rows.fixed_dofs, support, factor
             if not status.converged:
-                u[:] = saved  # the last converged state, never a failed iterate
+                u[:] = start  # the last converged state, never a failed iterate
                 prob.load_factor.Set(start_load + (step - 1) / load_steps * (1.0 - start_load))
                 status.message = f"load step {step} of {load_steps}: {status.message}"
                 return status
             status.steps = step
         return status
+
+    def _out_of_balance(self):
+        """The out-of-balance force, taken from the saved tangent if u is where it was left."""
+        saved = self.tangent
+        u = self.problem.u.vec.FV().NumPy()
+        if (saved is not None and saved.residual is not None and np.array_equal(saved.residual[0], u)
+                and saved.residual[1] == self.problem.load_factor.Get()):
+            return saved.residual[2].copy()
+        return self.problem.out_of_balance()
 
     def _hold_free_modes(self, rows, support):
         """Append rows n^T du = 0 for every rigid mode n that nothing holds."""
@@ -168,7 +224,8 @@ class NewtonSolver:
         return ConstraintRows(rows.fixed_dofs, rows.fixed_values, sp.vstack([rows.C, extra]).tocsr(),
                               np.concatenate([rows.g, extra @ u]), rows.labels + ["free modes"])
 
-    def _load_step(self, rows, support, target_fixed, target_rows, status):
+    def _load_step(self, rows, support, target_fixed, target_rows, status, factor=None):
+        """One load step; returns the last factorisation (None if there was none)."""
         prob = self.problem
         u = prob.u.vec.FV().NumPy()
         timings = status.timings
@@ -180,23 +237,29 @@ class NewtonSolver:
         prev = np.inf
         growing = 0
         with _Timer(timings, "residual"):
-            r = prob.out_of_balance()
+            r = self._out_of_balance()
+        given = factor
         for k in range(self.maxit):
-            if kkt is None or self.method == "full":
-                with _Timer(timings, "assemble"):
-                    K = prob.tangent()
+            if kkt is None or (self.method == "full" and given is None):
                 try:
-                    # not inside prob.threads(): the factorisation runs on one thread (kkt.py)
+                    if given is None:
+                        with _Timer(timings, "assemble"):
+                            K = prob.tangent()
+                            if self.tangent is not None and prob.nonlinear and self.method == "modified":
+                                K = _copy(K)   # the saved factor keeps K; the next assembly overwrites it
+                        # not inside prob.threads(): the factorisation runs on one thread (kkt.py)
+                        with _Timer(timings, "factorize"):
+                            factor = EliminatedFactor(K, rows.fixed_dofs, support.pins, self.linear_solver,
+                                                      self.inverse)
                     with _Timer(timings, "factorize"):
-                        kkt = ConstrainedSolver(K, rows.fixed_dofs, rows.C,
-                                                self.linear_solver, self.inverse,
-                                                modes=support.modes, pins=support.pins)
+                        kkt = ConstrainedSolver(None, rows.fixed_dofs, rows.C, modes=support.modes,
+                                                pins=support.pins, factor=factor)
                 except SingularSystem as err:
                     status.fail("singular", str(err))
-                    return
+                    return None
             if not np.all(np.isfinite(r)):
                 status.fail("nan", f"the residual is NaN/inf at iteration {k}")
-                return
+                return None
             du_fixed[:] = 0.0
             du_fixed[rows.fixed_dofs] = target_fixed - u[rows.fixed_dofs]   # eq. 6
             h = target_rows - rows.C @ u
@@ -208,10 +271,10 @@ class NewtonSolver:
                     force_scale = kkt.last_load_norm
             except SingularSystem as err:
                 status.fail("singular", str(err))
-                return
+                return None
             if not np.all(np.isfinite(du)):
                 status.fail("nan", f"the increment is NaN/inf at iteration {k}")
-                return
+                return None
             u += du
             status.iterations += 1
             norm = float(np.linalg.norm(du))
@@ -228,7 +291,7 @@ class NewtonSolver:
                 inverted = prob.inverted_elements() if prob.nonlinear else None
             if inverted:
                 status.fail("inverted_element", inverted)
-                return
+                return None
             # eq. 7; for the linear model one step is exact, and a residual at rounding level
             # proves it without a second solve
             exact = not prob.nonlinear and res_norm <= self.tol * force_scale
@@ -236,14 +299,16 @@ class NewtonSolver:
             rounding = norm <= 64 * np.finfo(float).eps * np.linalg.norm(u)
             if ratio < self.tol or norm == 0.0 or exact or rounding:
                 status.converged, status.reason, status.message = True, "converged", ""
-                return
+                if self.tangent is not None:
+                    self.tangent.residual = (u.copy(), prob.load_factor.Get(), r)
+                return factor
             if not np.isfinite(ratio) or ratio > self.divergence_factor:
                 status.fail("diverged", f"increment grew to {ratio:.2e} times the first one")
-                return
+                return None
             growing = growing + 1 if norm >= prev else 0
             prev = norm
             if growing >= 5:
                 status.fail("diverged", "the increment grew for 5 iterations in a row")
-                return
+                return None
         status.fail("max_iterations", f"no convergence in {self.maxit} iterations "
                                       f"(last relative increment {status.increment_history[-1]:.2e})")

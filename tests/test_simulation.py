@@ -89,6 +89,15 @@ def test_energy_released_by_cracking_is_positive(plate_run):
     assert energy[-1]["released_energy"] > 0.5 * energy[-1]["external_work"]   # broken: most of it released
 
 
+def test_small_plate_run_leaves_no_overlap():
+    """Contact rows re-linearised at the solution: the broken pieces of the driver's plate
+    do not overlap (before: 1.6e-9 of the area on the default plate)."""
+    result = Simulation(scenes.plate(maxh=0.06), pictures="none").run()
+    s = result.summary
+    assert result.ok and s["n_fragments"] >= 2
+    assert s["max_overlap_area"] < 1e-10 * s["area_initial"]
+
+
 def test_too_many_cracks_cut_the_increment():
     """max_new_cracks = 0: every increment that cracks is retried with dx * cut down to dx_min."""
     scene = scenes.plate(maxh=0.06)
