@@ -45,7 +45,7 @@ import scipy.sparse as sp
 from . import contact
 from .collision import detect_collisions
 from .crack import vertex_displacement
-from .meshio import mesh_to_arrays, orient_segments
+from .meshio import boundary_only, mesh_to_arrays
 from .seams import KINK_ANGLE, find_seams, seam_constraints
 from .solver import SavedTangent, SolveStatus
 
@@ -164,8 +164,7 @@ class ContactSolver:
         None of it changes while the problem is solved on one mesh: computed once per solve.
         """
         prob = self.problem
-        arrays = mesh_to_arrays(prob.mesh)
-        arrays.segments = orient_segments(arrays.triangles, arrays.segments)
+        arrays = boundary_only(mesh_to_arrays(prob.mesh))   # no bonded-interface segments
         _, comp = prob.fragments()
         fragment = comp[arrays.triangles[:, 0]]
         nv, n = prob.mesh.nv, prob.fes.ndof // 2
@@ -412,7 +411,7 @@ def _clip_half_plane(poly, a, b):
 
 def fragment_overlap_area(problem):
     """Total overlap area between triangles of the current configuration (0 if none)."""
-    arrays = mesh_to_arrays(problem.mesh)
+    arrays = boundary_only(mesh_to_arrays(problem.mesh))
     U = vertex_displacement(problem.u)
     _, comp = problem.fragments()
     fragment = comp[arrays.triangles[:, 0]]

@@ -159,6 +159,15 @@ def merge_meshes(*meshes):
                                        region_names, np.vstack(segs), np.concatenate(sbc), bc_names))
 
 
+def _half_edge_membership(triangles, segments):
+    """For each segment (p, q): is (p, q), is (q, p) a counter-clockwise triangle edge."""
+    T = np.asarray(triangles, dtype=np.int64)
+    S = np.asarray(segments, dtype=np.int64).reshape(-1, 2)
+    n = int(max(T.max(initial=-1), S.max(initial=-1))) + 1
+    half = np.unique(T[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2) @ np.array([n, 1]))
+    return np.isin(S @ np.array([n, 1]), half), np.isin(S[:, ::-1] @ np.array([n, 1]), half)
+
+
 def orient_segments(triangles, segments):
     """Segments turned so that their triangle lies on their left.
 
@@ -176,12 +185,31 @@ def orient_segments(triangles, segments):
     numpy.ndarray of int, shape (ns, 2)
         A copy; segments whose reverse is a triangle edge are reversed, the others kept.
     """
-    T = np.asarray(triangles, dtype=np.int64)
     S = np.array(segments, dtype=np.int64).reshape(-1, 2)
-    half = set(zip(*T[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2).T.tolist()))
-    flip = np.array([(p, q) not in half and (q, p) in half for p, q in S.tolist()], dtype=bool)
+    forward, backward = _half_edge_membership(triangles, S)
+    flip = backward & ~forward
     S[flip] = S[flip, ::-1]
     return S
+
+
+def boundary_only(arrays):
+    """The arrays with only the segments on the boundary of the triangles, oriented.
+
+    Interface segments between bonded regions (an edge of two triangles) are dropped,
+    boundary segments turned to have their triangle on the left (:func:`orient_segments`):
+    what collision detection and contact expect.
+
+    Returns
+    -------
+    MeshArrays
+        A new object sharing points and triangles.
+    """
+    forward, backward = _half_edge_membership(arrays.triangles, arrays.segments)
+    keep = forward ^ backward
+    S = np.asarray(arrays.segments, dtype=np.int64).reshape(-1, 2)
+    S = np.where(forward[:, None], S, S[:, ::-1])[keep]
+    return MeshArrays(arrays.points, arrays.triangles, arrays.regions, arrays.region_names, S,
+                      np.asarray(arrays.seg_bc)[keep], arrays.bc_names)
 
 
 def separate_region(mesh, region, boundary="interface", region_boundary=None):

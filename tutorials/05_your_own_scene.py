@@ -54,7 +54,7 @@ pts = [geo.AppendPoint(*p) for p in [(0, 0), (0.1, 0), (0.2, 0), (1.8, 0), (1.9,
 lines = [(0, 1, "bottom", 1, 0), (1, 2, "support_left", 1, 0), (2, 3, "bottom", 1, 0),
          (3, 4, "support_right", 1, 0), (4, 5, "bottom", 1, 0), (5, 6, "side", 1, 0),
          (6, 7, "top", 1, 0), (7, 8, "pad_contact", 1, 2), (8, 9, "top", 1, 0), (9, 0, "side", 1, 0),
-         (8, 10, "pad_side", 2, 0), (10, 11, "pad_top", 2, 0), (11, 7, "pad_side", 2, 0)]
+         (8, 10, "pad_side", 0, 2), (10, 11, "pad_top", 0, 2), (11, 7, "pad_side", 0, 2)]
 for a, b, name, left, right in lines:
     geo.Append(["line", pts[a], pts[b]], bc=name, leftdomain=left, rightdomain=right)
 geo.SetMaterial(1, "glass")
