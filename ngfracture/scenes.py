@@ -138,10 +138,11 @@ def disk(maxh=0.04, expansion=None, dx=None, core_stiffness=0.1, name="disk", co
     The disk (radius 1, hole radius 0.25) is the paper's glass (St Venant-Kirchhoff,
     plane strain); the core ring (radii 0.125 to 0.25) is ``core_stiffness`` times as stiff
     and never cracks. The core's inner boundary moves radially outward by x; frictionless
-    contact passes the expansion on to the disk. Free modes (the disk's rotation) are held
-    by multiplier rows. By default x runs to 12 times the expansion that first cracks an
-    intact disk (radial cracks grow from the hole, the inner part breaks into grains, the
-    outer ring stays whole).
+    contact passes the expansion on to the disk, which sits in a rigid ring (``confined``:
+    its outer boundary is held). Free modes (rotations of pieces) are held by multiplier
+    rows. By default x runs to 50 times the expansion that first cracks the intact disk:
+    radial cracks grow from the hole and stop inside (the ring confines them), the inner
+    part breaks into grains, the outer part stays whole.
 
     Parameters
     ----------
@@ -154,6 +155,8 @@ def disk(maxh=0.04, expansion=None, dx=None, core_stiffness=0.1, name="disk", co
     core_stiffness : float
         Young's modulus of the core relative to the disk's (> 0).
     name : str
+    confined : bool
+        Hold the disk's outer boundary (a rigid ring); False leaves it free.
 
     Returns
     -------
@@ -164,7 +167,7 @@ def disk(maxh=0.04, expansion=None, dx=None, core_stiffness=0.1, name="disk", co
     # the first crack: the hole's hoop strain u_r / r reaches the critical strain, so
     # u_r(hole) ~ c hole; the softer core ring is squeezed too: about 1.5 times that at its inside
     first = 1.5 * c * hole
-    expansion = _positive("expansion", expansion) if expansion is not None else 12 * first
+    expansion = _positive("expansion", expansion) if expansion is not None else 50 * first
     dx = _positive("dx", dx) if dx is not None else first / 5
     glass = StVenantKirchhoff(GLASS["E"], GLASS["nu"], plane="strain")
     core = StVenantKirchhoff(core_stiffness * GLASS["E"], 0.3, plane="strain")
@@ -185,17 +188,29 @@ def disk(maxh=0.04, expansion=None, dx=None, core_stiffness=0.1, name="disk", co
 
 
 def disintegration(maxh=0.04, expansion=None, dx=None, core_stiffness=0.1):
-    """The disk of :func:`disk` expanded until it falls apart (paper Fig. 10).
+    """The disk of :func:`disk`, free outside, expanded until it falls apart (paper Fig. 10).
 
-    Same scene with three times the final expansion.
+    Without the confining ring, radial cracks run through to the outside; the pieces
+    are held on their rigid modes by multiplier rows (the paper pins two points each),
+    so the core keeps pushing them and they break further. Three times the final
+    expansion of :func:`disk`.
+
+    Parameters
+    ----------
+    maxh, expansion, dx, core_stiffness
+        As for :func:`disk`.
+
+    Returns
+    -------
+    Scene
 
     Returns
     -------
     Scene
     """
     first = GLASS["critical"] * 0.25 * 1.5
-    expansion = expansion if expansion is not None else 36 * first
-    return disk(maxh, expansion, dx, core_stiffness, name="disintegration")
+    expansion = expansion if expansion is not None else 150 * first
+    return disk(maxh, expansion, dx, core_stiffness, name="disintegration", confined=False)
 
 
 #: the scenes of ``python -m ngfracture run``
