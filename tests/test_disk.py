@@ -1,0 +1,100 @@
+"""The disk around an expanding core (paper Fig. 9, 10): comminuted zone, intact ring, disintegration."""
+import math
+
+import numpy as np
+import pytest
+
+from ngfracture import scenes
+from ngfracture.fragments import FragmentStatistics
+from ngfracture.meshio import mesh_to_arrays
+from ngfracture.simulation import Simulation
+
+FIRST = 1.5 * 1.3817e-4 * 0.25      # the scenes' estimate of the first-crack expansion
+
+
+def encircles_origin(triangles, points, members):
+    """Whether the triangles ``members`` (one connected piece) contain a loop around (0, 0).
+
+    Lift the polar angle of the triangle centroids along a spanning tree of the piece
+    (neighbours share an edge); the piece winds around the origin exactly when two
+    neighbours end up with lifted angles about 2 pi apart.
+    """
+    members = np.asarray(members)
+    index = -np.ones(len(triangles), dtype=np.int64)
+    index[members] = np.arange(len(members))
+    c = points[triangles[members]].mean(axis=1)
+    theta = np.arctan2(c[:, 1], c[:, 0])
+    edges = {}
+    for k, t in enumerate(triangles[members]):
+        for a, b in ((t[0], t[1]), (t[1], t[2]), (t[2], t[0])):
+            edges.setdefault((min(a, b), max(a, b)), []).append(k)
+    neighbours = [[] for _ in members]
+    for ks in edges.values():
+        if len(ks) == 2:
+            neighbours[ks[0]].append(ks[1])
+            neighbours[ks[1]].append(ks[0])
+    lifted = np.full(len(members), np.nan)
+    lifted[0] = theta[0]
+    stack = [0]
+    while stack:
+        k = stack.pop()
+        for j in neighbours[k]:
+            step = (theta[j] - theta[k] + math.pi) % (2 * math.pi) - math.pi
+            if np.isnan(lifted[j]):
+                lifted[j] = lifted[k] + step
+                stack.append(j)
+            elif abs(lifted[j] - (lifted[k] + step)) > math.pi:
+                return True
+    return False
+
+
+def test_encircling_check_on_a_ring_and_a_c_shape():
+    from ngfracture.scenes import cored_disk_mesh
+    a = mesh_to_arrays(cored_disk_mesh(maxh=0.2))
+    disk = np.flatnonzero(a.regions == a.region_names.index("disk") + 1)
+    assert encircles_origin(a.triangles, a.points, disk)
+    c = a.points[a.triangles[disk]].mean(axis=1)
+    cut = disk[~((c[:, 0] > 0) & (np.abs(c[:, 1]) < 0.15))]      # a wedge removed: a C
+    assert not encircles_origin(a.triangles, a.points, cut)
+
+
+@pytest.fixture(scope="module")
+def disk_run():
+    return Simulation(scenes.disk(maxh=0.06), pictures="none").run()
+
+
+@pytest.mark.slow
+def test_disk_comminuted_zone_and_intact_ring(disk_run):
+    result = disk_run
+    assert result.ok and result.reason == "load_max", result.message
+    s = result.summary
+    assert s["area_final"] == s["area_initial"]
+    assert s["max_overlap_area"] <= 1e-10 * s["area_initial"]
+    a = result.state.arrays
+    stats = FragmentStatistics(result.problem.mesh)
+    disk_region = a.region_names.index("disk") + 1
+    on_disk = [f for f in stats.ids if np.all(a.regions[stats.fragment == f] == disk_region)]
+    ring = max(on_disk, key=lambda f: stats.areas[np.searchsorted(stats.ids, f)])
+    grains = [f for f in on_disk if f != ring]
+    # the comminuted zone: more than 20 grains, all inside the inner half of the disk
+    assert len(grains) > 20, len(grains)
+    centroid_r = np.hypot(*stats.centroids[np.searchsorted(stats.ids, grains)].T)
+    assert centroid_r.max() < 0.6
+    # the outer ring is one piece that still goes around the hole
+    assert encircles_origin(a.triangles, a.points, np.flatnonzero(stats.fragment == ring))
+
+
+@pytest.mark.slow
+def test_disintegration_many_disjoint_fragments():
+    result = Simulation(scenes.disintegration(maxh=0.08), pictures="none").run()
+    assert result.ok, result.message
+    s = result.summary
+    stats = FragmentStatistics(result.problem.mesh)
+    a = result.state.arrays
+    disk_region = a.region_names.index("disk") + 1
+    on_disk = [f for f in stats.ids if np.all(a.regions[stats.fragment == f] == disk_region)]
+    assert len(on_disk) > 20
+    # no piece of the disk goes around the hole any more
+    assert not any(encircles_origin(a.triangles, a.points, np.flatnonzero(stats.fragment == f)) for f in on_disk)
+    assert math.fsum(s["fragment_areas"]) == pytest.approx(s["area_initial"], rel=1e-14)
+    assert s["area_final"] == s["area_initial"]
