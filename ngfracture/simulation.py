@@ -415,6 +415,7 @@ class Simulation:
         self._split_positions = []      # per pass: reference positions of the vertices split
         prob = self._problem(self._mesh, self._x_try, state.u)
         self._equilibrium(prob, "increment", substeps)
+        self._dwork = self._increment_work(state, prob)
         new_prob, first = self._crack_pass(prob)
         c = self.control
         if first > c.max_new_cracks and dx * c.cut >= c.dx_min:
@@ -430,24 +431,28 @@ class Simulation:
             total += n
         return prob, first, total
 
+    @staticmethod
+    def _increment_work(state, prob):
+        """Work of the reactions over the increment just solved (trapezoid rule).
+
+        The increment is solved on the mesh of the accepted state, so its fixed dofs have
+        the numbers they had there (cracks come later, at fixed load: they do no work).
+        """
+        rows = prob.assemble_constraints()
+        pos = np.searchsorted(rows.fixed_dofs, state.fixed_dofs)
+        pos = np.minimum(pos, max(len(rows.fixed_dofs) - 1, 0))
+        same = (rows.fixed_dofs[pos] == state.fixed_dofs) if len(rows.fixed_dofs) else np.zeros(0, bool)
+        r_new = -prob.out_of_balance()[rows.fixed_dofs[pos[same]]]
+        dg = rows.fixed_values[pos[same]] - state.fixed_values[same]
+        return float(0.5 * np.dot(state.reactions[same] + r_new, dg))
+
     def _accept(self, state, prob, dx, first, total):
         arrays, mesh = round_trip(prob.mesh)
         u = prob.u.vec.FV().NumPy().copy()
         prob = self._problem(mesh, self._x_try, u)   # the state as a resume would see it
         rows = prob.assemble_constraints()
-        reactions = -prob.out_of_balance()[rows.fixed_dofs]
-        # work of the reactions over the increment (trapezoid; the dofs of the last accepted
-        # state keep their numbers through the increment, cracks come later at fixed load)
-        same = (len(state.fixed_dofs) == 0 or
-                (len(rows.fixed_dofs) >= len(state.fixed_dofs)))
-        dwork = 0.0
-        if len(state.fixed_dofs) and same:
-            pos = {int(d): i for i, d in enumerate(rows.fixed_dofs)}
-            idx = np.array([pos.get(int(d), -1) for d in state.fixed_dofs])
-            ok = idx >= 0
-            r_new = reactions[idx[ok]]
-            dg = rows.fixed_values[idx[ok]] - state.fixed_values[ok]
-            dwork = float(0.5 * np.dot(state.reactions[ok] + r_new, dg))
+        reactions = -prob.out_of_balance()[rows.fixed_dofs]   # for the work of the next increment
+        dwork = self._dwork
         energy = float(prob.energy())
         stats = FragmentStatistics(mesh)
         crack_len = crack_length(arrays)
