@@ -43,7 +43,20 @@ def _digest(arrays, header_bytes):
 
 
 def path_for(folder, step):
-    """The file name of the checkpoint of a step."""
+    """The file name of the checkpoint of a step.
+
+    Parameters
+    ----------
+    folder : str or pathlib.Path
+        The checkpoint folder.
+    step : int
+        Step number (six digits in the name).
+
+    Returns
+    -------
+    pathlib.Path
+        ``folder / "checkpoint_NNNNNN.npz"``.
+    """
     return Path(folder) / f"checkpoint_{int(step):06d}.npz"
 
 
@@ -57,6 +70,7 @@ def write(folder, step, arrays, meta, keep=2):
     step : int
         Step number, part of the file name.
     arrays : dict of str -> numpy.ndarray
+        The state to store, by name.
     meta : dict
         JSON-serialisable metadata.
     keep : int
@@ -100,9 +114,17 @@ def write(folder, step, arrays, meta, keep=2):
 def read(path):
     """Read and verify one checkpoint.
 
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The checkpoint file.
+
     Returns
     -------
-    (dict of arrays, dict header)
+    arrays : dict of str -> numpy.ndarray
+        The arrays given to :func:`write`.
+    header : dict
+        Format, format version, ngfracture version, step and user ``meta``.
 
     Raises
     ------
@@ -134,7 +156,18 @@ def read(path):
 
 
 def list_checkpoints(folder):
-    """Complete checkpoint files in a folder, oldest first (temporary files ignored)."""
+    """Complete checkpoint files in a folder, oldest first (temporary files ignored).
+
+    Parameters
+    ----------
+    folder : str or pathlib.Path
+        The checkpoint folder; a missing folder has none.
+
+    Returns
+    -------
+    list of pathlib.Path
+        Files named ``checkpoint_NNNNNN.npz``, by increasing step (not verified).
+    """
     folder = Path(folder)
     if not folder.is_dir():
         return []
@@ -144,6 +177,17 @@ def list_checkpoints(folder):
 
 def latest(folder):
     """Read the newest checkpoint of a folder.
+
+    Parameters
+    ----------
+    folder : str or pathlib.Path
+        The checkpoint folder.
+
+    Returns
+    -------
+    arrays : dict of str -> numpy.ndarray
+    header : dict
+        As for :func:`read`.
 
     Raises
     ------

@@ -209,12 +209,21 @@ def candidate_mask(tris, boundary_edges, nv=None):
     Parameters
     ----------
     tris : array_like, shape (nt, 3)
+        Triangles, counter-clockwise in the reference configuration.
     boundary_edges : array_like, shape (ne, 2)
+        Directed boundary / crack edges with their triangle on the left.
     nv : int, optional
+        Number of vertices; by default 1 + the largest index used.
 
     Returns
     -------
     numpy.ndarray of bool, shape (nt,)
+        True for triangles with at least one boundary or crack edge.
+
+    Raises
+    ------
+    ValueError
+        As :func:`boundary_edge_mask`.
     """
     return boundary_edge_mask(tris, boundary_edges, nv).any(axis=1)
 
@@ -338,6 +347,11 @@ def triangles_collide(x, tris, pairs, tol=0.0):
     -------
     numpy.ndarray of bool, shape (k,)
         True where the interiors overlap (exact), or the distance is <= tol when tol > 0.
+
+    Raises
+    ------
+    ValueError, TypeError
+        On wrong shapes or types, non-finite positions, indices out of range, tol < 0.
     """
     tol = _check_tol(tol)
     X = current_coordinates(x)

@@ -53,7 +53,17 @@ def _as_vector_cf(value, comps):
 
 @dataclass
 class Dirichlet:
-    """Prescribed displacement on named boundaries (component=None: both; 0 or 1: gliding)."""
+    """Prescribed displacement on named boundaries (component=None: both; 0 or 1: gliding).
+
+    Parameters
+    ----------
+    boundaries : tuple of str
+        Boundary names of the mesh.
+    value : ngsolve.CoefficientFunction
+        The prescribed displacement as a 2-vector CoefficientFunction.
+    component : None, 0/'x' or 1/'y'
+        None prescribes both components, otherwise only that one.
+    """
     boundaries: tuple
     value: object
     component: object = None
@@ -61,7 +71,17 @@ class Dirichlet:
 
 @dataclass
 class PointConstraint:
-    """Prescribed displacement of one vertex."""
+    """Prescribed displacement of one vertex.
+
+    Parameters
+    ----------
+    vertex : int
+        Vertex number (0-based).
+    value : (float, float)
+        Prescribed displacement.
+    component : None, 0/'x' or 1/'y'
+        None prescribes both components, otherwise only that one.
+    """
     vertex: int
     value: tuple
     component: object = None
@@ -69,7 +89,21 @@ class PointConstraint:
 
 @dataclass
 class ConstraintRows:
-    """The assembled constraints: fixed dofs with target values, plus general rows C u = g."""
+    """The assembled constraints: fixed dofs with target values, plus general rows C u = g.
+
+    Parameters
+    ----------
+    fixed_dofs : numpy.ndarray of int64, shape (k,)
+        Dofs prescribed by single-dof rows, ascending.
+    fixed_values : numpy.ndarray, shape (k,)
+        Their prescribed values.
+    C : scipy.sparse.csr_matrix, shape (m, ndof)
+        General constraint rows.
+    g : numpy.ndarray, shape (m,)
+        Right-hand side of the general rows.
+    labels : list of str
+        Label of every block of rows added with ``ConstraintSet.add_rows``, in order.
+    """
     fixed_dofs: np.ndarray
     fixed_values: np.ndarray
     C: sp.csr_matrix
@@ -78,6 +112,7 @@ class ConstraintRows:
 
     @property
     def n_rows(self):
+        """Total number of constraint rows: single-dof plus general."""
         return len(self.fixed_dofs) + self.C.shape[0]
 
 
@@ -153,6 +188,15 @@ class ConstraintSet:
     def add_rows(self, C, g, label="rows"):
         """Add general constraint rows C u = g (kept as Lagrange multipliers).
 
+        Parameters
+        ----------
+        C : scipy.sparse matrix or array_like, shape (m, ndof)
+            The rows, one column per dof of the space.
+        g : array_like, shape (m,)
+            Right-hand side.
+        label : str
+            Name of this block of rows (for messages and ``clear_rows``).
+
         Raises
         ------
         ValueError
@@ -167,7 +211,13 @@ class ConstraintSet:
         self.rows.append((C, g, label))
 
     def clear_rows(self, label=None):
-        """Remove general rows (all, or those with the given label)."""
+        """Remove general rows (all, or those with the given label).
+
+        Parameters
+        ----------
+        label : str, optional
+            Remove only the blocks added with this label; None removes every block.
+        """
         self.rows = [r for r in self.rows if label is not None and r[2] != label]
 
     # -- assembly -------------------------------------------------------------------

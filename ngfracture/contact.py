@@ -83,7 +83,7 @@ __all__ = ["ContactConstraints", "select_contacts", "gap_rows", "independent_row
 class ContactConstraints:
     """Node-to-segment constraints, one entry per row of C.
 
-    Attributes
+    Parameters
     ----------
     slave, a, c : numpy.ndarray of int, shape (m,)
         Slave vertex and master edge a -> c.
@@ -120,7 +120,18 @@ class ContactConstraints:
 
     @classmethod
     def stack(cls, parts):
-        """The rows of several ContactConstraints (same number of dofs), in order."""
+        """The rows of several ContactConstraints (same number of dofs), in order.
+
+        Parameters
+        ----------
+        parts : sequence of ContactConstraints
+            At least one; all with the same number of columns in C.
+
+        Returns
+        -------
+        ContactConstraints
+            The rows of ``parts[0]``, then those of ``parts[1]``, ...
+        """
         fields = ("slave", "a", "c", "master_tri", "slave_tri", "pair", "xi", "normal",
                   "dist", "angle")
         return cls(*(np.concatenate([getattr(p, f) for p in parts]) for f in fields),
@@ -128,7 +139,18 @@ class ContactConstraints:
                    g=np.concatenate([p.g for p in parts]))
 
     def subset(self, rows):
-        """The constraints ``rows`` (an index array or boolean mask), C and g included."""
+        """The constraints ``rows`` (an index array or boolean mask), C and g included.
+
+        Parameters
+        ----------
+        rows : array_like of int or bool
+            Row indices (in the order wanted) or a mask of shape (m,).
+
+        Returns
+        -------
+        ContactConstraints
+            New arrays holding the selected rows.
+        """
         rows = np.asarray(rows)
         if rows.dtype != bool:
             rows = rows.astype(np.int64)

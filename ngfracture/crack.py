@@ -84,7 +84,18 @@ _RULE_NAMES = [(RULE_1, "1"), (RULE_1A, "1a"), (RULE_1B, "1b"), (RULE_2, "2"),
 
 
 def rule_names(flags):
-    """Names of the rules set in one record flag, e.g. ``['1', '1b']``."""
+    """Names of the rules set in one record flag, e.g. ``['1', '1b']``.
+
+    Parameters
+    ----------
+    flags : int
+        An entry of ``record["rule"]`` (bit flags ``RULE_*``).
+
+    Returns
+    -------
+    list of str
+        The names ("1", "1a", "1b", "2", "2a", "2b", "tip", "none") in that order.
+    """
     return [name for bit, name in _RULE_NAMES if int(flags) & bit]
 
 
@@ -205,6 +216,11 @@ def principal(tensors):
         Shape (n,).
     directions : numpy.ndarray
         Shape (n, 2), angle in (-pi/2, pi/2]; an isotropic tensor gets (1, 0).
+
+    Raises
+    ------
+    ValueError
+        If tensors is not of shape (n, 3) or holds NaN or inf.
     """
     t = np.asarray(tensors, dtype=float)
     if t.ndim != 2 or t.shape[1] != 3:
@@ -228,6 +244,11 @@ def select(values, critical):
     -------
     numpy.ndarray
         Vertex numbers by decreasing value, ties by increasing vertex number.
+
+    Raises
+    ------
+    ValueError
+        If critical is not a finite number > 0.
     """
     c = _check_critical(critical)
     return _C.CrackSelect(np.asarray(values, dtype=float), c)
@@ -246,6 +267,11 @@ class StrainCriterion:
         Critical principal strain, finite and > 0.
     measure : {'green', 'linear'}
         Green-Lagrange for the nonlinear models, small strain for the linear one.
+
+    Raises
+    ------
+    ValueError
+        If critical is not a finite number > 0 or the measure is unknown.
     """
 
     def __init__(self, critical, measure="green"):
@@ -255,7 +281,20 @@ class StrainCriterion:
         self.measure = measure
 
     def vertex_tensor(self, mesh, u):
-        """Nodal strain (nv, 3) of displacement u on mesh, see :func:`vertex_strain`."""
+        """Nodal strain of displacement u on mesh, see :func:`vertex_strain`.
+
+        Parameters
+        ----------
+        mesh : ngsolve.Mesh
+            2D triangle mesh (reference configuration).
+        u : ngsolve.GridFunction or numpy.ndarray
+            Displacement (``VectorH1``) or vertex values (nv, 2).
+
+        Returns
+        -------
+        numpy.ndarray
+            Shape (nv, 3), rows (xx, yy, xy), in this criterion's measure.
+        """
         return vertex_strain(mesh, u, self.measure)
 
     def __repr__(self):
@@ -266,7 +305,7 @@ class StrainCriterion:
 class SplitResult:
     """Outcome of one splitting pass.
 
-    Attributes
+    Parameters
     ----------
     mesh : ngsolve.Mesh
         The new mesh (same triangles in the same order, more vertices).
@@ -277,6 +316,7 @@ class SplitResult:
     fragment : numpy.ndarray
         Fragment (connected component) number of every triangle, numbered by first triangle.
     nfragments : int
+        Number of fragments.
     crack_segments : numpy.ndarray
         (m, 2) vertex pairs of the boundary segments added in region ``crack``.
     timings : dict
@@ -367,11 +407,17 @@ def transfer_vertex_field(values, result):
     values : numpy.ndarray
         Shape (nv_old, ...).
     result : SplitResult
+        The pass that made the new mesh.
 
     Returns
     -------
     numpy.ndarray
         Shape (nv_new, ...).
+
+    Raises
+    ------
+    ValueError
+        If values does not have one row per vertex of the old mesh.
     """
     a = np.asarray(values)
     if a.shape[0] != result.record["nv_old"]:
@@ -392,6 +438,7 @@ def transfer(u, result):
     u : ngsolve.GridFunction
         On ``VectorH1(old_mesh, order=p)``, p <= 2.
     result : SplitResult
+        The pass that split ``old_mesh``.
 
     Returns
     -------
@@ -404,6 +451,10 @@ def transfer(u, result):
     ------
     NotImplementedError
         For order >= 3.
+    ValueError
+        If u does not live on the mesh that was split.
+    TypeError
+        If u is not on a 2D ``VectorH1`` space.
     """
     p = _field_order(u)
     if result.mesh is u.space.mesh:
@@ -429,11 +480,13 @@ def split_by_tensor(mesh, tensors, critical, crack_name="crack", skip_neighbours
     Parameters
     ----------
     mesh : ngsolve.Mesh
+        2D triangle mesh, reference configuration.
     tensors : numpy.ndarray
         Shape (nv, 3), rows (xx, yy, xy), e.g. a nodal strain or stress.
     critical : float
         Finite, > 0; vertices whose largest principal value exceeds it are split.
     crack_name : str
+        Boundary name of the new crack faces.
     skip_neighbours : bool
         See :func:`split_vertices`.
 
@@ -447,6 +500,8 @@ def split_by_tensor(mesh, tensors, critical, crack_name="crack", skip_neighbours
     ValueError
         Wrong tensor shape, NaN values, critical <= 0 or NaN, non-2D mesh; ``MeshError``
         (a ValueError) on a bad mesh (meshcheck.py).
+    TypeError
+        If mesh is not an ``ngsolve.Mesh``.
     """
     _check_mesh(mesh)
     c = _check_critical(critical)
@@ -481,10 +536,12 @@ def crack_step(mesh, u, critical=None, measure="green", criterion=None, crack_na
     criterion : object, optional
         Anything with ``critical`` and ``vertex_tensor(mesh, u)``.
     crack_name : str
+        Boundary name of the new crack faces.
 
     Returns
     -------
     new_mesh : ngsolve.Mesh
+        The split mesh (the input mesh itself if nothing was split).
     new_u : ngsolve.GridFunction
         u carried exactly through the vertex map.
     result : SplitResult
@@ -493,7 +550,11 @@ def crack_step(mesh, u, critical=None, measure="green", criterion=None, crack_na
     Raises
     ------
     ValueError, TypeError
-        Bad mesh (``MeshError``, see meshcheck.py), field or threshold, before any work.
+        Bad mesh (``MeshError``, see meshcheck.py), field or threshold, neither critical
+        nor criterion given, or a criterion tensor field of the wrong shape; before any
+        splitting.
+    NotImplementedError
+        For a displacement of order >= 3.
     """
     _check_mesh(mesh)
     if criterion is None:

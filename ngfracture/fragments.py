@@ -29,6 +29,7 @@ def fragment_ids(mesh):
     Parameters
     ----------
     mesh : ngsolve.Mesh
+        2D triangle mesh.
 
     Returns
     -------
@@ -125,7 +126,14 @@ class FragmentStatistics:
         return c / self.areas[:, None]
 
     def summary(self):
-        """Plain numbers for a JSON summary: count, total area, min/mean/max fragment area."""
+        """Plain numbers for a JSON summary: count, total area, min/mean/max fragment area.
+
+        Returns
+        -------
+        dict
+            ``fragments``, ``total_area``, ``min_area``, ``mean_area``, ``max_area`` and
+            ``single_triangle_fragments`` (fragments of one triangle), as Python numbers.
+        """
         return {"fragments": self.count, "total_area": self.total_area,
                 "min_area": float(self.areas.min()), "mean_area": float(self.areas.mean()),
                 "max_area": float(self.areas.max()),

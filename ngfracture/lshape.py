@@ -174,12 +174,36 @@ class LShapeSolution:
         return u, sigma
 
     def stress_of(self, v):
-        """Linear-elastic stress ``lambda tr(eps) I + 2 mu eps`` of a field (GridFunction, trial function or CF)."""
+        """Linear-elastic stress ``lambda tr(eps) I + 2 mu eps`` with this solution's Lame parameters.
+
+        Parameters
+        ----------
+        v : ngsolve.GridFunction, trial/test function or CoefficientFunction
+            A displacement (anything with ``ng.Grad``).
+
+        Returns
+        -------
+        ngsolve.CoefficientFunction
+            2x2 stress.
+        """
         return linear_stress(v, self.lam, self.mu)
 
 
 def linear_stress(v, lam, mu):
-    """Linear-elastic Cauchy stress of the displacement ``v`` (anything with ``ng.Grad``)."""
+    """Linear-elastic Cauchy stress ``lambda tr(eps) I + 2 mu eps`` of a displacement.
+
+    Parameters
+    ----------
+    v : ngsolve.GridFunction, trial/test function or CoefficientFunction
+        A displacement (anything with ``ng.Grad``).
+    lam, mu : float
+        Lame parameters of the 2D model.
+
+    Returns
+    -------
+    ngsolve.CoefficientFunction
+        2x2 stress, eps = sym(grad v).
+    """
     eps = ng.Sym(ng.Grad(v))
     return lam * ng.Trace(eps) * ng.Id(2) + 2.0 * mu * eps
 
@@ -218,6 +242,11 @@ def default_grading(order):
     -------
     float
         gamma.
+
+    Raises
+    ------
+    ValueError
+        If order is not an integer >= 1.
     """
     _check_int("order", order, 1)
     return float(math.ceil(order / singular_exponent()))
@@ -309,6 +338,11 @@ def lshape_mesh(level=0, h0=0.5, gamma=1.0):
     Returns
     -------
     ngsolve.Mesh
+
+    Raises
+    ------
+    ValueError
+        On bad ``level``, ``h0`` or ``gamma``.
     """
     _check_int("level", level, 0)
     mesh = None
@@ -318,7 +352,18 @@ def lshape_mesh(level=0, h0=0.5, gamma=1.0):
 
 
 def max_edge_length(mesh):
-    """Largest edge length of a 2D ngsolve mesh (the ``h`` of the convergence tables)."""
+    """Largest edge length of a 2D ngsolve mesh (the ``h`` of the convergence tables).
+
+    Parameters
+    ----------
+    mesh : ngsolve.Mesh
+        2D mesh.
+
+    Returns
+    -------
+    float
+        The longest edge, in the units of the coordinates.
+    """
     xy = np.array([v.point for v in mesh.vertices])
     ev = np.array([[v.nr for v in e.vertices] for e in mesh.edges])
     return float(np.max(np.linalg.norm(xy[ev[:, 0]] - xy[ev[:, 1]], axis=1)))

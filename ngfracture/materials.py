@@ -61,12 +61,34 @@ def lame_parameters(E, nu, plane="strain"):
 
 
 def green_lagrange(H):
-    """Green-Lagrange strain (H + H^T + H^T H)/2; this form keeps digits at tiny strains."""
+    """Green-Lagrange strain (H + H^T + H^T H)/2; this form keeps digits at tiny strains.
+
+    Parameters
+    ----------
+    H : ngsolve.CoefficientFunction
+        Displacement gradient grad u, 2x2.
+
+    Returns
+    -------
+    ngsolve.CoefficientFunction
+        The symmetric 2x2 strain E = (F^T F - I)/2 with F = I + H.
+    """
     return 0.5 * (H + H.trans + H.trans * H)
 
 
 def small_strain(H):
-    """Linearised strain (H + H^T)/2."""
+    """Linearised strain (H + H^T)/2.
+
+    Parameters
+    ----------
+    H : ngsolve.CoefficientFunction
+        Displacement gradient grad u, 2x2.
+
+    Returns
+    -------
+    ngsolve.CoefficientFunction
+        The symmetric 2x2 small strain.
+    """
     return 0.5 * (H + H.trans)
 
 
@@ -101,19 +123,73 @@ class Material:
         return f"{type(self).__name__}(E={self.E!r}, nu={self.nu!r}, plane={self.plane!r})"
 
     def strain(self, H):
-        """The strain measure of the model (Green-Lagrange unless linear)."""
+        """The strain measure of the model (Green-Lagrange unless linear).
+
+        Parameters
+        ----------
+        H : ngsolve.CoefficientFunction
+            Displacement gradient grad u, 2x2.
+
+        Returns
+        -------
+        ngsolve.CoefficientFunction
+            Symmetric 2x2 strain.
+        """
         return green_lagrange(H)
 
     def energy(self, H):
-        """Strain-energy density as a CoefficientFunction of H = grad u."""
+        """Strain-energy density as a CoefficientFunction of H = grad u.
+
+        Parameters
+        ----------
+        H : ngsolve.CoefficientFunction
+            Displacement gradient grad u, 2x2 (a trial function's gradient for assembly).
+
+        Returns
+        -------
+        ngsolve.CoefficientFunction
+            Scalar energy per unit reference area (unit thickness).
+
+        Raises
+        ------
+        NotImplementedError
+            Always, in the base class: every model defines its energy.
+        """
         raise NotImplementedError
 
     def first_piola(self, H):
-        """First Piola-Kirchhoff stress P = dW/dF."""
+        """First Piola-Kirchhoff stress P = dW/dF.
+
+        Parameters
+        ----------
+        H : ngsolve.CoefficientFunction
+            Displacement gradient grad u, 2x2.
+
+        Returns
+        -------
+        ngsolve.CoefficientFunction
+            2x2 stress (force per unit reference length, unit thickness).
+
+        Raises
+        ------
+        NotImplementedError
+            Always, in the base class: every model defines its stress.
+        """
         raise NotImplementedError
 
     def cauchy_stress(self, H):
-        """Cauchy stress sigma = P F^T / det F (equal to P for the linear model)."""
+        """Cauchy stress sigma = P F^T / det F (equal to P for the linear model).
+
+        Parameters
+        ----------
+        H : ngsolve.CoefficientFunction
+            Displacement gradient grad u, 2x2.
+
+        Returns
+        -------
+        ngsolve.CoefficientFunction
+            Symmetric 2x2 true stress in the current configuration.
+        """
         F = ng.Id(2) + H
         return (1.0 / ng.Det(F)) * self.first_piola(H) * F.trans
 
@@ -122,36 +198,137 @@ class LinearElastic(Material):
     """Linear (small-strain) elasticity: W = mu eps:eps + lambda/2 (tr eps)^2.
 
     Not objective: a large rigid rotation produces strain.
+
+    Parameters
+    ----------
+    E : float
+        Young's modulus (> 0).
+    nu : float
+        Poisson's ratio (-1 < nu < 0.5).
+    plane : {"strain", "stress"}
+        2D reduction, plane strain by default.
+
+    Raises
+    ------
+    ValueError
+        On NaN/inf values, E <= 0, nu out of (-1, 0.5) or an unknown plane.
     """
 
     name = "linear"
     geometrically_nonlinear = False
 
     def strain(self, H):
+        """The small strain (H + H^T)/2.
+
+        Parameters
+        ----------
+        H : ngsolve.CoefficientFunction
+            Displacement gradient grad u, 2x2.
+
+        Returns
+        -------
+        ngsolve.CoefficientFunction
+            Symmetric 2x2 strain.
+        """
         return small_strain(H)
 
     def energy(self, H):
+        """Strain-energy density mu eps:eps + lambda/2 (tr eps)^2.
+
+        Parameters
+        ----------
+        H : ngsolve.CoefficientFunction
+            Displacement gradient grad u, 2x2.
+
+        Returns
+        -------
+        ngsolve.CoefficientFunction
+            Scalar energy per unit reference area.
+        """
         eps = small_strain(H)
         return self.mu * ng.InnerProduct(eps, eps) + 0.5 * self.lam * ng.Trace(eps) ** 2
 
     def first_piola(self, H):
+        """Stress 2 mu eps + lambda tr(eps) I (no distinction of stress measures).
+
+        Parameters
+        ----------
+        H : ngsolve.CoefficientFunction
+            Displacement gradient grad u, 2x2.
+
+        Returns
+        -------
+        ngsolve.CoefficientFunction
+            2x2 stress.
+        """
         eps = small_strain(H)
         return 2 * self.mu * eps + self.lam * ng.Trace(eps) * ng.Id(2)
 
     def cauchy_stress(self, H):
+        """The linear stress, the same as :meth:`first_piola` (no division by det F).
+
+        Parameters
+        ----------
+        H : ngsolve.CoefficientFunction
+            Displacement gradient grad u, 2x2.
+
+        Returns
+        -------
+        ngsolve.CoefficientFunction
+            Symmetric 2x2 stress.
+        """
         return self.first_piola(H)
 
 
 class StVenantKirchhoff(Material):
-    """St Venant-Kirchhoff: W = mu E:E + lambda/2 (tr E)^2 with the Green-Lagrange strain E."""
+    """St Venant-Kirchhoff: W = mu E:E + lambda/2 (tr E)^2 with the Green-Lagrange strain E.
+
+    Parameters
+    ----------
+    E : float
+        Young's modulus (> 0).
+    nu : float
+        Poisson's ratio (-1 < nu < 0.5).
+    plane : {"strain", "stress"}
+        2D reduction, plane strain by default.
+
+    Raises
+    ------
+    ValueError
+        On NaN/inf values, E <= 0, nu out of (-1, 0.5) or an unknown plane.
+    """
 
     name = "svk"
 
     def energy(self, H):
+        """Strain-energy density mu E:E + lambda/2 (tr E)^2.
+
+        Parameters
+        ----------
+        H : ngsolve.CoefficientFunction
+            Displacement gradient grad u, 2x2.
+
+        Returns
+        -------
+        ngsolve.CoefficientFunction
+            Scalar energy per unit reference area.
+        """
         Egl = green_lagrange(H)
         return self.mu * ng.InnerProduct(Egl, Egl) + 0.5 * self.lam * ng.Trace(Egl) ** 2
 
     def first_piola(self, H):
+        """First Piola-Kirchhoff stress P = F S, S = 2 mu E + lambda tr(E) I.
+
+        Parameters
+        ----------
+        H : ngsolve.CoefficientFunction
+            Displacement gradient grad u, 2x2.
+
+        Returns
+        -------
+        ngsolve.CoefficientFunction
+            2x2 stress per unit reference length.
+        """
         Egl = green_lagrange(H)
         S = 2 * self.mu * Egl + self.lam * ng.Trace(Egl) * ng.Id(2)
         return (ng.Id(2) + H) * S
@@ -161,11 +338,37 @@ class NeoHookean(Material):
     """Compressible neo-Hooke: W = mu/2 (tr C - 2) - mu ln J + lambda/2 (ln J)^2.
 
     Undefined for det F <= 0: the solver reports such a state as an inverted element.
+
+    Parameters
+    ----------
+    E : float
+        Young's modulus (> 0).
+    nu : float
+        Poisson's ratio (-1 < nu < 0.5).
+    plane : {"strain", "stress"}
+        2D reduction, plane strain by default.
+
+    Raises
+    ------
+    ValueError
+        On NaN/inf values, E <= 0, nu out of (-1, 0.5) or an unknown plane.
     """
 
     name = "neohooke"
 
     def energy(self, H):
+        """Strain-energy density mu/2 (tr C - 2) - mu ln J + lambda/2 (ln J)^2.
+
+        Parameters
+        ----------
+        H : ngsolve.CoefficientFunction
+            Displacement gradient grad u, 2x2.
+
+        Returns
+        -------
+        ngsolve.CoefficientFunction
+            Scalar energy per unit reference area; not finite where det F <= 0.
+        """
         F = ng.Id(2) + H
         J = ng.Det(F)
         # tr C - 2 = 2 tr H + H:H, written so that it keeps digits at tiny strains
@@ -173,6 +376,18 @@ class NeoHookean(Material):
         return 0.5 * self.mu * trC_minus_2 - self.mu * ng.log(J) + 0.5 * self.lam * ng.log(J) ** 2
 
     def first_piola(self, H):
+        """First Piola-Kirchhoff stress P = mu (F - F^-T) + lambda ln J F^-T.
+
+        Parameters
+        ----------
+        H : ngsolve.CoefficientFunction
+            Displacement gradient grad u, 2x2.
+
+        Returns
+        -------
+        ngsolve.CoefficientFunction
+            2x2 stress per unit reference length; undefined where det F <= 0.
+        """
         F = ng.Id(2) + H
         J = ng.Det(F)
         FinvT = ng.Inv(F).trans
@@ -184,6 +399,22 @@ MATERIALS = {cls.name: cls for cls in (LinearElastic, StVenantKirchhoff, NeoHook
 
 def make_material(name, E, nu, plane="strain"):
     """A material by its short name: "linear", "svk" or "neohooke".
+
+    Parameters
+    ----------
+    name : {"linear", "svk", "neohooke"}
+        LinearElastic, StVenantKirchhoff or NeoHookean (the keys of ``MATERIALS``).
+    E : float
+        Young's modulus (> 0).
+    nu : float
+        Poisson's ratio (-1 < nu < 0.5).
+    plane : {"strain", "stress"}
+        2D reduction.
+
+    Returns
+    -------
+    Material
+        A new instance of the named model.
 
     Raises
     ------

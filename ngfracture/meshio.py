@@ -24,7 +24,25 @@ import numpy as np
 
 @dataclass
 class MeshArrays:
-    """A 2D triangle mesh as plain arrays (see the module docstring)."""
+    """A 2D triangle mesh as plain arrays (see the module docstring).
+
+    Parameters
+    ----------
+    points : numpy.ndarray, shape (nv, 2)
+        Reference coordinates.
+    triangles : numpy.ndarray of int, shape (ne, 3)
+        Vertex numbers (0-based), counter-clockwise.
+    regions : numpy.ndarray of int, shape (ne,)
+        Material region of every triangle, 1-based into ``region_names``.
+    region_names : list of str
+        Material names.
+    segments : numpy.ndarray of int, shape (ns, 2)
+        Boundary edges (0-based vertex numbers), the domain on their left.
+    seg_bc : numpy.ndarray of int, shape (ns,)
+        Boundary number of every segment, 1-based into ``bc_names``.
+    bc_names : list of str
+        Boundary names.
+    """
     points: np.ndarray
     triangles: np.ndarray
     regions: np.ndarray
@@ -34,7 +52,18 @@ class MeshArrays:
     bc_names: list
 
     def as_dict(self, prefix="mesh_"):
-        """Arrays for a checkpoint (names are stored as one '\\n'-joined string each)."""
+        """Arrays for a checkpoint (names are stored as one '\\n'-joined string each).
+
+        Parameters
+        ----------
+        prefix : str
+            Prepended to every key, so that several meshes fit in one checkpoint.
+
+        Returns
+        -------
+        dict of str -> numpy.ndarray
+            Read back by :meth:`from_dict` with the same prefix.
+        """
         return {prefix + "points": self.points, prefix + "triangles": self.triangles,
                 prefix + "regions": self.regions, prefix + "segments": self.segments,
                 prefix + "seg_bc": self.seg_bc,
@@ -42,12 +71,37 @@ class MeshArrays:
                 prefix + "bc_names": np.array("\n".join(self.bc_names))}
 
     def boundary_segments(self, name):
-        """The (m, 2) segments of the boundary called ``name`` (empty if there is none)."""
+        """The segments of the boundary called ``name``.
+
+        Parameters
+        ----------
+        name : str
+            Boundary name; several boundary numbers may carry it.
+
+        Returns
+        -------
+        numpy.ndarray of int, shape (m, 2)
+            Empty if there is no such boundary.
+        """
         ids = [i for i, n in enumerate(self.bc_names, start=1) if n == name]
         return self.segments[np.isin(self.seg_bc, ids)]
 
     @classmethod
     def from_dict(cls, d, prefix="mesh_"):
+        """The arrays stored by :meth:`as_dict`.
+
+        Parameters
+        ----------
+        d : mapping of str -> numpy.ndarray
+            E.g. the arrays of a checkpoint.
+        prefix : str
+            The prefix given to :meth:`as_dict`.
+
+        Returns
+        -------
+        MeshArrays
+            The arrays of ``d`` themselves (not copies).
+        """
         return cls(d[prefix + "points"], d[prefix + "triangles"], d[prefix + "regions"],
                    str(d[prefix + "region_names"]).split("\n"), d[prefix + "segments"],
                    d[prefix + "seg_bc"], str(d[prefix + "bc_names"]).split("\n"))
@@ -55,6 +109,16 @@ class MeshArrays:
 
 def mesh_to_arrays(mesh):
     """The arrays of an NGSolve (or netgen) 2D triangle mesh.
+
+    Parameters
+    ----------
+    mesh : ngsolve.Mesh or netgen.meshing.Mesh
+        2D mesh of triangles.
+
+    Returns
+    -------
+    MeshArrays
+        New arrays (0-based vertex numbers), elements and segments in mesh order.
 
     Raises
     ------
@@ -83,6 +147,15 @@ def mesh_to_arrays(mesh):
 
 def mesh_from_arrays(arrays):
     """An NGSolve mesh from MeshArrays (vertex i is point i, elements in the given order).
+
+    Parameters
+    ----------
+    arrays : MeshArrays
+        The mesh; boundary names and material names are kept.
+
+    Returns
+    -------
+    ngsolve.Mesh
 
     Raises
     ------
@@ -132,6 +205,11 @@ def merge_meshes(*meshes):
     Region and boundary names are merged by name: equal names become one region or
     one boundary.  Elements keep the order of the inputs, body after body.
 
+    Parameters
+    ----------
+    *meshes : ngsolve.Mesh
+        The bodies, 2D triangle meshes; vertices are numbered body after body.
+
     Returns
     -------
     ngsolve.Mesh
@@ -179,6 +257,7 @@ def orient_segments(triangles, segments):
     triangles : numpy.ndarray of int, shape (ne, 3)
         Counter-clockwise triangles.
     segments : numpy.ndarray of int, shape (ns, 2)
+        Boundary segments in either orientation.
 
     Returns
     -------
@@ -198,6 +277,11 @@ def boundary_only(arrays):
     Interface segments between bonded regions (an edge of two triangles) are dropped,
     boundary segments turned to have their triangle on the left (:func:`orient_segments`):
     what collision detection and contact expect.
+
+    Parameters
+    ----------
+    arrays : MeshArrays
+        A mesh whose segments may include interface segments or either orientation.
 
     Returns
     -------

@@ -94,10 +94,13 @@ def element_strain(mesh, u, measure="green", arrays=None):
     Parameters
     ----------
     mesh : ngsolve.Mesh
+        2D triangle mesh, reference configuration.
     u : ngsolve.GridFunction or numpy.ndarray
         Displacement (``VectorH1``) or vertex values (nv, 2).
     measure : {'green', 'linear'}
         (H + H^T + H^T H)/2 or (H + H^T)/2 with H = grad u.
+    arrays : MeshArrays, optional
+        Reuse arrays already extracted with :func:`vertex_arrays`.
 
     Returns
     -------
@@ -209,11 +212,13 @@ def cracks_to_pyvista(mesh, u=None, boundary="crack", arrays=None):
     Parameters
     ----------
     mesh : ngsolve.Mesh
+        2D triangle mesh, reference configuration.
     u : ngsolve.GridFunction or numpy.ndarray, optional
         Displacement; point data ``displacement`` (3-vectors, z = 0).
     boundary : str
         Boundary name of the crack faces.
     arrays : MeshArrays, optional
+        Reuse arrays already extracted with :func:`vertex_arrays`.
 
     Returns
     -------
@@ -221,6 +226,11 @@ def cracks_to_pyvista(mesh, u=None, boundary="crack", arrays=None):
         One line per segment (both faces of a crack: two lines on the same reference
         points); only the vertices on those segments, their mesh numbers in point data
         ``vertex``. Empty (no points, no lines) when nothing has cracked.
+
+    Raises
+    ------
+    ValueError
+        Not a 2D triangle mesh, or a displacement that does not fit it.
     """
     import pyvista as pv
     a = arrays or vertex_arrays(mesh)
@@ -328,7 +338,8 @@ class TimeSeriesWriter:
     FileNotFoundError
         ``resume`` on a folder without ``results.pvd``, or a step file it lists is missing.
     ValueError
-        ``force`` together with ``resume``; ``last_step`` without ``resume``.
+        ``force`` together with ``resume``; ``last_step`` without ``resume``; with
+        ``resume``, a ``results.pvd`` that is not valid XML or lists foreign files.
     """
 
     PVD = "results.pvd"
@@ -435,7 +446,9 @@ class TimeSeriesWriter:
         ------
         ValueError
             A step not larger than the last one (it would overwrite), a step beyond 6
-            digits, a non-finite time.
+            digits, a non-finite time, or arrays that do not fit the mesh.
+        FileExistsError
+            A file of this step exists although the collection does not list it.
         """
         if isinstance(step, bool) or not isinstance(step, (int, np.integer)) or not 0 <= step <= 999999:
             raise ValueError(f"TimeSeriesWriter.write: step must be an integer in [0, 999999], got {step!r}")
@@ -483,6 +496,8 @@ def check_headless():
     Raises
     ------
     RenderError
+        No display and neither Mesa's EGL nor OSMesa; the message lists the missing
+        libraries and the Debian packages that provide them.
     """
     if not sys.platform.startswith("linux") or os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"):
         return
@@ -516,6 +531,7 @@ def render_png(mesh, u, fragment, path, window_size=(1200, 900), scale=1.0, crac
     Parameters
     ----------
     mesh : ngsolve.Mesh
+        2D triangle mesh, reference configuration.
     u : ngsolve.GridFunction or numpy.ndarray or None
         Displacement (None: the reference configuration).
     fragment : array_like of int
@@ -527,6 +543,7 @@ def render_png(mesh, u, fragment, path, window_size=(1200, 900), scale=1.0, crac
     scale : float
         Displacement magnification.
     crack_boundary : str
+        Boundary name of the crack faces.
     line_width : float
         Width of the crack lines in pixels.
     force : bool
@@ -535,6 +552,7 @@ def render_png(mesh, u, fragment, path, window_size=(1200, 900), scale=1.0, crac
     Returns
     -------
     pathlib.Path
+        ``path``.
 
     Raises
     ------
@@ -603,10 +621,12 @@ def plot_fragment_sizes(areas, path, force=False, title="Fragment-size distribut
     force : bool
         Overwrite an existing file.
     title : str
+        Figure title; the number of fragments is appended.
 
     Returns
     -------
     pathlib.Path
+        ``path``.
 
     Raises
     ------
@@ -692,6 +712,7 @@ def write_summary(path, summary, force=False):
     Returns
     -------
     pathlib.Path
+        ``path``.
 
     Raises
     ------
@@ -700,7 +721,8 @@ def write_summary(path, summary, force=False):
     ValueError
         A NaN or infinite number (named by its key path).
     TypeError
-        A value JSON cannot hold (named by its key path).
+        ``summary`` is not a dict, or a value or key JSON cannot hold (named by its key
+        path).
     """
     if not isinstance(summary, dict):
         raise TypeError(f"write_summary: summary must be a dict, got {type(summary).__name__}")

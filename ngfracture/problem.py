@@ -24,7 +24,18 @@ from .solver import NewtonSolver
 
 
 def check_mesh(mesh):
-    """Raise ValueError unless mesh is a non-empty 2D NGSolve mesh of triangles."""
+    """Raise ValueError unless mesh is a non-empty 2D NGSolve mesh.
+
+    Parameters
+    ----------
+    mesh : object
+        The object to check.
+
+    Raises
+    ------
+    ValueError
+        If mesh is not an ``ngsolve.Mesh``, is not 2D or has no elements.
+    """
     if not isinstance(mesh, ng.Mesh):
         raise ValueError(f"mesh must be an ngsolve.Mesh, got {type(mesh).__name__}")
     if mesh.dim != 2:
@@ -34,7 +45,23 @@ def check_mesh(mesh):
 
 
 def element_vertices(mesh):
-    """Vertex numbers of every triangle, shape (ne, 3), 0-based."""
+    """Vertex numbers of every triangle, 0-based.
+
+    Parameters
+    ----------
+    mesh : ngsolve.Mesh
+        2D mesh.
+
+    Returns
+    -------
+    numpy.ndarray of int64, shape (ne, 3)
+        In element order.
+
+    Raises
+    ------
+    ValueError
+        If the mesh has quadrilaterals.
+    """
     nodes = mesh.ngmesh.Elements2D().NumPy()["nodes"]
     if nodes.shape[1] > 3 and np.any(nodes[:, 3] != 0):
         raise ValueError("only triangular meshes are supported (the mesh has quadrilaterals)")
@@ -43,6 +70,18 @@ def element_vertices(mesh):
 
 def region_materials(mesh, material):
     """{region name: Material} for every material region of the mesh.
+
+    Parameters
+    ----------
+    mesh : ngsolve.Mesh
+        The mesh whose regions (``mesh.GetMaterials()``) need a material.
+    material : Material or dict of str -> Material
+        One material for all regions, or one per region.
+
+    Returns
+    -------
+    dict of str -> Material
+        Every region of the mesh mapped to its material.
 
     Raises
     ------
@@ -128,20 +167,55 @@ class ElasticProblem:
 
     # -- set-up ---------------------------------------------------------------------
     def add_dirichlet(self, boundaries, value=(0.0, 0.0), component=None):
-        """Prescribe the displacement on named boundaries; see ConstraintSet.add_dirichlet."""
+        """Prescribe the displacement on named boundaries; see ConstraintSet.add_dirichlet.
+
+        Parameters
+        ----------
+        boundaries : str or sequence of str
+            Boundary names of the mesh.
+        value : float, pair, or ngsolve.CoefficientFunction
+            Prescribed displacement (a scalar needs ``component``).
+        component : None, 0/'x' or 1/'y'
+            None prescribes both components; 0 or 1 only that one (gliding).
+        """
         self.constraints.add_dirichlet(boundaries, value, component)
 
     def add_point_constraint(self, vertex, value=(0.0, 0.0), component=None):
-        """Prescribe the displacement of one vertex; see ConstraintSet.add_point."""
+        """Prescribe the displacement of one vertex; see ConstraintSet.add_point.
+
+        Parameters
+        ----------
+        vertex : int
+            Vertex number (0-based).
+        value : float or pair
+            Prescribed displacement.
+        component : None, 0/'x' or 1/'y'
+            None prescribes both components; 0 or 1 only that one.
+        """
         self.constraints.add_point(vertex, value, component)
 
     def add_body_force(self, f):
-        """Add a body force per unit reference area (a 2-vector CoefficientFunction or pair)."""
+        """Add a body force per unit reference area, scaled by ``load_factor``.
+
+        Parameters
+        ----------
+        f : pair of float or ngsolve.CoefficientFunction
+            Force per unit reference area (2-vector).
+        """
         self._loads.append(("volume", ng.CF(tuple(f)) if not isinstance(f, ng.CoefficientFunction) else f, None))
         self._form = None
 
     def add_traction(self, boundary, t):
         """Add a dead traction per unit reference length on a named boundary.
+
+        Scaled by ``load_factor`` like the body forces.
+
+        Parameters
+        ----------
+        boundary : str
+            Boundary name of the mesh.
+        t : pair of float or ngsolve.CoefficientFunction
+            Traction per unit reference length (2-vector).
 
         Raises
         ------
@@ -159,7 +233,13 @@ class ElasticProblem:
     PARALLEL_MIN_DOFS = 20000
 
     def threads(self):
-        """NGSolve's task manager for problems big enough to profit from threads."""
+        """NGSolve's task manager for problems big enough to profit from threads.
+
+        Returns
+        -------
+        context manager
+            ``ngsolve.TaskManager()`` from ``PARALLEL_MIN_DOFS`` dofs on, else a no-op.
+        """
         return ng.TaskManager() if self.fes.ndof >= self.PARALLEL_MIN_DOFS else contextlib.nullcontext()
 
     @property
@@ -183,6 +263,11 @@ class ElasticProblem:
         """Assemble and return the tangent stiffness at the current displacement.
 
         The linear model's stiffness does not depend on u: it is assembled once and kept.
+
+        Returns
+        -------
+        ngsolve.BaseMatrix
+            The tangent (``form.mat``), ndof x ndof, symmetric.
         """
         form = self.form
         if self.nonlinear or self._linear_K is None:
@@ -204,7 +289,13 @@ class ElasticProblem:
         return form.mat
 
     def out_of_balance(self):
-        """External minus internal nodal forces at the current displacement (numpy copy)."""
+        """External minus internal nodal forces at the current displacement.
+
+        Returns
+        -------
+        numpy.ndarray, shape (ndof,)
+            A copy, in NGSolve's dof layout; the external loads are scaled by ``load_factor``.
+        """
         form = self.form
         if not self.nonlinear:
             K = self._linear_K if self._linear_K is not None else self.tangent()
@@ -216,15 +307,40 @@ class ElasticProblem:
         return -self._res.FV().NumPy().copy()
 
     def assemble_constraints(self):
+        """The constraint rows for the current mesh; see ConstraintSet.assemble.
+
+        Returns
+        -------
+        ConstraintRows
+        """
         return self.constraints.assemble()
 
     # -- checks that turn silent garbage into reasons -------------------------------------
     def fragments(self):
-        """Connected components of the mesh: (count, piece id per vertex)."""
+        """Connected components of the mesh.
+
+        Returns
+        -------
+        count : int
+            Number of pieces.
+        piece : numpy.ndarray of int, shape (nv,)
+            Piece id of every vertex.
+        """
         return rigid.pieces(self._elements, self.mesh.nv)
 
     def support(self, rows):
-        """The rigid modes that single-dof rows leave free, with pins to factorise around them."""
+        """The rigid modes that single-dof rows leave free, with pins to factorise around them.
+
+        Parameters
+        ----------
+        rows : ConstraintRows
+            The assembled constraints (only ``fixed_dofs`` is used).
+
+        Returns
+        -------
+        rigid.Support
+            Modes at the current configuration.
+        """
         x = self._points + vertex_displacement(self.u)
         return rigid.analyse_support(x, self._elements, self.fes.ndof // 2, self.fes.ndof, rows.fixed_dofs)
 
@@ -233,6 +349,18 @@ class ElasticProblem:
 
         Modes left free by the single-dof rows must be fixed by the general rows:
         C R must have full column rank (R: those modes at the current configuration).
+
+        Parameters
+        ----------
+        rows : ConstraintRows
+            The assembled constraints.
+        support : rigid.Support, optional
+            Result of :meth:`support` for these rows, computed if omitted.
+
+        Returns
+        -------
+        str
+            Empty if every rigid mode is held; else names the unheld pieces.
         """
         support = support if support is not None else self.support(rows)
         k = support.modes.shape[1]
@@ -250,7 +378,13 @@ class ElasticProblem:
                 f"pieces without full support from single-dof rows: {described}")
 
     def inverted_elements(self):
-        """A message naming the elements with det F <= 0 at a check point ('' if none)."""
+        """A message naming the elements with det F <= 0 at a check point.
+
+        Returns
+        -------
+        str
+            Empty if no element is inverted (see :meth:`min_det_F` for the check points).
+        """
         detF = self.min_det_F()
         bad = np.flatnonzero(~(detF > 0))
         if bad.size:
@@ -259,7 +393,13 @@ class ElasticProblem:
         return ""
 
     def min_det_F(self):
-        """Smallest det F per element (P1: exact; else over vertices, edge midpoints and centroid)."""
+        """Smallest det F per element (P1: exact; else over vertices, edge midpoints and centroid).
+
+        Returns
+        -------
+        numpy.ndarray, shape (ne,)
+            det F = current / reference area for order 1; NaN where F is not finite.
+        """
         if self.order == 1:
             # F is constant on a P1 triangle: det F = current area / reference area
             # (numpy on vertex positions: 1.7 ms -> 0.2 ms per check on the plate)
@@ -275,15 +415,34 @@ class ElasticProblem:
 
     # -- results ------------------------------------------------------------------------------
     def strain(self):
-        """The materials' strain tensor of the current displacement (CoefficientFunction)."""
+        """The materials' strain tensor of the current displacement.
+
+        Returns
+        -------
+        ngsolve.CoefficientFunction
+            2x2, per region (Green-Lagrange, or small strain for the linear model).
+        """
         return self._per_region(lambda m: m.strain(ng.Grad(self.u)))
 
     def stress(self):
-        """Cauchy stress of the current displacement (CoefficientFunction)."""
+        """Cauchy stress of the current displacement.
+
+        Returns
+        -------
+        ngsolve.CoefficientFunction
+            2x2, per region.
+        """
         return self._per_region(lambda m: m.cauchy_stress(ng.Grad(self.u)))
 
     def energy(self):
-        """Total elastic energy of the current displacement."""
+        """Total elastic energy of the current displacement.
+
+        Returns
+        -------
+        float
+            Strain energy integrated over the reference domain (unit thickness), without
+            the work of the loads.
+        """
         return ng.Integrate(self._per_region(lambda m: m.energy(ng.Grad(self.u))), self.mesh,
                             order=2 * self.order)
 

@@ -19,7 +19,22 @@ from scipy.sparse.csgraph import connected_components
 
 
 def pieces(elements, nv):
-    """Connected components of a triangle mesh: (count, piece id per vertex)."""
+    """Connected components of a triangle mesh (through shared vertices).
+
+    Parameters
+    ----------
+    elements : numpy.ndarray of int, shape (ne, 3)
+        Triangle vertex numbers.
+    nv : int
+        Number of vertices (a vertex in no triangle is a piece of its own).
+
+    Returns
+    -------
+    count : int
+        Number of pieces.
+    piece : numpy.ndarray of int, shape (nv,)
+        Piece id of every vertex.
+    """
     # two edges per triangle connect its three vertices
     rows = np.concatenate([elements[:, 0], elements[:, 1]])
     cols = np.concatenate([elements[:, 1], elements[:, 2]])
@@ -30,9 +45,22 @@ def pieces(elements, nv):
 def piece_modes(x, verts, n):
     """The three rigid modes of one piece as dense columns over its vertex dofs.
 
-    Returns (dofs, M) with dofs the x dofs then the y dofs of verts (dof = c*n + v)
-    and M of shape (2 len(verts), 3): translation x, translation y, rotation about
-    the centroid (scaled by the piece size for conditioning).
+    Parameters
+    ----------
+    x : numpy.ndarray, shape (nv, 2)
+        Vertex positions at which the modes are taken.
+    verts : numpy.ndarray of int, shape (k,)
+        The vertices of the piece.
+    n : int
+        Scalar dofs per component (dof = c*n + v).
+
+    Returns
+    -------
+    dofs : numpy.ndarray of int, shape (2 k,)
+        The x dofs then the y dofs of verts.
+    M : numpy.ndarray, shape (2 k, 3)
+        Translation x, translation y, rotation about the centroid (scaled by the piece
+        size for conditioning).
     """
     p = x[verts]
     rel = (p - p.mean(axis=0)) / max(np.ptp(p, axis=0).max(), 1e-300)
@@ -49,13 +77,14 @@ def piece_modes(x, verts, n):
 class Support:
     """How the single-dof rows hold every piece.
 
-    Attributes
+    Parameters
     ----------
     modes : scipy.sparse.csc_matrix (ndof, k)
         Rigid modes that the single-dof rows leave free (zero on fixed dofs).
     pins : numpy.ndarray (k,)
         One free dof per such mode; pinning them makes K_ff regular.
-    unheld : list of (piece, number of free modes)
+    unheld : list of (int, int)
+        (piece, number of free modes) of every piece with free modes.
     """
     modes: sp.csc_matrix
     pins: np.ndarray
@@ -74,12 +103,14 @@ def analyse_support(x, elements, n, ndof, fixed_dofs):
     n : int
         Scalar dofs per component (dof = c*n + v).
     ndof : int
+        Number of dofs of the space.
     fixed_dofs : numpy.ndarray
         Dofs fixed by single-dof rows.
 
     Returns
     -------
     Support
+        The free modes of all pieces, their pins and the pieces they belong to.
     """
     nv = x.shape[0]
     ncomp, comp = pieces(elements, nv)

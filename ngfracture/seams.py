@@ -52,7 +52,7 @@ SLIP = 0.5
 class Seams:
     """Coincident boundary edges of a mesh.
 
-    Attributes
+    Parameters
     ----------
     facets : numpy.ndarray of int, shape (k, 4)
         (p, q, p2, q2): segment p -> q of side A (domain on its left) lies on segment
@@ -84,6 +84,7 @@ def find_seams(points, segments):
     Returns
     -------
     Seams
+        Every pair of coincident segments once; no facets if there is none.
     """
     X = np.ascontiguousarray(points, dtype=np.float64)
     S = np.asarray(segments, dtype=np.int64).reshape(-1, 2)
@@ -113,6 +114,7 @@ def seam_constraints(seams, points, displacement, kink_angle=KINK_ANGLE, slip=SL
     Parameters
     ----------
     seams : Seams
+        From :func:`find_seams` on the reference mesh.
     points, displacement : array_like, shape (nv, 2)
         Reference coordinates and the (predicted) displacement.
     kink_angle : float

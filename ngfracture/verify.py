@@ -46,10 +46,12 @@ def dirichlet_boundaries(variant):
     Parameters
     ----------
     variant : {"dirichlet", "traction-free"}
+        Boundary-value problem.
 
     Returns
     -------
     str
+        ``"outer|reentrant"`` or ``"outer"``.
 
     Raises
     ------
@@ -113,9 +115,13 @@ def solve_ngfracture(mesh, order, sol, variant="dirichlet", model="linear", retu
     Parameters
     ----------
     mesh : ngsolve.Mesh
+        An L-shape mesh.
     order : int
+        Polynomial order of the VectorH1 space.
     sol : lshape.LShapeSolution
+        Exact solution (Dirichlet data and material parameters).
     variant : {"dirichlet", "traction-free"}
+        Boundary-value problem.
     model : {"linear", "svk", "neohooke"}
         Material model (``ngfracture.make_material`` names).  Eq. 15 is exact
         for "linear" only; the hyperelastic models approach it in the
