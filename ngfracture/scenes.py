@@ -36,9 +36,25 @@ def notched_plate_mesh(maxh=0.034, width=1.0, height=1.0, notch_depth=0.04, notc
     bottom); region ``plate``. Near the notch tips the mesh size is ``notch_maxh``
     (default: a quarter of the notch depth, at most maxh).
 
+    Parameters
+    ----------
+    maxh : float
+        Mesh size away from the notches.
+    width, height : float
+        The rectangle.
+    notch_depth, notch_width : float
+        Depth and opening of each V-notch.
+    notch_maxh : float, optional
+        Mesh size at the notch tips.
+
     Returns
     -------
     ngsolve.Mesh
+
+    Raises
+    ------
+    ValueError
+        A size that is not a finite positive number, or notches that do not fit.
     """
     for name, v in (("maxh", maxh), ("width", width), ("height", height), ("notch_depth", notch_depth),
                     ("notch_width", notch_width)):
@@ -113,9 +129,22 @@ def cored_disk_mesh(maxh=0.04, radius=1.0, hole=0.25, core_inner=0.125):
     alone couples them. Boundaries: ``outer``, ``hole`` (the disk's side of the
     interface), ``core_surface`` (the core's side), ``core_inner``.
 
+    Parameters
+    ----------
+    maxh : float
+        Mesh size.
+    radius, hole, core_inner : float
+        Outer radius of the disk, radius of its hole (= the core's outer radius), inner
+        radius of the core ring.
+
     Returns
     -------
     ngsolve.Mesh
+
+    Raises
+    ------
+    ValueError
+        A size that is not a finite positive number, or radii out of order.
     """
     from .meshio import separate_region
     for name, v in (("maxh", maxh), ("radius", radius), ("hole", hole), ("core_inner", core_inner)):

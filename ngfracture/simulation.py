@@ -108,7 +108,19 @@ class Scene:
     control: dict = field(default_factory=dict)
 
     def validate(self):
-        """Raise ValueError naming the first bad field (before any work)."""
+        """Check every field before any work.
+
+        Returns
+        -------
+        dict of str -> float or None
+            The critical strain of every region of the mesh (None: never cracks).
+
+        Raises
+        ------
+        ValueError
+            Naming the first bad field (a non-positive load or increment, an unknown
+            region, a bad critical strain, no region that can crack, a bad material).
+        """
         if not isinstance(self.name, str) or not self.name:
             raise ValueError(f"Scene.name must be a non-empty string, got {self.name!r}")
         for key in ("load_max", "dx", "contact_tol"):
@@ -188,6 +200,18 @@ class StepControl:
     split: str = "spread"
 
     def validate(self, dx):
+        """Fill in the default bounds of dx from the first increment and check every field.
+
+        Parameters
+        ----------
+        dx : float
+            The scene's first increment.
+
+        Raises
+        ------
+        ValueError
+            Naming the first field out of range.
+        """
         if self.dx_min is None:
             self.dx_min = dx / 64
         if self.dx_max is None:
@@ -206,7 +230,16 @@ class StepControl:
 
 
 class StepFailed(Exception):
-    """A solve inside a step failed: its reason, and the phase ("increment" or "relaxation")."""
+    """A solve inside a step failed.
+
+    Parameters
+    ----------
+    reason : str
+        The solver's reason (nan, diverged, inverted_element, singular, active_set, ...).
+    phase : {"increment", "relaxation"}
+        The solve of the increment, or one at fixed load after a split.
+    message : str
+    """
 
     def __init__(self, reason, phase, message):
         super().__init__(f"{reason} ({phase}): {message}")
@@ -215,7 +248,28 @@ class StepFailed(Exception):
 
 @dataclass
 class State:
-    """An accepted state: everything a resume needs."""
+    """An accepted state: everything a resume needs.
+
+    Parameters
+    ----------
+    arrays : MeshArrays
+        The mesh.
+    u : numpy.ndarray
+        The P1 displacement vector in VectorH1 layout.
+    x, dx : float
+        The load parameter and the next increment.
+    step, quiet : int
+        Steps accepted, and crack-free steps in a row.
+    work : float
+        External work so far.
+    reactions, fixed_values, fixed_dofs : numpy.ndarray
+        Reactions, prescribed values and numbers of the fixed dofs, for the work of the
+        next increment.
+    peak_energy : float
+        Largest elastic energy so far.
+    history : list of dict
+        One record per accepted step.
+    """
     arrays: MeshArrays
     u: np.ndarray            # P1 displacement vector, VectorH1 layout
     x: float
@@ -231,7 +285,17 @@ class State:
 
 
 def round_trip(mesh):
-    """The mesh through its checkpoint representation (arrays and back)."""
+    """The mesh through its checkpoint representation (arrays and back).
+
+    Parameters
+    ----------
+    mesh : ngsolve.Mesh
+
+    Returns
+    -------
+    (MeshArrays, ngsolve.Mesh)
+        The arrays and the mesh rebuilt from them, as a resumed run rebuilds it.
+    """
     arrays = mesh_to_arrays(mesh)
     return arrays, mesh_from_arrays(arrays)
 
@@ -519,7 +583,15 @@ class Simulation:
             return attempt, dx, None
 
     def run(self):
-        """Run to the end; returns a RunResult (``ok``, ``reason``, ``summary``)."""
+        """Run to the end.
+
+        Returns
+        -------
+        RunResult
+            ``ok``, ``reason``, ``message``, the ``summary`` (also in summary.json), the
+            last accepted problem and state. A failed run is a result with ``ok`` False,
+            not an exception; the last good state is written.
+        """
         t_start = time.perf_counter()
         if self._resumed_state is not None:
             state = self._resumed_state
@@ -671,7 +743,7 @@ def _jsonish(obj):
 class RunResult:
     """How a simulation ended.
 
-    Attributes
+    Parameters
     ----------
     ok : bool
         True when the run reached its end (final load, step limit, broken through).
@@ -696,7 +768,17 @@ class RunResult:
 
 
 def crack_length(arrays):
-    """Length of the crack in the reference configuration: half the crack-face length."""
+    """Length of the crack in the reference configuration: half the crack-face length.
+
+    Parameters
+    ----------
+    arrays : MeshArrays
+        A mesh whose crack faces are the boundary segments named ``crack``.
+
+    Returns
+    -------
+    float
+    """
     if "crack" not in arrays.bc_names:
         return 0.0
     segs = arrays.boundary_segments("crack")
