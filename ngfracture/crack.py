@@ -103,7 +103,7 @@ def _check_critical(critical, what="critical strain"):
     try:
         c = float(critical)
     except (TypeError, ValueError):
-        raise ValueError(f"ngfracture.crack: {what} must be a number, got {critical!r}")
+        raise ValueError(f"ngfracture.crack: {what} must be a number, got {critical!r}") from None
     if not math.isfinite(c) or c <= 0:
         raise ValueError(f"ngfracture.crack: {what} must be finite and > 0, got {critical!r}")
     return c
@@ -457,11 +457,11 @@ def transfer(u, result):
         If u is not on a 2D ``VectorH1`` space.
     """
     p = _field_order(u)
-    if result.mesh is u.space.mesh:
-        return u                      # nothing was split: the field is already there
-    if p > 2:
+    if p > 2:   # refused even when nothing split: the same call must not depend on the data
         raise NotImplementedError("ngfracture.crack.transfer: order >= 3 is not supported "
                                   "(edge dof orientation changes with the vertex numbers)")
+    if result.mesh is u.space.mesh:
+        return u                      # nothing was split: the field is already there
     if u.space.mesh.nv != result.record["nv_old"]:
         raise ValueError("ngfracture.crack.transfer: the field is not on the split mesh")
     fes = ngsolve.VectorH1(result.mesh, order=p)

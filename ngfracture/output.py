@@ -114,7 +114,7 @@ def element_strain(mesh, u, measure="green", arrays=None):
     """
     if measure not in ("green", "linear"):
         raise ValueError(f"ngfracture.output: measure must be 'green' or 'linear', got {measure!r}")
-    a = arrays or vertex_arrays(mesh)
+    a = arrays if arrays is not None else vertex_arrays(mesh)
     U = _displacement(mesh, u)
     X, T = a.points, a.triangles
     D = np.stack([X[T[:, 1]] - X[T[:, 0]], X[T[:, 2]] - X[T[:, 0]]], axis=2)   # columns: edges
@@ -174,7 +174,7 @@ def to_pyvista(mesh, u=None, fragment=None, strain="green", point_data=None, cel
         Arrays whose length does not fit the mesh, non-finite displacement.
     """
     import pyvista as pv
-    a = arrays or vertex_arrays(mesh)
+    a = arrays if arrays is not None else vertex_arrays(mesh)
     ne, nv = len(a.triangles), len(a.points)
     cells = np.column_stack([np.full(ne, 3, dtype=np.int64), a.triangles]).ravel()
     grid = pv.UnstructuredGrid(cells, np.full(ne, pv.CellType.TRIANGLE, dtype=np.uint8),
@@ -233,7 +233,7 @@ def cracks_to_pyvista(mesh, u=None, boundary="crack", arrays=None):
         Not a 2D triangle mesh, or a displacement that does not fit it.
     """
     import pyvista as pv
-    a = arrays or vertex_arrays(mesh)
+    a = arrays if arrays is not None else vertex_arrays(mesh)
     seg = a.boundary_segments(boundary)
     used, local = np.unique(seg, return_inverse=True)
     local = local.reshape(seg.shape)
