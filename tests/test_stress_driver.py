@@ -6,7 +6,11 @@ Measured (netgen/NGSolve of this checkout):
 * critical strain 1e-12 on the plate (maxh 0.1, 234 vertices, 394 triangles), contact
   "never": the first step (dx cut to dx_min = dx/64 = 2.16e-7) shatters the plate into
   45 fragments in one crack pass and one relaxation pass, 237 split vertices, 471
-  vertices (ratio 1.195 to the triangles); later steps split nothing.
+  vertices (ratio 1.195 to the triangles); later steps split nothing. With contact
+  "auto" the same step is refused instead (open): the contact rows hold a mechanism of
+  the 45 fragments only at sigma 9.2e-10 (of 4.4), rigid.unheld_mode_rows counts it as
+  held and the floating check does not; the run stops at step 0 with reason "failed"
+  (singular), the initial state written.
 * threads 1 and 2 (assembly in the TaskManager, PARALLEL_MIN_DOFS = 0), plate maxh
   0.06: 21 steps, 46 split vertices, 3 fragments either way; triangles and points
   bitwise equal, displacement equal to 2.4e-20 (2.6e-16 of its maximum).
