@@ -126,6 +126,7 @@ def _run_run(args):
     if args.force and args.resume:
         raise ValueError("--force and --resume exclude each other")
     out = args.out if args.out is not None else os.path.join("out", args.scene)
+    Simulation.check_output(out, force=args.force, resume=args.resume)   # before meshing
     options = {} if args.maxh is None else {"maxh": args.maxh}
     scene = scenes.SCENES[args.scene](**options)
     if args.load_max is not None:

@@ -368,14 +368,31 @@ class Simulation:
                     "summary.json", "final.png", "step_*.png", "fragment_sizes.png",
                     ".checkpoint_*.tmp")
 
-    def _own_files(self):
-        return sorted({p for pat in self.OWN_PATTERNS for p in self.out.glob(pat)})
+    @classmethod
+    def check_output(cls, out, force=False, resume=False):
+        """Refuse an output folder before any work; returns the files of ours in it.
+
+        Raises
+        ------
+        FileExistsError
+            ``out`` is not a folder, or holds results and neither force nor resume is given.
+        checkpoint.CheckpointError
+            ``resume`` and ``out`` has no checkpoint.
+        """
+        out = Path(out)
+        if out.exists() and not out.is_dir():
+            raise FileExistsError(f"output folder {out} exists and is not a folder")
+        own = sorted({p for pat in cls.OWN_PATTERNS for p in out.glob(pat)}) if out.exists() else []
+        if resume and not checkpoint.list_checkpoints(out):
+            raise checkpoint.CheckpointError(f"{out}: no checkpoint to resume from")
+        if own and not (force or resume):
+            raise FileExistsError(f"output folder {out} already holds results ({own[0].name}, ...); "
+                                  f"use force to replace them or resume to continue")
+        return own
 
     def _prepare_output(self):
         from .output import TimeSeriesWriter
-        if self.out.exists() and not self.out.is_dir():
-            raise FileExistsError(f"output folder {self.out} exists and is not a folder")
-        own = self._own_files() if self.out.exists() else []
+        own = self.check_output(self.out, self.force, self.resume)
         if self.resume:
             arrays, header = checkpoint.latest(self.out)
             self._resumed_state = self._state_from_checkpoint(arrays, header)
@@ -386,9 +403,6 @@ class Simulation:
             for p in self.out.glob(".checkpoint_*.tmp"):   # a checkpoint write that was killed
                 p.unlink()
             return
-        if own and not self.force:
-            raise FileExistsError(f"output folder {self.out} already holds results ({own[0].name}, ...); "
-                                  f"use force to replace them or resume to continue")
         self.out.mkdir(parents=True, exist_ok=True)
         for p in own:
             p.unlink()
