@@ -372,6 +372,18 @@ class Simulation:
     def check_output(cls, out, force=False, resume=False):
         """Refuse an output folder before any work; returns the files of ours in it.
 
+        Parameters
+        ----------
+        out : path
+            The output folder (need not exist).
+        force, resume : bool
+            As for :class:`Simulation`.
+
+        Returns
+        -------
+        list of pathlib.Path
+            The files in ``out`` that ngfracture writes (what ``force`` removes).
+
         Raises
         ------
         FileExistsError
