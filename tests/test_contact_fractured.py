@@ -190,9 +190,9 @@ def test_obliquely_pressed_kinked_lips_settle(bands):
 @pytest.mark.slow
 def test_disk_expansion_runs_to_the_end():
     """The disk scene (maxh 0.1) expanded to 50 x 1.5 x critical x hole / 4: its contact
-    solves used to cycle at step 32 (period 4, reason "active_set"). Measured: load_max (40 steps,
-    3 fragments, max overlap area 7.3e-7) in
-    about 30 s, 29 of 79 contact solves used the complementarity problem."""
+    solves used to cycle at step 32 (period 4, reason "active_set"). Measured: load_max
+    (40 steps, 3 fragments, max overlap area 7.3e-7) in about 30 s; 29 of 79 contact solves
+    used the complementarity problem."""
     from ngfracture import scenes
     from ngfracture.simulation import Simulation
     r = Simulation(scenes.disk(maxh=0.1, expansion=50 * 1.5 * 1.3817e-4 * 0.25), pictures="none").run()
