@@ -242,6 +242,7 @@ class ConstrainedSolver:
             S = self.C @ self._Z
             S = 0.5 * (S + S.T)
             G = (self.C @ self._R).toarray()
+            self._S, self._G = S, G       # kept for solve_unilateral
             coarse = np.block([[S, -G], [-G.T, np.zeros((self.k, self.k))]])
             # equilibrate, so that the pivot test does not depend on units: S ~ 1/E while
             # G ~ 1 (measured: E = 5e9 made a regular system look singular, ratio 3e-13)
@@ -275,12 +276,7 @@ class ConstrainedSolver:
         lam : numpy.ndarray (m,)
             Multipliers of the general rows.
         """
-        q = r
-        if np.any(du_fixed):
-            self._tmp.FV().NumPy()[:] = du_fixed
-            q = r - (self.K * self._tmp).Evaluate().FV().NumPy()
-        self.last_load_norm = float(np.linalg.norm(q[self.free]))
-        du = du_fixed + self.factor.solve(q)
+        q, du = self._unconstrained(r, du_fixed)
         lam = np.zeros(self.m)
         if self.m:
             rhs = np.concatenate([self.C @ du - h, -(self._R.T @ q)])
@@ -289,3 +285,66 @@ class ConstrainedSolver:
             du -= self._Z @ lam
             du += self._R @ alpha
         return du, lam
+
+    def _unconstrained(self, r, du_fixed):
+        """The load q with the prescribed increments moved over, and du = du_fixed + K^+ q."""
+        q = r
+        if np.any(du_fixed):
+            self._tmp.FV().NumPy()[:] = du_fixed
+            q = r - (self.K * self._tmp).Evaluate().FV().NumPy()
+        self.last_load_norm = float(np.linalg.norm(q[self.free]))
+        return q, du_fixed + self.factor.solve(q)
+
+    def solve_unilateral(self, r, du_fixed, h, unilateral):
+        """Solve with some general rows as inequalities: a linear complementarity problem.
+
+        Rows i in ``unilateral`` hold as C_i du >= h_i with lam_i <= 0 and
+        lam_i (C_i du - h_i) = 0 (frictionless contact: h = -gap, lam compressive); the
+        others as in :meth:`solve`. In multipliers this is the dual problem of FETI
+        contact (Dostal):
+
+            min 1/2 lam^T S lam - b^T lam   s.t.  G^T lam = R^T q,  lam_i <= 0 (i unilateral)
+
+        with b = C (du_fixed + K^+ q) - h, solved exactly by the dual active-set method
+        (:func:`ngfracture.qp.convex_qp`); S is positive definite on the null space of G^T
+        when the rows are independent and the free modes held, as the constructor checks.
+
+        Parameters
+        ----------
+        r, du_fixed, h
+            As for :meth:`solve`.
+        unilateral : numpy.ndarray of int or bool
+            The rows that are inequalities.
+
+        Returns
+        -------
+        du : numpy.ndarray (ndof,)
+        lam : numpy.ndarray (m,)
+            Exactly 0 for the released unilateral rows.
+        closed : numpy.ndarray of bool (m,)
+            The rows that hold with equality, C_i du = h_i: the equalities and the unilateral
+            rows that are not released. A closed row may carry no force (lam_i = 0): it
+            touches, and still fixes the position of a piece that no force holds.
+        """
+        from .qp import convex_qp    # only needed here
+
+        q, du = self._unconstrained(r, du_fixed)
+        if not self.m:
+            return du, np.zeros(0), np.zeros(0, dtype=bool)
+        bounded = np.zeros(self.m, dtype=bool)
+        bounded[unilateral] = True
+        b = self.C @ du - h
+        # in the equilibrated variables y = lam / d of the constructor (unit diagonal),
+        # with H = S + G G^T: the same minimiser on G^T lam = R^T q, and positive definite
+        d, gscale = self._scale[:self.m], self._scale[self.m:]
+        Gs = d[:, None] * self._G * gscale[None, :]
+        H = d[:, None] * self._S * d[None, :] + Gs @ Gs.T
+        e = gscale * (self._R.T @ q)
+        y, alpha, _, active = convex_qp(H, d * b + Gs @ e, Gs.T, e, -np.eye(self.m)[bounded], np.zeros(bounded.sum()))
+        released = np.zeros(self.m, dtype=bool)
+        released[np.flatnonzero(bounded)[active]] = True
+        y[released] = 0.0                        # released rows carry exactly nothing
+        lam = d * y
+        du -= self._Z @ lam
+        du += self._R @ (gscale * alpha)
+        return du, lam, ~released

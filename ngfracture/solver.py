@@ -206,6 +206,48 @@ class NewtonSolver:
             status.steps = step
         return status
 
+    def unilateral_multipliers(self, unilateral):
+        """Multipliers of one linearised step in which some general rows are inequalities.
+
+        The step of the first Newton iteration from the current state to the prescribed
+        values (with the saved tangent if it holds, as :meth:`solve` would use it), with the
+        general rows ``unilateral`` (indices into the assembled general rows) as C du >= h,
+        lam <= 0, complementary: a linear complementarity problem solved exactly
+        (:meth:`kkt.ConstrainedSolver.solve_unilateral`). The state is not changed.
+
+        Returns
+        -------
+        lam : numpy.ndarray
+            Multipliers of the assembled general rows (0 for released unilateral rows).
+        closed : numpy.ndarray of bool
+            The rows that hold with equality (see ConstrainedSolver.solve_unilateral).
+
+        Raises
+        ------
+        SingularSystem
+            Dependent rows or an unheld free mode.
+        """
+        prob = self.problem
+        rows = prob.assemble_constraints()
+        m = rows.C.shape[0]
+        saved = self.tangent
+        reuse = (saved is not None and saved.factor is not None and saved.holds(rows.fixed_dofs)
+                 and (self.method == "modified" or not prob.nonlinear))
+        support = saved.support if reuse else prob.support(rows)
+        if self.fix_free_modes:
+            rows = self._hold_free_modes(rows, support)
+        factor = saved.factor if reuse else EliminatedFactor(prob.tangent(), rows.fixed_dofs, support.pins,
+                                                             self.linear_solver, self.inverse)
+        kkt = ConstrainedSolver(None, rows.fixed_dofs, rows.C, modes=support.modes, pins=support.pins,
+                                factor=factor)
+        u = prob.u.vec.FV().NumPy()
+        du_fixed = np.zeros(u.size)
+        du_fixed[rows.fixed_dofs] = rows.fixed_values - u[rows.fixed_dofs]
+        with prob.threads():
+            _, lam, closed = kkt.solve_unilateral(self._out_of_balance(), du_fixed, rows.g - rows.C @ u,
+                                                  unilateral)
+        return lam[:m], closed[:m]
+
     def _out_of_balance(self):
         """The out-of-balance force, taken from the saved tangent if u is where it was left."""
         saved = self.tangent

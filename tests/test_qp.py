@@ -1,0 +1,60 @@
+"""The dense QP behind the contact LCP: exact Kuhn-Tucker points in finitely many steps."""
+import numpy as np
+import pytest
+
+from ngfracture.qp import Infeasible, convex_qp
+
+
+def kuhn_tucker_error(H, c, A_eq, b_eq, A_in, b_in, x, u_eq, u_in):
+    """Largest violation of stationarity, feasibility, sign and complementarity (relative)."""
+    scale = np.abs(c).max() + np.abs(H @ x).max()
+    s = A_in @ x - b_in
+    return max(np.abs(H @ x - c - A_eq.T @ u_eq - A_in.T @ u_in).max() / scale,
+               np.abs(A_eq @ x - b_eq).max(initial=0.0), max(0.0, -s.min(initial=0.0)),
+               max(0.0, -u_in.min(initial=0.0)) / scale, np.abs(u_in * s).max(initial=0.0) / scale)
+
+
+@pytest.mark.parametrize("seed", range(20))
+def test_random_bound_and_equality_constrained_qps(seed):
+    """Sign bounds on some variables plus equalities, as in the contact dual: KT to 1e-10."""
+    rng = np.random.default_rng(seed)
+    n, p = int(rng.integers(2, 40)), int(rng.integers(0, 3))
+    B = rng.standard_normal((n, n))
+    H, c = B @ B.T + 1e-3 * np.eye(n), rng.standard_normal(n)
+    A_eq, b_eq = rng.standard_normal((p, n)), rng.standard_normal(p)
+    A_in = -np.eye(n)[rng.choice(n, int(rng.integers(0, n)), replace=False)]
+    b_in = np.zeros(len(A_in))
+    x, u_eq, u_in, active = convex_qp(H, c, A_eq, b_eq, A_in, b_in)
+    assert kuhn_tucker_error(H, c, A_eq, b_eq, A_in, b_in, x, u_eq, u_in) < 1e-10
+    assert np.all(u_in[~active] == 0.0)
+
+
+def test_lcp_matches_enumeration_of_all_active_sets():
+    """min 1/2 x^T H x - c^T x, x <= 0 for an SPD H that is no M-matrix (mixed-sign
+    coupling, as nearly parallel contact rows give): the unique KT point, found by trying
+    all 2^6 active sets, is reproduced to rounding."""
+    rng = np.random.default_rng(1)
+    B = rng.standard_normal((6, 6))
+    H, c = B @ B.T + 0.1 * np.eye(6), rng.standard_normal(6)
+    assert (H - np.diag(np.diag(H)) > 0).any()          # not an M-matrix
+    x, _, _, _ = convex_qp(H, c, np.zeros((0, 6)), np.zeros(0), -np.eye(6), np.zeros(6))
+    found = []
+    for mask in range(64):
+        free = np.array([(mask >> i) & 1 for i in range(6)], dtype=bool)
+        y = np.zeros(6)
+        y[free] = np.linalg.solve(H[np.ix_(free, free)], c[free])
+        g = c - H @ y                   # >= 0 where x is held at 0 (its multiplier)
+        if np.all(y[free] <= 1e-13) and np.all(g[~free] >= -1e-13):
+            found.append(y)
+    assert len(found) == 1 and np.abs(x - found[0]).max() < 1e-12 * np.abs(found[0]).max()
+
+
+def test_infeasible_constraints_are_reported():
+    """x <= 0 and x = 1 have no common point."""
+    with pytest.raises(Infeasible):
+        convex_qp(np.eye(1), np.zeros(1), np.ones((1, 1)), np.ones(1), -np.eye(1), np.zeros(1))
+
+
+if __name__ == "__main__":
+    import sys
+    sys.exit(pytest.main([__file__, "-q"]))
