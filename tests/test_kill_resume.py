@@ -4,7 +4,8 @@ The runs are real processes (``python -c`` calling the CLI's ``main``) killed wi
 SIGKILL. One case kills during a checkpoint write: the child announces the write on
 stdout from inside ``os.replace`` (wrapped in the checkpoint module only) and sleeps
 there; the kill lands between the fsync'ed temporary file and the rename.
-The sweep over random moments is marked slow (``pytest -m slow``).
+The sweep over random moments is marked ``kill_sweep``: a plain ``pytest`` leaves it out,
+the README's test command (and so CI) runs it.
 """
 import json
 import os
@@ -96,7 +97,7 @@ def test_kill_during_a_checkpoint_write_resumes_to_the_same_result(reference, tm
     _compare(out, reference)
 
 
-@pytest.mark.slow
+@pytest.mark.kill_sweep
 @pytest.mark.parametrize("seed", range(5))
 def test_kill_at_a_random_moment_resumes_to_the_same_result(reference, tmp_path, seed):
     total = json.loads((reference / "summary.json").read_text())["timings"]["wall"]
