@@ -69,6 +69,18 @@ LABEL = "contact"
 class ContactResult:
     """How a contact solve ended.
 
+    Made by :meth:`ContactSolver.solve` (true when converged).
+
+    Parameters
+    ----------
+    status : SolveStatus or None
+        Initial status; ContactSolver.solve passes None and then stores the status of
+        every Newton solve in turn.
+    converged, reason, rounds, constraints, multipliers, released, max_penetration
+        Initial values of the attributes of the same names (below).
+    timings, history, updates, lcp
+        Likewise; by default zero timings for the four phases, an empty history, 0, 0.
+
     Attributes
     ----------
     status : SolveStatus
@@ -133,8 +145,8 @@ class ContactSolver:
     tol : float
         Precision threshold of the detection (a length): pairs closer than tol count,
         and slave nodes within tol of a master segment can get a constraint.
-    penetration_tol : float
-        Penetration depth accepted at the end.
+    penetration_tol : float, optional
+        Penetration depth accepted at the end (a length); None: 1e-10 * tol.
     max_rounds : int
         Detect-and-solve rounds before giving up with reason "active_set".
     rank_tol : float
@@ -162,7 +174,14 @@ class ContactSolver:
         settles in 2 to 7 rounds where it converges; on kinked lips pressed obliquely it
         wandered for 20 rounds.
     **solve_options
-        Passed to ``problem.solve`` (method, tol, maxit, ...).
+        Passed to ``problem.solve`` (method, tol, maxit, ...); ``fix_free_modes`` is
+        always set to True (free pieces are held on their rigid modes), and ``tangent`` is
+        chosen by :meth:`solve`.
+
+    Raises
+    ------
+    ValueError
+        If ``tol`` is NaN, infinite or negative. The other arguments are not checked here.
     """
 
     def __init__(self, problem, tol, penetration_tol=None, max_rounds=20, rank_tol=1e-5, max_updates=5,
@@ -277,7 +296,18 @@ class ContactSolver:
         return status
 
     def solve(self):
-        """Solve for equilibrium with contact; returns a ContactResult."""
+        """Solve for equilibrium with contact.
+
+        The problem's rows labelled "contact" are replaced by the active set of each round
+        and are those of the last solve at the end; the displacement is the solution of
+        the last converged Newton solve.
+
+        Returns
+        -------
+        ContactResult
+            Converged, or reason: the Newton reason of a failed solve, or "active_set" when
+            ``max_rounds`` rounds passed without a settled set. Failures are not raised.
+        """
         prob = self.problem
         prob.constraints.clear_rows(LABEL)
         # the rounds are at the load of the prediction: they reuse its factorised tangent
@@ -395,6 +425,20 @@ def relinearise_node_to_segment(cs, X, U):
     """The rows of cs with normal and projection of the master edge at X + U (eq. 13, 14).
 
     Rows snapped to a node (xi = 0 or 1) stay node-to-node; the normal keeps its side.
+
+    Parameters
+    ----------
+    cs : contact.ContactConstraints
+        Node-to-segment rows (slave, master edge a -> c, previous xi and normal).
+    X, U : numpy.ndarray, shape (nv, 2)
+        Reference vertex coordinates and vertex displacements (current = X + U).
+
+    Returns
+    -------
+    contact.ContactConstraints
+        The same rows in the same order, with xi (clipped to [0, 1]), unit normal, dist
+        (signed distance at X + U), C and g recomputed; slave, a, c, triangles, pair and
+        angle kept. ``cs`` itself when it is empty.
     """
     if len(cs) == 0:
         return cs
@@ -418,6 +462,20 @@ def reachable(cs, U, tol):
     segment than it has moved relative to that segment (plus the threshold).  Deeper
     "penetrations" come from picking the wrong way out near crack tips and corners;
     imposing them would tear the mesh (measured: inverted elements), so they are dropped.
+
+    Parameters
+    ----------
+    cs : contact.ContactConstraints
+        Candidate rows, with ``dist`` at the current configuration.
+    U : numpy.ndarray, shape (nv, 2)
+        Vertex displacements.
+    tol : float
+        Detection threshold (a length) added to the relative motion.
+
+    Returns
+    -------
+    numpy.ndarray of bool, shape (len(cs),)
+        True where -dist <= |u_slave - xi u_a - (1 - xi) u_c| + tol.
     """
     if len(cs) == 0:
         return np.zeros(0, dtype=bool)
@@ -480,7 +538,23 @@ def _clip_half_plane(poly, a, b):
 
 
 def fragment_overlap_area(problem):
-    """Total overlap area between triangles of the current configuration (0 if none)."""
+    """Total overlap area between triangles of the current configuration (0 if none).
+
+    Pairs are those of ``detect_collisions`` with tol = 0 on the true boundary segments
+    (interiors overlapping; mesh neighbours in one fragment excepted), their intersection
+    areas summed by :func:`overlap_area`.
+
+    Parameters
+    ----------
+    problem : ElasticProblem
+        Its mesh, fragments and displacement; only the vertex values of the displacement
+        count (straight-sided triangles).
+
+    Returns
+    -------
+    float
+        Area, in the square of the mesh's length unit.
+    """
     arrays = boundary_only(mesh_to_arrays(problem.mesh))
     U = vertex_displacement(problem.u)
     _, comp = problem.fragments()

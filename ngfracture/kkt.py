@@ -40,7 +40,20 @@ class SingularSystem(RuntimeError):
 
 
 def to_scipy(mat):
-    """An NGSolve sparse matrix as a scipy CSR matrix (a copy)."""
+    """An NGSolve sparse matrix as a scipy CSR matrix (a copy).
+
+    Parameters
+    ----------
+    mat : ngsolve.SparseMatrix
+        A real sparse matrix (``mat.CSR()`` gives its values, column indices and row
+        pointers).
+
+    Returns
+    -------
+    scipy.sparse.csr_matrix, shape (mat.height, mat.width)
+        The same entries, including explicitly stored zeros; the arrays are copied, so
+        later changes to ``mat`` do not show in it.
+    """
     vals, cols, rows = mat.CSR()
     return sp.csr_matrix((np.array(vals), np.array(cols), np.array(rows)), shape=(mat.height, mat.width))
 
@@ -55,6 +68,12 @@ def reproducible_threads():
     thread it is bitwise reproducible; on the 2-core machine it was not slower
     (1.87-1.90 s against 1.89-2.13 s at 145k P1 dofs). Must be entered outside a
     TaskManager context (its thread count is fixed when it starts).
+
+    Yields
+    ------
+    None
+        The body of the ``with`` block runs with ``ngsolve.SetNumThreads(1)``; the previous
+        thread count is restored on leaving it, also when it raises.
     """
     before = ng.GetNumThreads()
     ng.SetNumThreads(1)
@@ -76,15 +95,25 @@ class EliminatedFactor:
     ----------
     K : ngsolve.SparseMatrix
         Tangent stiffness on all dofs (kept as given; do not reassemble it while in use).
-    fixed_dofs, pins : numpy.ndarray
-        Dofs left out of the factorisation.
+    fixed_dofs, pins : array_like of int
+        Dofs left out of the factorisation: those fixed by single-dof rows, and one pin per
+        free rigid mode (``rigid.Support.pins``; None for none).
     linear_solver, inverse, gmres_tol
-        See ConstrainedSolver.
+        See ConstrainedSolver. ``inverse`` is used only by "direct", ``gmres_tol`` (the
+        relative residual GMRES must reach) only by "gmres".
 
     Attributes
     ----------
     seconds : float
         Time spent factorising and in triangular solves (or GMRES) so far.
+
+    Raises
+    ------
+    ValueError
+        If ``linear_solver`` is not one of ``LINEAR_SOLVERS``.
+    SingularSystem
+        If the incomplete LU factorisation of "gmres" fails. A singular K under "direct"
+        is found only by the first :meth:`solve`.
     """
 
     def __init__(self, K, fixed_dofs, pins=None, linear_solver="direct", inverse="sparsecholesky",
@@ -123,7 +152,19 @@ class EliminatedFactor:
         self.seconds = time.perf_counter() - t0
 
     def matches(self, fixed_dofs, pins):
-        """True if this factorisation leaves out exactly these fixed dofs and pins."""
+        """True if this factorisation leaves out exactly these fixed dofs and pins.
+
+        Parameters
+        ----------
+        fixed_dofs, pins : numpy.ndarray of int
+            Compared element by element, in order, with those of the constructor (after its
+            conversion to int64; pins=None became an empty array there, so pass an empty
+            array, not None, for "no pins").
+
+        Returns
+        -------
+        bool
+        """
         return np.array_equal(self.fixed_dofs, fixed_dofs) and np.array_equal(self.pins, pins)
 
     def solve(self, B):
@@ -131,6 +172,25 @@ class EliminatedFactor:
 
         Entries of B at fixed dofs and pins are ignored; X is zero there. Checked: the
         factorisation must solve its own system.
+
+        Parameters
+        ----------
+        B : numpy.ndarray, shape (ndof,) or (ndof, m)
+            Right-hand side(s) in NGSolve's dof layout (forces); m may be 0.
+
+        Returns
+        -------
+        numpy.ndarray, same shape as B
+            The solution(s) (displacements), float64.
+
+        Raises
+        ------
+        SingularSystem
+            "gmres": if GMRES does not converge for a column or gives NaN/inf. "direct": if
+            the solution has NaN/inf, or if the first solve with a nonzero right-hand side
+            on the factorised dofs leaves a relative residual of 1e-6 or more in its largest
+            column (sparse Cholesky of a singular or indefinite matrix can return finite
+            garbage; checked once per factorisation).
         """
         t0 = time.perf_counter()
         single = B.ndim == 1
@@ -176,7 +236,26 @@ class EliminatedFactor:
         self._checked = True
 
     def columns(self, C):
-        """Z = K^+ C^T (ndof, m); rows met in the last call are not solved again."""
+        """Z = K^+ C^T (ndof, m); rows met in the last call are not solved again.
+
+        A row is recognised by its stored column indices and values (bitwise); the cache
+        keeps only the rows of the latest call.
+
+        Parameters
+        ----------
+        C : scipy.sparse matrix or array_like, shape (m, ndof)
+            Constraint rows.
+
+        Returns
+        -------
+        numpy.ndarray, shape (ndof, m)
+            Column i is K^+ C_i^T, zero at fixed dofs and pins.
+
+        Raises
+        ------
+        SingularSystem
+            From :meth:`solve`, if the rows not cached need a solve and it fails.
+        """
         C = sp.csr_matrix(C)
         keys = [C.indices[s:e].tobytes() + C.data[s:e].tobytes() for s, e in zip(C.indptr[:-1], C.indptr[1:])]
         Z = np.zeros((self.ndof, len(keys)))
@@ -197,9 +276,9 @@ class ConstrainedSolver:
 
     Parameters
     ----------
-    K : ngsolve.SparseMatrix
-        Tangent stiffness on all dofs.
-    fixed_dofs : numpy.ndarray
+    K : ngsolve.SparseMatrix or None
+        Tangent stiffness on all dofs (None allowed when ``factor`` is given).
+    fixed_dofs : numpy.ndarray of int
         Dofs fixed by single-dof rows (eliminated).
     C : scipy.sparse matrix, shape (m, ndof)
         General constraint rows (may have m = 0).
@@ -208,7 +287,11 @@ class ConstrainedSolver:
         "gmres": the paper's ILU-preconditioned GMRES (slow; for comparison).
     inverse : str
         NGSolve direct solver for "direct" ("sparsecholesky", "umfpack", "pardiso").
-    modes, pins : see rigid.Support.
+    gmres_tol : float
+        Relative residual at which GMRES stops ("gmres" only).
+    modes, pins : optional
+        Free rigid modes, scipy.sparse (ndof, k), and one pinned dof per mode, array of
+        int (k,); see rigid.Support. None: no free modes, no pins.
     factor : EliminatedFactor, optional
         A factorisation of K for the same fixed dofs and pins to reuse (then K, the
         solver options and the factorisation cost nothing here).
@@ -216,7 +299,12 @@ class ConstrainedSolver:
     Raises
     ------
     SingularSystem
-        If K_ff or the Schur complement is singular.
+        If K_ff or the Schur complement is singular: free rigid modes but no general
+        rows, general rows (nearly) dependent or leaving a mode free (coarse pivot ratio
+        <= 1e-12), or a failed factorisation or solve of K_ff (see EliminatedFactor).
+    ValueError
+        If ``factor`` was made for other fixed dofs or pins, or (without ``factor``) if
+        ``linear_solver`` is unknown.
     """
 
     def __init__(self, K, fixed_dofs, C, linear_solver="direct", inverse="sparsecholesky", gmres_tol=1e-12,

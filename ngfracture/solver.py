@@ -29,6 +29,15 @@ REASONS = ("converged", "max_iterations", "diverged", "nan", "singular", "invert
 class SolveStatus:
     """How a solve ended.
 
+    A solve starts from the defaults and fills it in; it is true when converged.
+
+    Parameters
+    ----------
+    converged, reason, message, iterations, steps, increment_history, residual_history
+        Initial values of the attributes of the same names (below).
+    timings, multipliers
+        Likewise; by default a dict of zeros for the five phases and an empty array.
+
     Attributes
     ----------
     converged : bool
@@ -67,6 +76,20 @@ class SolveStatus:
         return self.converged
 
     def fail(self, reason, message):
+        """Record a failure: converged becomes False, reason and message are set.
+
+        Parameters
+        ----------
+        reason : str
+            One of REASONS other than "converged" (not checked).
+        message : str
+            Human-readable detail.
+
+        Returns
+        -------
+        SolveStatus
+            This status (changed in place), so that ``return status.fail(...)`` works.
+        """
         self.converged, self.reason, self.message = False, reason, message
         return self
 
@@ -103,6 +126,18 @@ class SavedTangent:
         self.fixed_dofs = self.support = self.factor = self.residual = None
 
     def holds(self, fixed_dofs):
+        """True if a tangent is saved and it was factorised for exactly these fixed dofs.
+
+        Parameters
+        ----------
+        fixed_dofs : numpy.ndarray of int
+            Fixed dofs of the solve that wants to reuse it (compared in order).
+
+        Returns
+        -------
+        bool
+            False for an empty SavedTangent.
+        """
         return self.fixed_dofs is not None and np.array_equal(self.fixed_dofs, fixed_dofs)
 
 
@@ -140,6 +175,13 @@ class NewtonSolver:
         rows that stop them from drifting; otherwise such a body is reported as floating.
     tangent : SavedTangent, optional
         Reuse its factorisation, or leave this solve's in it (see SavedTangent).
+
+    Raises
+    ------
+    ValueError
+        If ``method`` is not in METHODS, ``tol`` not a number in (0, 1) or ``maxit`` not a
+        positive integer. ``linear_solver`` is not checked here: an unknown one raises
+        ValueError when a solve factorises.
     """
 
     def __init__(self, problem, method="modified", tol=1e-10, maxit=50, linear_solver="direct",
@@ -163,9 +205,24 @@ class NewtonSolver:
         The prescribed values (and external loads) are reached in ``load_steps`` equal
         increments from the current state.
 
+        Parameters
+        ----------
+        load_steps : int
+            Number of equal increments (>= 1) of the load factor, the fixed dof values and
+            the right-hand sides of the general rows.
+
         Returns
         -------
         SolveStatus
+            Failures (floating body, singular system, NaN, divergence, inverted element,
+            no convergence) are reported here, not raised; on failure the displacement and
+            the load factor are those of the last converged load step.
+
+        Raises
+        ------
+        ValueError
+            If ``load_steps`` is not a positive integer, or if the constructor's
+            ``linear_solver`` is unknown (raised at the first factorisation).
         """
         if isinstance(load_steps, bool) or not isinstance(load_steps, int) or load_steps < 1:
             raise ValueError(f"load_steps must be a positive integer, got {load_steps!r}")
@@ -215,6 +272,12 @@ class NewtonSolver:
         lam <= 0, complementary: a linear complementarity problem solved exactly
         (:meth:`kkt.ConstrainedSolver.solve_unilateral`). The state is not changed.
 
+        Parameters
+        ----------
+        unilateral : numpy.ndarray of int
+            Indices of the unilateral rows among the assembled general rows (with
+            ``fix_free_modes``, the rows appended for free modes stay equalities).
+
         Returns
         -------
         lam : numpy.ndarray
@@ -225,7 +288,9 @@ class NewtonSolver:
         Raises
         ------
         SingularSystem
-            Dependent rows or an unheld free mode.
+            Dependent rows, an unheld free mode or a singular stiffness.
+        qp.QPError
+            If the dual active-set method fails (see :func:`ngfracture.qp.convex_qp`).
         """
         prob = self.problem
         rows = prob.assemble_constraints()
