@@ -746,7 +746,8 @@ class Simulation:
         if self.pictures != "none":
             try:
                 scale = self._picture_scale(state)
-                render_png(prob.mesh, prob.u, stats.fragment, self.out / "final.png", scale=scale)
+                render_png(prob.mesh, prob.u, stats.fragment, self.out / "final.png", scale=scale,
+                           force=True)   # ours: a resumed run redraws it
                 pictures["final"] = "final.png"
                 pictures["displacement_scale"] = scale
             except RenderError as err:

@@ -187,3 +187,15 @@ def test_crack_length_of_a_straight_cut():
     a = MeshArrays(pts, np.zeros((0, 3), int), np.zeros(0, int), ["r"], np.array([[0, 1], [3, 2]]),
                    np.array([1, 1]), ["crack"])
     assert crack_length(a) == 1.0
+
+
+def test_resuming_a_finished_run_redraws_its_final_outputs(tmp_path):
+    """A run killed while writing its final files resumes from the last checkpoint and redraws them."""
+    control = lambda: StepControl(max_steps=2)
+    first = Simulation(scenes.plate(maxh=0.1), control(), out=tmp_path).run()
+    assert first.reason == "max_steps"
+    (tmp_path / "summary.json").unlink()                 # as if killed before the summary
+    again = Simulation(scenes.plate(maxh=0.1), control(), out=tmp_path, resume=True).run()
+    assert again.reason == "max_steps" and again.summary["n_steps"] == 2
+    assert (tmp_path / "summary.json").exists()
+    assert again.summary["history"] == first.summary["history"]
