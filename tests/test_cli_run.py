@@ -27,10 +27,15 @@ PHASES = ["solve", "strain", "split", "rebuild", "collision", "contact", "output
 
 
 def _env():
+    """The environment with a relative PYTHONPATH made absolute (the child runs elsewhere).
+
+    Nothing is added: an installed ngfracture must be found as installed; the repository
+    root on the path would import the uncompiled source tree instead.
+    """
     env = dict(os.environ)
-    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
     paths = [os.path.abspath(p) for p in env.get("PYTHONPATH", "").split(os.pathsep) if p]
-    env["PYTHONPATH"] = os.pathsep.join(paths or [root])
+    if paths:
+        env["PYTHONPATH"] = os.pathsep.join(paths)
     return env
 
 
