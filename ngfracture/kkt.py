@@ -452,6 +452,9 @@ class ConstrainedSolver:
         with b = C (du_fixed + K^+ q) - h, solved exactly by the dual active-set method
         (:func:`ngfracture.qp.convex_qp`); S is positive definite on the null space of G^T
         when the rows are independent and the free modes held, as the constructor checks.
+        The modes are the corrected ones (Rt, Gt) but their stiffness A is left out: exact
+        when K R = 0; for pressed pieces an approximation, used to choose the active set,
+        which :meth:`solve` then imposes exactly.
 
         Parameters
         ----------
