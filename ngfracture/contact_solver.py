@@ -174,9 +174,10 @@ class ContactSolver:
         settles in 2 to 7 rounds where it converges; on kinked lips pressed obliquely it
         wandered for 20 rounds.
     **solve_options
-        Passed to ``problem.solve`` (method, tol, maxit, ...); ``fix_free_modes`` is
-        always set to True (free pieces are held on their rigid modes), and ``tangent`` is
-        chosen by :meth:`solve`.
+        Passed to ``problem.solve`` (method, tol, maxit, ...); ``fix_free_modes`` is True
+        (free pieces are held on the rigid modes contact leaves free) unless given as "all"
+        (held on all their rigid modes: contact rows dependent on those holds are dropped
+        too), and ``tangent`` is chosen by :meth:`solve`.
 
     Raises
     ------
@@ -197,7 +198,7 @@ class ContactSolver:
         self.kink_angle = kink_angle
         self.pdas_rounds = pdas_rounds
         self.options = dict(solve_options)
-        self.options["fix_free_modes"] = True
+        self.options["fix_free_modes"] = "all" if self.options.get("fix_free_modes") == "all" else True
 
     def _geometry(self):
         """Mesh arrays, fragment per triangle, and the fixed dofs (all, and in the P1 layout).
@@ -212,6 +213,20 @@ class ContactSolver:
         fixed = prob.assemble_constraints().fixed_dofs
         v, c = fixed % n, fixed // n
         return arrays, fragment, fixed, (c * nv + v)[v < nv]
+
+    def _held_modes(self):
+        """With fix_free_modes "all", the rows that hold the pieces, in the P1 layout (else None).
+
+        Contact rows dependent on them would make the solve singular (a small piece with
+        more contact rows than deformation modes)."""
+        if self.options["fix_free_modes"] != "all":
+            return None
+        prob = self.problem
+        modes = prob.support(prob.assemble_constraints()).modes.T.tocoo()
+        nv, n = prob.mesh.nv, prob.fes.ndof // 2
+        v, c = modes.col % n, modes.col // n
+        keep = v < nv          # the modes live on the vertex dofs
+        return sp.csr_matrix((modes.data[keep], (modes.row[keep], (c * nv + v)[keep])), shape=(modes.shape[0], 2 * nv))
 
     def _relinearised(self, pool, n_seam, seam_keys, seams, X, U):
         """The rows of pool (seam rows first) linearised at X + U, in the same order."""
@@ -267,7 +282,8 @@ class ContactSolver:
         cannot be solved (then the primal-dual update goes on).
         """
         t0 = time.perf_counter()
-        cand = candidates[contact.independent_rows(pool.C[candidates], fixed_dofs=fixed, rtol=self.rank_tol)] \
+        cand = candidates[contact.independent_rows(pool.C[candidates], fixed_dofs=fixed, G=self._holds,
+                                                   rtol=self.rank_tol)] \
             if len(candidates) else candidates
         prob = self.problem
         prob.constraints.clear_rows(LABEL)
@@ -323,6 +339,7 @@ class ContactSolver:
             return result
         t0 = time.perf_counter()
         arrays, fragment, fixed_all, fixed = self._geometry()
+        self._holds = self._held_modes()
         seams = find_seams(arrays.points, arrays.segments)
         nv, n = prob.mesh.nv, prob.fes.ndof // 2
         result.timings["contact"] += time.perf_counter() - t0
@@ -358,7 +375,7 @@ class ContactSolver:
             want = np.array([(lam[k] <= 0.0) if k in lam else (g < -self.penetration_tol)
                              for k, g in zip(keys, gap)], dtype=bool)
             want = np.flatnonzero(want)
-            kept = want[contact.independent_rows(pool.C[want], fixed_dofs=fixed, rtol=self.rank_tol)] \
+            kept = want[contact.independent_rows(pool.C[want], fixed_dofs=fixed, G=self._holds, rtol=self.rank_tol)] \
                 if want.size else want
             dependent = np.setdiff1d(want, kept)
             other = np.setdiff1d(np.arange(len(keys)), dependent)

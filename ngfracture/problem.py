@@ -470,9 +470,10 @@ class ElasticProblem:
         linear_solver : {"direct", "gmres"}
         inverse : str
             NGSolve direct solver for "direct".
-        fix_free_modes : bool
+        fix_free_modes : bool or "all"
             Hold free fragments by multiplier rows on their unheld rigid modes
-            instead of reporting them as floating bodies.
+            instead of reporting them as floating bodies; "all": on all their rigid modes
+            (see :class:`solver.NewtonSolver`).
         tangent : solver.SavedTangent, optional
             A factorised tangent to reuse at this load, or to leave this solve's in
             (contact rounds at a fixed load).

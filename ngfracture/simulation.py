@@ -93,6 +93,10 @@ class Scene:
     control : dict
         StepControl settings this scene needs (e.g. more cracks per increment where
         many start at once by symmetry); explicit StepControl arguments override them.
+    fix_free_modes : True or "all"
+        How pieces without Dirichlet support are held (``NewtonSolver``): True, on the
+        rigid modes that contact leaves free; "all", on all their rigid modes (the paper's
+        pinned fragments), for scenes where contact pushes pieces that nothing else holds.
     """
     name: str
     mesh: object
@@ -106,6 +110,7 @@ class Scene:
     stop_when_unloaded: bool = False
     parameters: dict = field(default_factory=dict)
     control: dict = field(default_factory=dict)
+    fix_free_modes: object = True
 
     def validate(self):
         """Check every field before any work.
@@ -143,6 +148,8 @@ class Scene:
                                  f"finite number > 0 (or None: never cracks), got {c!r}")
         if not any(c is not None for c in crit.values()):
             raise ValueError(f"Scene {self.name!r}: no region can crack (every critical strain is None)")
+        if self.fix_free_modes not in (True, "all"):
+            raise ValueError(f"Scene {self.name!r}: fix_free_modes must be True or 'all', got {self.fix_free_modes!r}")
         if not isinstance(self.material, (Material, dict)):
             raise ValueError(f"Scene {self.name!r}: material must be a Material or a dict of them")
         return crit
@@ -440,7 +447,8 @@ class Simulation:
         c = self.control
         options = dict(method=c.method, tol=c.tol, maxit=c.maxit, load_steps=substeps)
         if self._needs_contact(prob.mesh):
-            solver = ContactSolver(prob, tol=self.scene.contact_tol)   # its tol: detection threshold
+            solver = ContactSolver(prob, tol=self.scene.contact_tol,   # its tol: detection threshold
+                                   fix_free_modes=self.scene.fix_free_modes)
             solver.options.update(options)                              # Newton's tol, method, maxit
             result = solver.solve()
             self.timings["solve"] += result.timings["solve"]
@@ -454,7 +462,7 @@ class Simulation:
                                  else f"contact active set did not settle in {result.rounds} rounds")
             return status
         t0 = time.perf_counter()
-        status = prob.solve(fix_free_modes=True, **options)
+        status = prob.solve(fix_free_modes=self.scene.fix_free_modes, **options)
         self.timings["solve"] += time.perf_counter() - t0
         self.timings["linear"] += status.timings["factorize"] + status.timings["solve"]
         self._iterations += status.iterations

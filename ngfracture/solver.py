@@ -110,7 +110,7 @@ class SavedTangent:
     on a linear model, whose tangent is constant); a solve given a filled one for the same
     fixed dofs uses it instead of assembling and factorising, and rebuilds only the Schur
     complement of its general rows. Its rigid modes and pins stay those of the
-    configuration the tangent was assembled at, where K R = 0 holds.
+    configuration the tangent was assembled at (kkt.py corrects them for K R != 0).
 
     Attributes
     ----------
@@ -170,24 +170,29 @@ class NewtonSolver:
         NGSolve direct solver name.
     divergence_factor : float
         An increment this many times larger than the first one means divergence.
-    fix_free_modes : bool
-        Fix the rigid modes that no constraint holds (free fragments) by multiplier
+    fix_free_modes : bool or "all"
+        True: fix the rigid modes that no constraint holds (free fragments) by multiplier
         rows that stop them from drifting; otherwise such a body is reported as floating.
+        "all": fix every rigid mode that the single-dof rows leave free, also those that
+        general rows (contact) hold: every piece without Dirichlet support is held like the
+        paper's pinned fragments, and contact presses it against its hold.
     tangent : SavedTangent, optional
         Reuse its factorisation, or leave this solve's in it (see SavedTangent).
 
     Raises
     ------
     ValueError
-        If ``method`` is not in METHODS, ``tol`` not a number in (0, 1) or ``maxit`` not a
-        positive integer. ``linear_solver`` is not checked here: an unknown one raises
-        ValueError when a solve factorises.
+        If ``method`` is not in METHODS, ``tol`` not a number in (0, 1), ``maxit`` not a
+        positive integer or ``fix_free_modes`` not False, True or "all". ``linear_solver``
+        is not checked here: an unknown one raises ValueError when a solve factorises.
     """
 
     def __init__(self, problem, method="modified", tol=1e-10, maxit=50, linear_solver="direct",
                  inverse="sparsecholesky", divergence_factor=1e4, fix_free_modes=False, tangent=None):
         if method not in METHODS:
             raise ValueError(f"method must be one of {METHODS}, got {method!r}")
+        if fix_free_modes not in (False, True, "all"):
+            raise ValueError(f"fix_free_modes must be False, True or 'all', got {fix_free_modes!r}")
         if not (isinstance(tol, (int, float)) and 0 < tol < 1):
             raise ValueError(f"tol must be in (0, 1), got {tol!r}")
         if isinstance(maxit, bool) or not isinstance(maxit, int) or maxit < 1:
@@ -323,8 +328,11 @@ class NewtonSolver:
         return self.problem.out_of_balance()
 
     def _hold_free_modes(self, rows, support):
-        """Append rows n^T du = 0 for every rigid mode n that nothing holds."""
-        extra = rigid.unheld_mode_rows(rows.C, support.modes)
+        """Append rows n^T du = 0 for every rigid mode n that nothing holds (or every free one)."""
+        if self.fix_free_modes == "all":
+            extra = support.modes.T.tocsr()
+        else:
+            extra = rigid.unheld_mode_rows(rows.C, support.modes)
         if extra.shape[0] == 0:
             return rows
         u = self.problem.u.vec.FV().NumPy()
