@@ -93,9 +93,9 @@ def test_disk_comminuted_zone_and_intact_ring(disk_run):
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason="open (issue 5): the split disk no longer stalls at step 47 (pieces "
-                   "held on all modes), but the run is not yet measured to the end: step 59, x = 0.00325, "
-                   "18 fragments after 400 s, each step slower (maxh 0.08)")
+@pytest.mark.xfail(strict=True, reason="open (issue 5): at maxh 0.08 the disk falls apart into 19 pieces, "
+                   "none around the hole, then step 77 (x = 0.00453 of 0.00777) fails after 5 retries "
+                   "(max_iterations); 849 s")
 def test_disintegration_many_disjoint_fragments():
     result = Simulation(scenes.disintegration(maxh=0.08), pictures="none").run()
     assert result.ok, result.message
