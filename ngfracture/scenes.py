@@ -21,6 +21,13 @@ from .simulation import Scene
 #: the paper's glass: E = 5 GPa, nu = 0.18, critical principal strain 1.3817e-4
 GLASS = dict(E=5e9, nu=0.18, critical=1.3817e-4)
 
+#: radii of the disk's hole and of the core ring's inside (the disk's radius is 1)
+HOLE, CORE_INNER = 0.25, 0.125
+#: expansion of the core's inside that first cracks the glass disk: the hole's hoop strain
+#: u_r / r reaches the critical strain at u_r(hole) ~ critical * hole, and the softer core
+#: ring is squeezed too, about 1.5 times that at its inside
+FIRST_CRACK = 1.5 * GLASS["critical"] * HOLE
+
 
 def _positive(name, value):
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0:
@@ -194,12 +201,9 @@ def disk(maxh=0.06, expansion=None, dx=None, core_stiffness=0.1, name="disk", co
     Scene
     """
     maxh, core_stiffness = _positive("maxh", maxh), _positive("core_stiffness", core_stiffness)
-    hole, core_inner, c = 0.25, 0.125, GLASS["critical"]
-    # the first crack: the hole's hoop strain u_r / r reaches the critical strain, so
-    # u_r(hole) ~ c hole; the softer core ring is squeezed too: about 1.5 times that at its inside
-    first = 1.5 * c * hole
-    expansion = _positive("expansion", expansion) if expansion is not None else 50 * first
-    dx = _positive("dx", dx) if dx is not None else first / 5
+    hole, core_inner, c = HOLE, CORE_INNER, GLASS["critical"]
+    expansion = _positive("expansion", expansion) if expansion is not None else 50 * FIRST_CRACK
+    dx = _positive("dx", dx) if dx is not None else FIRST_CRACK / 5
     glass = StVenantKirchhoff(GLASS["E"], GLASS["nu"], plane="strain")
     core = StVenantKirchhoff(core_stiffness * GLASS["E"], 0.3, plane="strain")
 
@@ -244,13 +248,8 @@ def disintegration(maxh=0.06, expansion=None, dx=None, core_stiffness=0.1):
     Returns
     -------
     Scene
-
-    Returns
-    -------
-    Scene
     """
-    first = GLASS["critical"] * 0.25 * 1.5
-    expansion = expansion if expansion is not None else 150 * first
+    expansion = expansion if expansion is not None else 150 * FIRST_CRACK
     return disk(maxh, expansion, dx, core_stiffness, name="disintegration", confined=False)
 
 

@@ -361,7 +361,6 @@ class Simulation:
         self.checkpoint_every = checkpoint_every
         self.progress = progress
         self.timings = dict.fromkeys(PHASES, 0.0)
-        self.newton_iterations = []
         self.writer = None
         self._resumed_state = None
         #: math.fsum of the triangle areas; splitting keeps every triangle and coordinate,
@@ -475,7 +474,7 @@ class Simulation:
         t0 = time.perf_counter()
         mesh = prob.mesh
         tensors = StrainCriterion(1.0).vertex_tensor(mesh, prob.u)
-        arrays = self._arrays_of(mesh)
+        arrays = mesh_to_arrays(mesh)
         names = arrays.region_names
         inv = np.array([0.0] + [1.0 / self.critical[n] if self.critical.get(n) is not None else 0.0
                                 for n in names])
@@ -484,11 +483,6 @@ class Simulation:
         np.maximum.at(scale, arrays.triangles.ravel(), np.repeat(inv[arrays.regions], 3))
         self.timings["strain"] += time.perf_counter() - t0
         return tensors * scale[:, None]
-
-    def _arrays_of(self, mesh):
-        if getattr(self, "_arrays_cache", (None, None))[0] is not mesh:
-            self._arrays_cache = (mesh, mesh_to_arrays(mesh))
-        return self._arrays_cache[1]
 
     def _crack_pass(self, prob):
         """One splitting pass; returns (new problem or None, number of split vertices)."""
@@ -554,6 +548,7 @@ class Simulation:
         energy = float(prob.energy())
         stats = FragmentStatistics(mesh)
         crack_len = crack_length(arrays)
+        # a step that cracked keeps its (possibly cut) increment; quiet steps may grow it
         quiet = state.quiet + 1 if total == 0 else 0
         new_dx = dx
         if quiet >= self.control.grow_after:
@@ -661,9 +656,6 @@ class Simulation:
                 break
             prob, first, total = attempt
             state, prob, self._mesh, stats = self._accept(state, prob, dx, first, total)
-            if total:
-                state.dx = dx            # a step that cracked keeps its (possibly cut) increment
-            self.newton_iterations.append(state.history[-1]["newton_iterations"])
             if self.writer is not None:
                 self._write_step(state, prob, stats)
                 if state.step % self.checkpoint_every == 0:
@@ -723,7 +715,7 @@ class Simulation:
                 "x": state.x, "dx": state.dx, "step": state.step, "quiet": state.quiet, "work": state.work,
                 "peak_energy": state.peak_energy, "history": state.history,
                 "area_initial": self.area_initial,
-                "timings": self.timings, "newton_iterations": self.newton_iterations}
+                "timings": self.timings}
         checkpoint.write(self.out, state.step, arrays, meta)
         self.timings["output"] += time.perf_counter() - t0
 
@@ -735,7 +727,6 @@ class Simulation:
                 f"{meta.get('parameters')!r}, not {self.scene.name!r} with {self.scene.parameters!r}")
         self.area_initial = meta["area_initial"]
         self.timings.update(meta.get("timings", {}))
-        self.newton_iterations = list(meta.get("newton_iterations", []))
         return State(arrays=MeshArrays.from_dict(arrays), u=arrays["u"], x=meta["x"], dx=meta["dx"],
                      step=meta["step"], quiet=meta["quiet"], work=meta["work"], reactions=arrays["reactions"],
                      fixed_values=arrays["fixed_values"], fixed_dofs=arrays["fixed_dofs"],

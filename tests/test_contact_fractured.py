@@ -195,7 +195,7 @@ def test_disk_expansion_runs_to_the_end():
     used the complementarity problem."""
     from ngfracture import scenes
     from ngfracture.simulation import Simulation
-    r = Simulation(scenes.disk(maxh=0.1, expansion=50 * 1.5 * 1.3817e-4 * 0.25), pictures="none").run()
+    r = Simulation(scenes.disk(maxh=0.1, expansion=50 * scenes.FIRST_CRACK), pictures="none").run()
     assert r.reason == "load_max", r.summary["message"]
     assert r.summary["max_overlap_area"] < 1e-5 * np.pi
 
@@ -210,17 +210,10 @@ R0, R1, R2 = 0.5, 1.0, 2.0
 
 
 def rings_mesh(maxh):
-    """Core ring R0 < r < R1 and disk ring R1 < r < R2 as one netgen mesh, then the core
-    detached: its interface nodes are copies of the disk's ("interface" / "core_surface")."""
-    from netgen.geom2d import SplineGeometry
-    from ngfracture.meshio import separate_region
-    geo = SplineGeometry()
-    geo.AddCircle((0, 0), R2, leftdomain=1, rightdomain=0, bc="outer")
-    geo.AddCircle((0, 0), R1, leftdomain=2, rightdomain=1, bc="interface")
-    geo.AddCircle((0, 0), R0, leftdomain=0, rightdomain=2, bc="inner")
-    geo.SetMaterial(1, "disk")
-    geo.SetMaterial(2, "core")
-    return separate_region(ng.Mesh(geo.GenerateMesh(maxh=maxh)), "core")
+    """Core ring R0 < r < R1 and disk ring R1 < r < R2, the scenes' two bodies touching along
+    r = R1 with coincident copies of the interface nodes ("hole" / "core_surface")."""
+    from ngfracture.scenes import cored_disk_mesh
+    return cored_disk_mesh(maxh, radius=R2, hole=R1, core_inner=R0)
 
 
 def compound_cylinder(delta, E_core, E_disk, nu):
@@ -241,7 +234,7 @@ def rings_errors(maxh, delta=1e-3, E_core=1.0, E_disk=10.0, nu=0.3):
     mesh = rings_mesh(maxh)
     prob = nf.ElasticProblem(mesh, {"core": nf.LinearElastic(E_core, nu, plane="strain"),
                                     "disk": nf.LinearElastic(E_disk, nu, plane="strain")})
-    prob.add_dirichlet("inner", ng.CF((delta * ng.x / R0, delta * ng.y / R0)))
+    prob.add_dirichlet("core_inner", ng.CF((delta * ng.x / R0, delta * ng.y / R0)))
     result = ContactSolver(prob, tol=0.1 * maxh).solve()
     assert result.converged and result.rounds <= 3, (result.reason, result.history)
     adhesive, penetration, complementarity = kuhn_tucker(prob, result, maxh)
@@ -269,7 +262,7 @@ def rings_errors(maxh, delta=1e-3, E_core=1.0, E_disk=10.0, nu=0.3):
 def test_separate_region_gives_coincident_copies():
     mesh = rings_mesh(0.2)
     a = mesh_to_arrays(mesh)
-    iface, surf = a.boundary_segments("interface"), a.boundary_segments("core_surface")
+    iface, surf = a.boundary_segments("hole"), a.boundary_segments("core_surface")
     assert len(iface) == len(surf) > 20
     # the two sides are the same edges, reversed, on different vertices
     def edges(S):

@@ -9,7 +9,6 @@ from ngfracture.fragments import FragmentStatistics
 from ngfracture.meshio import mesh_to_arrays
 from ngfracture.simulation import Simulation
 
-FIRST = 1.5 * 1.3817e-4 * 0.25      # the scenes' estimate of the first-crack expansion
 
 
 def encircles_origin(triangles, points, members):

@@ -99,7 +99,7 @@ plt.show()
 
 # %%
 out = Path("out") / "disk"
-scene = scenes.disk(maxh=0.1, expansion=30 * 1.5 * 1.3817e-4 * 0.25)
+scene = scenes.disk(maxh=0.1, expansion=30 * scenes.FIRST_CRACK)
 run = Simulation(scene, out=out, force=True).run()
 s = run.summary
 print(run.reason, "|", s["n_steps"], "steps,", s["n_split_vertices"], "split vertices,",
