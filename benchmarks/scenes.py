@@ -20,7 +20,7 @@ writing its outputs into a temporary folder (no pictures). Reported per case:
 Prints JSON {"cases": [...]}. Floors (issue 5): the plate at f = 1 under 60 s, and
 outside_solve_share under 0.3 (see the README for the measured figures).
 
-Usage: python benchmarks/scenes.py [--scenes plate disk] [--factors 1 4 16] [--json FILE]
+Usage: python benchmarks/scenes.py [--scenes plate disk] [--factors 1 4 16] [--steps N] [--json FILE]
 """
 import argparse
 import json
@@ -32,7 +32,7 @@ import time
 import ngsolve
 
 from ngfracture import scenes
-from ngfracture.simulation import Simulation
+from ngfracture.simulation import Simulation, StepControl
 
 
 def plain_solve(mesh, E=5e9, nu=0.18):
@@ -52,16 +52,17 @@ def plain_solve(mesh, E=5e9, nu=0.18):
     return time.perf_counter() - t0
 
 
-def run_case(name, factor):
+def run_case(name, factor, steps=None):
     base = scenes.SCENES[name]()
     scene = scenes.SCENES[name](maxh=base.parameters["maxh"] / math.sqrt(factor))
     t_plain = min(plain_solve(scene.mesh) for _ in range(2))
+    control = StepControl(**{**scene.control, "max_steps": steps}) if steps else None
     with tempfile.TemporaryDirectory() as out:
-        result = Simulation(scene, out=out, pictures="none").run()
+        result = Simulation(scene, control, out=out, pictures="none").run()
     s = result.summary
     wall = s["timings"]["wall"]
     linear = s["timings"].get("linear", float("nan"))
-    return {"scene": name, "factor": factor, "ntri": scene.mesh.ne, "reason": result.reason,
+    return {"scene": name, "factor": factor, "ntri": scene.mesh.ne, "reason": result.reason, "max_steps": steps,
             "nsteps": s["n_steps"], "n_split_vertices": s["n_split_vertices"],
             "n_fragments": s["n_fragments"], "phases": s["timings"], "linear": linear,
             "outside_solve_share": 1.0 - s["timings"]["solve"] / wall,
@@ -73,12 +74,15 @@ def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--scenes", nargs="+", default=["plate", "disk"], choices=sorted(scenes.SCENES))
     p.add_argument("--factors", nargs="+", type=int, default=[1, 4, 16])
+    p.add_argument("--steps", type=int, default=None,
+                   help="stop every run after this many steps (for the finest meshes; the "
+                        "shares are then those of the first steps)")
     p.add_argument("--json", default=None, help="also write the JSON to this file")
     args = p.parse_args(argv)
     cases = []
     for name in args.scenes:
         for f in args.factors:
-            cases.append(run_case(name, f))
+            cases.append(run_case(name, f, args.steps))
             print(json.dumps(cases[-1]), file=sys.stderr)
     text = json.dumps({"cases": cases}, indent=2)
     print(text)

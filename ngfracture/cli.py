@@ -104,7 +104,8 @@ def _add_run(subparsers):
                    help="continue the run in DIR from its newest checkpoint; the result equals "
                         "an uninterrupted run")
     p.add_argument("--pictures", choices=["final", "every", "none"], default="final",
-                   help="PNG of the final state (default), of every step, or none")
+                   help="PNG of the final state and the fragment-size plot (default), also of every "
+                        "step, or no pictures")
     p.add_argument("--contact", choices=["auto", "never"], default="auto",
                    help="auto: contact from the first crack on (from the start for separate "
                         "bodies); never: no contact rows (overlap is still measured)")

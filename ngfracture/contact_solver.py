@@ -277,14 +277,14 @@ class ContactSolver:
         forces, g(lam) = q - S lam (S = C K^-1 C^T through the same constrained solver, so
         single-dof rows and the coarse problem of free modes count): a linear
         complementarity problem, which the dual active-set method solves in finitely many
-        steps (see :meth:`kkt.ConstrainedSolver.solve_unilateral`). Dependent candidates are
-        dropped first (S must be regular). Returns pool indices, or None if the problem
-        cannot be solved (then the primal-dual update goes on).
+        steps (see :meth:`kkt.ConstrainedSolver.solve_unilateral`). Candidates may be linearly
+        dependent: at a junction five rows bound the relative motion of three copies (4
+        dofs), and dropping one as dependent would drop its inequality (measured: it came
+        back penetrated by 4e-6 and the set cycled). Returns pool indices, an independent
+        set, or None if the problem cannot be solved (then the primal-dual update goes on).
         """
         t0 = time.perf_counter()
-        cand = candidates[contact.independent_rows(pool.C[candidates], fixed_dofs=fixed, G=self._holds,
-                                                   rtol=self.rank_tol)] \
-            if len(candidates) else candidates
+        cand = candidates
         prob = self.problem
         prob.constraints.clear_rows(LABEL)
         prob.constraints.add_rows(_space_columns(pool.C[cand], nv, n), -pool.g[cand], label=LABEL)
@@ -300,8 +300,11 @@ class ContactSolver:
             result.timings["solve"] += time.perf_counter() - t0
         result.lcp += 1
         # the rows that press and those that touch without force: the latter place pieces
-        # that no force holds where the solution has them (else their modes are frozen)
-        return cand[closed[offset:offset + len(cand)]]
+        # that no force holds where the solution has them (else their modes are frozen);
+        # dependent ones hold with the others, as equalities they would make K singular
+        choice = cand[closed[offset:offset + len(cand)]]
+        return choice[contact.independent_rows(pool.C[choice], fixed_dofs=fixed, G=self._holds,
+                                               rtol=self.rank_tol)] if len(choice) else choice
 
     def _newton(self, result, tangent):
         t0 = time.perf_counter()

@@ -350,6 +350,9 @@ class ConstrainedSolver:
     factor : EliminatedFactor, optional
         A factorisation of K for the same fixed dofs and pins to reuse (then K, the
         solver options and the factorisation cost nothing here).
+    dependent_rows : bool
+        Allow linearly dependent general rows; then only :meth:`solve_unilateral` works
+        (inequalities that are dependent as vectors are still distinct constraints).
 
     Raises
     ------
@@ -363,7 +366,7 @@ class ConstrainedSolver:
     """
 
     def __init__(self, K, fixed_dofs, C, linear_solver="direct", inverse="sparsecholesky", gmres_tol=1e-12,
-                 modes=None, pins=None, factor=None):
+                 modes=None, pins=None, factor=None, dependent_rows=False):
         if factor is None:
             factor = EliminatedFactor(K, fixed_dofs, pins, linear_solver, inverse, gmres_tol)
         elif not factor.matches(np.asarray(fixed_dofs, dtype=np.int64),
@@ -387,13 +390,17 @@ class ConstrainedSolver:
             S = 0.5 * (S + S.T)
             G = (self.C @ self._R).toarray()
             self._S, self._G = S, G       # kept for solve_unilateral
-            coarse = np.block([[S, -G], [-G.T, -A]])
-            # equilibrate, so that the pivot test does not depend on units: S ~ 1/E while
-            # G ~ 1 (measured: E = 5e9 made a regular system look singular, ratio 3e-13)
+            self._coarse = None
             d = np.diag(S)
             d = np.where(d > 0, 1.0 / np.sqrt(np.where(d > 0, d, 1.0)), 1.0)
             gn = np.linalg.norm(d[:, None] * G, axis=0)
             self._scale = np.concatenate([d, np.where(gn > 0, 1.0 / np.where(gn > 0, gn, 1.0), 1.0)])
+            if dependent_rows:
+                return
+            coarse = np.block([[S, -G], [-G.T, -A]])
+            # equilibrated (the scale above), so that the pivot test does not depend on units:
+            # S ~ 1/E while G ~ 1 (measured: E = 5e9 made a regular system look singular,
+            # ratio 3e-13)
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", sla.LinAlgWarning)   # judged by the pivots below
                 self._coarse = sla.lu_factor(self._scale[:, None] * coarse * self._scale[None, :])
@@ -419,7 +426,15 @@ class ConstrainedSolver:
         du : numpy.ndarray (ndof,)
         lam : numpy.ndarray (m,)
             Multipliers of the general rows.
+
+        Raises
+        ------
+        SingularSystem
+            If made with ``dependent_rows=True`` (no coarse factorisation), or if the
+            factorised stiffness fails (see :meth:`EliminatedFactor.solve`).
         """
+        if self.m and self._coarse is None:
+            raise SingularSystem("made with dependent_rows=True: only solve_unilateral is available")
         q, du = self._unconstrained(r, du_fixed)
         lam = np.zeros(self.m)
         if self.m:
@@ -452,6 +467,9 @@ class ConstrainedSolver:
         with b = C (du_fixed + K^+ q) - h, solved exactly by the dual active-set method
         (:func:`ngfracture.qp.convex_qp`); S is positive definite on the null space of G^T
         when the rows are independent and the free modes held, as the constructor checks.
+        With ``dependent_rows`` S is only semidefinite: 1e-10 (relative to its unit
+        diagonal after equilibration) is added to it, which picks the smallest multipliers
+        and lets the gaps miss by about 1e-10 of the displacement scale.
         The modes are the corrected ones (Rt, Gt) but their stiffness A is left out: exact
         when K R = 0; for pressed pieces an approximation, used to choose the active set,
         which :meth:`solve` then imposes exactly.
@@ -486,6 +504,8 @@ class ConstrainedSolver:
         d, gscale = self._scale[:self.m], self._scale[self.m:]
         Gs = d[:, None] * self._G * gscale[None, :]
         H = d[:, None] * self._S * d[None, :] + Gs @ Gs.T
+        if self._coarse is None:
+            H += 1e-10 * np.eye(self.m)
         e = gscale * (self._R.T @ q)
         y, alpha, _, active = convex_qp(H, d * b + Gs @ e, Gs.T, e, -np.eye(self.m)[bounded], np.zeros(bounded.sum()))
         released = np.zeros(self.m, dtype=bool)

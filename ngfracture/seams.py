@@ -33,8 +33,25 @@ every round of a solve:
 
 For small displacements this is the classical node-to-node contact of matching meshes: it
 transmits a uniform pressure exactly (patch test) and converges like the P1 solution.
+
+Junctions: where a point is split into three or more copies (cracks meet, a crack reaches
+a split interface), each copy owns a wedge of the full angle around the point, and a copy
+pair shares at most one facet. For small relative motion r = x_j - x_i of two copies, r
+must stay outside wedge i and -r outside wedge j; the facet rows above state that only in
+part (measured: 3.3e-10 overlap of 2.0 on a zigzag crack pressed by 1e-3, every
+overlapping pair at a three-copy point). Where one wedge of a pair is reflex (wider than
+pi), the other copy must stay in its complement, a convex cone: one row per edge of the
+reflex wedge (exact; the edges shared as facets already have their row), identified by
+(copy, copy, edge) and built at the prediction like the facet rows.
+
+Two convex wedges without a shared facet (the diagonal of a four-way junction) are left
+alone: their exact condition, "outside edge 1 or outside edge 2", is not convex. Tried
+and removed: one row across the separating line of widest margin. It is conservative and
+holds the two pieces apart when the pieces between them leave, which over-constrains:
+tutorial 5's beam stopped with an active set that did not settle and the disk with
+diverging Newton solves, both of which ran to the end without it.
 """
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -62,10 +79,14 @@ class Seams:
         copies of a split junction vertex).
     seam_edge : set of (int, int)
         Both lips' edges as sorted vertex pairs.
+    edge_rows : numpy.ndarray of int, shape (k, 4)
+        (owner, other, tail, head): at a junction, copy ``other`` stays outside boundary
+        segment tail -> head of the reflex wedge of copy ``owner`` (owner is tail or head).
     """
     facets: np.ndarray
     copy_id: np.ndarray
     seam_edge: set
+    edge_rows: np.ndarray = field(default_factory=lambda: np.zeros((0, 4), dtype=np.int64))
 
     def __len__(self):
         return len(self.facets)
@@ -105,7 +126,57 @@ def find_seams(points, segments):
     a, b = a[keep], b[keep]
     facets = np.column_stack([S[a, 0], S[a, 1], S[b, 1], S[b, 0]])
     edges = np.sort(np.vstack([S[a], S[b]]), axis=1) if len(a) else np.zeros((0, 2), np.int64)
-    return Seams(facets=facets, copy_id=copy_id, seam_edge=set(map(tuple, edges.tolist())))
+    return Seams(facets=facets, copy_id=copy_id, seam_edge=set(map(tuple, edges.tolist())),
+                 edge_rows=_reflex_edge_rows(X, S, copy_id, facets))
+
+
+def _copy_pairs(copy_id, candidates):
+    """All pairs (i < j) of the candidate vertices with the same copy id."""
+    order = candidates[np.lexsort((candidates, copy_id[candidates]))]
+    pairs = []
+    for d in range(1, len(order)):
+        same = copy_id[order[d:]] == copy_id[order[:-d]]
+        if not same.any():
+            break            # sorted by id: no group has more than d members
+        pairs.append(np.column_stack([order[:-d][same], order[d:][same]]))
+    return np.vstack(pairs) if pairs else np.zeros((0, 2), dtype=np.int64)
+
+
+def _reflex_edge_rows(X, S, copy_id, facets):
+    """The edge rows of :class:`Seams`: (owner, other, tail, head), see the module notes."""
+    nv = len(X)
+    none = np.zeros((0, 4), dtype=np.int64)
+    if len(S) == 0:
+        return none
+    # the wedge of a copy lies between its one outgoing and one incoming boundary segment
+    out_end, in_start = np.full(nv, -1), np.full(nv, -1)
+    out_end[S[:, 0]], in_start[S[:, 1]] = S[:, 1], S[:, 0]
+    simple = (np.bincount(S[:, 0], minlength=nv) == 1) & (np.bincount(S[:, 1], minlength=nv) == 1)
+    counts = np.bincount(copy_id)
+    P = _copy_pairs(copy_id, np.flatnonzero(simple & (counts[copy_id] >= 2)))
+    if len(P) == 0:
+        return none
+    # the copy across each vertex's outgoing / incoming segment, where that is a facet
+    out_twin, in_twin = np.full(nv, -1), np.full(nv, -1)
+    p, q, p2, q2 = facets.T
+    out_twin[p], in_twin[q], in_twin[p2], out_twin[q2] = p2, q2, p, q
+    reflex = _wedge_width(X, out_end, in_start) > np.pi + KINK_ANGLE
+    rows = []
+    for owner, other in (P.T, P[:, ::-1].T):
+        r = reflex[owner]
+        o, t = owner[r], other[r]
+        rows.append(np.column_stack([o, t, o, out_end[o]])[out_twin[o] != t])
+        rows.append(np.column_stack([o, t, in_start[o], o])[in_twin[o] != t])
+    return np.vstack(rows).astype(np.int64)
+
+
+def _wedge_width(x, out_end, in_start):
+    """Counter-clockwise angle (0, 2 pi] of every vertex's wedge (-1 ends: meaningless)."""
+    v = np.arange(len(x))
+    a = x[out_end] - x[v]
+    b = x[in_start] - x[v]
+    width = np.mod(np.arctan2(b[:, 1], b[:, 0]) - np.arctan2(a[:, 1], a[:, 0]), 2 * np.pi)
+    return np.where(width == 0.0, 2 * np.pi, width)
 
 
 def seam_constraints(seams, points, displacement, kink_angle=KINK_ANGLE, slip=SLIP):
@@ -126,15 +197,26 @@ def seam_constraints(seams, points, displacement, kink_angle=KINK_ANGLE, slip=SL
     Returns
     -------
     rows : ContactConstraints
-        a = c = the lower-numbered twin (master), slave = the other, xi = 1, normal from
-        the master's lip towards the slave's, dist the gap at the given configuration;
-        master_tri, slave_tri and pair are -1.
+        Facet rows: a = c = the lower-numbered twin (master), slave = the other, normal
+        from the master's lip towards the slave's. Junction rows: master the owner of the
+        reflex wedge. xi = 1, dist the
+        gap at the given configuration; master_tri, slave_tri and pair are -1.
     keys : numpy.ndarray of int, shape (m, 3)
-        (master, slave, facet) identifying each row; facet is -1 for the merged row of a
-        straight node. The same seams give the same keys in every configuration.
+        (lower vertex, higher vertex, kind) identifying each row: kind is the facet, -1 for
+        the merged row of a straight node, -3 - v for the edge row of the reflex wedge's
+        edge ending in v. The same seams give the same keys in every
+        configuration.
     """
     X = np.asarray(points, dtype=np.float64)
     x = X + np.asarray(displacement, dtype=np.float64)
+    parts = [_facet_rows(seams, X, x, kink_angle, slip), _edge_rows(seams, X, x, slip)]
+    master, slave, key3, normal = (np.concatenate([part[k] for part in parts]) for k in range(4))
+    keys = np.column_stack([np.minimum(master, slave), np.maximum(master, slave), key3]).astype(np.int64)
+    return _rows(X, x, master, slave, normal.reshape(-1, 2)), keys
+
+
+def _facet_rows(seams, X, x, kink_angle, slip):
+    """Rows at the facet ends: (master, slave, facet or -1, normal), master the lower twin."""
     F = seams.facets
     # every facet end with distinct twins: (b, b2, facet)
     ends = np.vstack([np.column_stack([F[:, 0], F[:, 2], np.arange(len(F))]),
@@ -142,15 +224,12 @@ def seam_constraints(seams, points, displacement, kink_angle=KINK_ANGLE, slip=SL
     ends = ends[ends[:, 0] != ends[:, 1]]
     if len(ends) == 0:
         e = np.zeros(0, dtype=np.int64)
-        return _rows(X, x, e, e, np.zeros((0, 2))), np.zeros((0, 3), dtype=np.int64)
+        return e, e, e, np.zeros((0, 2))
     p, q, p2, q2 = F.T
-
-    def rot(v):                                   # outward normal of an edge of side A
-        return np.column_stack([v[:, 1], -v[:, 0]])
-    n_ref = rot(X[q] - X[p])
+    n_ref = _outward(X[q] - X[p])
     length = np.linalg.norm(n_ref, axis=1)
     n_ref /= length[:, None]
-    n_cur = rot((x[q] - x[p]) + (x[q2] - x[p2]))
+    n_cur = _outward((x[q] - x[p]) + (x[q2] - x[p2]))
     n_cur /= np.linalg.norm(n_cur, axis=1)[:, None]
     # orient every end as (low vertex, high vertex) so both facets of a node pair agree
     b, b2, f = ends.T
@@ -174,12 +253,29 @@ def seam_constraints(seams, points, displacement, kink_angle=KINK_ANGLE, slip=SL
     np.minimum.at(size, group, ln)
     lo, hi = lo[first], hi[first]
     facet = np.where(merged[first], -1, f[first])
-    # twins still facing each other
-    rel = x[hi] - x[lo]
-    slid = np.abs(rel[:, 0] * normal[:, 1] - rel[:, 1] * normal[:, 0])
-    ok = slid <= slip * size
-    lo, hi, facet, normal = lo[ok], hi[ok], facet[ok], normal[ok]
-    return _rows(X, x, lo, hi, normal), np.column_stack([lo, hi, facet]).astype(np.int64)
+    ok = _facing(x, lo, hi, normal, slip * size)
+    return lo[ok], hi[ok], facet[ok], normal[ok]
+
+
+def _edge_rows(seams, X, x, slip):
+    """Junction rows of a reflex wedge: the other copy outside the edge tail -> head."""
+    owner, other, tail, head = seams.edge_rows.T
+    normal = _outward(x[head] - x[tail])
+    normal /= np.maximum(np.linalg.norm(normal, axis=1), 1e-300)[:, None]
+    far = np.where(tail == owner, head, tail)
+    ok = _facing(x, owner, other, normal, slip * np.linalg.norm(X[head] - X[tail], axis=1))
+    return owner[ok], other[ok], -3 - far[ok], normal[ok]
+
+
+def _outward(v):
+    """The normal of segments v with the domain on their left (v rotated clockwise)."""
+    return np.column_stack([v[:, 1], -v[:, 0]])
+
+
+def _facing(x, master, slave, normal, reach):
+    """Rows whose nodes slid tangentially by at most reach (still facing each other)."""
+    rel = x[slave] - x[master]
+    return np.abs(rel[:, 0] * normal[:, 1] - rel[:, 1] * normal[:, 0]) <= reach
 
 
 def _rows(X, x, master, slave, normal):

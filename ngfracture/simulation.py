@@ -13,9 +13,12 @@ One load step, from an accepted state (mesh, displacement, load parameter x)::
        row without a crack, dx = min(dx * grow, dx_max).
 
 A failed solve (diverged, NaN, singular, inverted element, contact set that does not
-settle) sends the step back to the saved state: a failure of the increment solve is
-retried with the same target in twice as many Newton load steps (the load path does not
-change), a failure at fixed load after a split with dx * cut; after ``max_retries``
+settle) sends the step back to the saved state: with modified Newton, the first retry
+solves the same attempt with full Newton (the tangent factorised at the start of a solve
+can be too far from the state that new contact rows impose: measured on the disk, Newton
+diverged with the saved tangent and converged with fresh ones); then a failure of the
+increment solve is retried with the same target in twice as many Newton load steps (the
+load path does not change), a failure at fixed load after a split with dx * cut; after ``max_retries``
 failures the run stops with the last good state written and a reason.  The run ends when x reaches the scene's ``load_max``, after ``max_steps``
 steps, or, for scenes that ask for it, once the body is broken through (the elastic
 energy has fallen below ``unloaded_fraction`` of its peak after cracks appeared).
@@ -177,7 +180,8 @@ class StepControl:
     max_relax_passes : int
         Crack passes at fixed load at most (a bound, not a tuning knob).
     method : {"modified", "full"}
-        Newton variant (paper: modified, tangent factorised once per load step).
+        Newton variant (paper: modified, tangent factorised once per load step). A step
+        whose modified Newton solve fails is retried with full Newton first.
     tol : float
         Newton tolerance of eq. 7.
     maxit : int
@@ -321,7 +325,8 @@ class Simulation:
     resume : bool
         Continue from the newest checkpoint in ``out``.
     pictures : {"final", "every", "none"}
-        PNG of the final state, of every step, or none.
+        PNG of the final state (and the fragment-size plot), of every step too, or no
+        picture at all.
     checkpoint_every : int
         Write a checkpoint after every this many accepted steps (and at the end).
     progress : callable(dict), optional
@@ -346,6 +351,7 @@ class Simulation:
         self.scene = scene
         self.critical = scene.validate()
         self.control = control if control is not None else StepControl(**scene.control)
+        self._method = self.control.method      # the Newton variant of the current attempt
         self.control.validate(scene.dx)
         if pictures not in ("final", "every", "none"):
             raise ValueError(f"pictures must be 'final', 'every' or 'none', got {pictures!r}")
@@ -444,7 +450,7 @@ class Simulation:
     def _equilibrium(self, prob, phase, substeps=1):
         """Solve in ``substeps`` load steps; raise StepFailed(reason, phase) if it does not converge."""
         c = self.control
-        options = dict(method=c.method, tol=c.tol, maxit=c.maxit, load_steps=substeps)
+        options = dict(method=self._method, tol=c.tol, maxit=c.maxit, load_steps=substeps)
         if self._needs_contact(prob.mesh):
             solver = ContactSolver(prob, tol=self.scene.contact_tol,   # its tol: detection threshold
                                    fix_free_modes=self.scene.fix_free_modes)
@@ -558,7 +564,7 @@ class Simulation:
                   "released_energy": state.work + dwork - energy, "crack_length": crack_len,
                   "fragments": int(stats.count), "newton_iterations": int(self._iterations),
                   "retries": int(self._retries), "failures": list(self._failures),
-                  "substeps": int(self._substeps), "relax_passes": max(len(self._split_positions) - 1, 0)}
+                  "substeps": int(self._substeps), "method": self._method, "relax_passes": max(len(self._split_positions) - 1, 0)}
         if first and not any(h["split_vertices"] for h in state.history):
             # where cracking began: the vertices split by the first pass that split any
             record["initiation"] = self._split_positions[0].tolist()
@@ -581,7 +587,8 @@ class Simulation:
     def _step(self, state, dx):
         """Attempts of one step until one is accepted: (attempt, dx, None) or (None, dx, last failure).
 
-        Too many cracks: dx * cut. A failed solve of the increment: the same target in twice
+        Too many cracks: dx * cut. A failed solve with modified Newton: the same attempt with
+        full Newton (from then on for this step). A failed solve of the increment: the same target in twice
         as many substeps (load steps of the Newton solver, no crack pass between them), so
         a passing trouble does not change the load path. A failed solve at fixed load
         (relaxation on a split mesh): dx * cut, substeps reset. Every attempt starts from
@@ -589,6 +596,7 @@ class Simulation:
         """
         c = self.control
         self._retries, self._failures, substeps = 0, [], 1
+        self._method = c.method
         while True:
             self._iterations = 0
             try:
@@ -598,7 +606,9 @@ class Simulation:
                 self._failures.append(err.reason)
                 if self._retries > c.max_retries:
                     return None, dx, err
-                if err.phase == "increment":
+                if self._method == "modified":
+                    self._method = "full"           # the same attempt with fresh tangents
+                elif err.phase == "increment":
                     substeps *= 2
                 elif dx * c.cut >= c.dx_min:
                     dx, substeps = dx * c.cut, 1
@@ -751,8 +761,9 @@ class Simulation:
                 pictures["displacement_scale"] = scale
             except RenderError as err:
                 pictures["final_error"] = str(err)
-        plot_fragment_sizes(stats.areas, self.out / "fragment_sizes.png", force=True)
-        pictures["fragment_sizes"] = "fragment_sizes.png"
+            # matplotlib's import and first figure cost 2-3 s, a fifth of a plate run
+            plot_fragment_sizes(stats.areas, self.out / "fragment_sizes.png", force=True)
+            pictures["fragment_sizes"] = "fragment_sizes.png"
         self.timings["output"] += time.perf_counter() - t0
         summary["timings"]["output"] = round(self.timings["output"], 6)
         summary["pictures"] = pictures

@@ -63,8 +63,9 @@ def disk_run():
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason="open (issue 4): grains pressed outward into the ring overlap it "
-                   "across circumferential crack seams: measured 7.2e-7 = 2.3e-7 of the area, 137 pairs")
+@pytest.mark.xfail(strict=True, reason="known weakness: 8.2e-7 (2.7e-7 of the area) in 38 triangle pairs, all "
+                   "at four-copy points across the diagonal (copies without a shared facet, which get no "
+                   "row: their exact condition is not convex; see ngfracture.seams)")
 def test_disk_contact_leaves_no_overlap(disk_run):
     s = disk_run.summary
     assert s["max_overlap_area"] <= 1e-10 * s["area_initial"]
@@ -72,7 +73,15 @@ def test_disk_contact_leaves_no_overlap(disk_run):
 
 @pytest.mark.slow
 def test_disk_comminuted_zone_and_intact_ring(disk_run):
-    """Measured at maxh 0.06: 92 steps, 219 split vertices, 21 grains (centroids r <= 0.36)."""
+    """The issue's requirement: more than 20 grains, and an intact outer ring (one piece
+    that holds the whole outer boundary and still goes around the hole).
+
+    Measured at maxh 0.06: 92 steps, 253 split vertices, 25 grains with centroids at
+    r <= 0.63 of R = 1. The bound on the grains' radius was 0.6, fitted to an earlier run
+    (grains up to 0.36); since the junction contact rows a few grains also break off along
+    the radial cracks, and the bound is now the inner three quarters, with the intact
+    outer boundary checked directly.
+    """
     result = disk_run
     assert result.ok and result.reason == "load_max", result.message
     s = result.summary
@@ -83,22 +92,27 @@ def test_disk_comminuted_zone_and_intact_ring(disk_run):
     on_disk = [f for f in stats.ids if np.all(a.regions[stats.fragment == f] == disk_region)]
     ring = max(on_disk, key=lambda f: stats.areas[np.searchsorted(stats.ids, f)])
     grains = [f for f in on_disk if f != ring]
-    # the comminuted zone: more than 20 grains, all inside the inner half of the disk
     assert len(grains) > 20, len(grains)
-    centroid_r = np.hypot(*stats.centroids[np.searchsorted(stats.ids, grains)].T)
-    assert centroid_r.max() < 0.6
-    # the outer ring is one piece that still goes around the hole
+    # the outer ring is one piece: every triangle on the outer boundary belongs to it ...
+    outer = a.segments[a.seg_bc == a.bc_names.index("outer") + 1]
+    on_outer = np.flatnonzero(np.isin(a.triangles, outer).sum(axis=1) >= 2)
+    assert len(on_outer) >= len(outer) and np.all(stats.fragment[on_outer] == ring)
+    # ... and it still goes around the hole
     assert encircles_origin(a.triangles, a.points, np.flatnonzero(stats.fragment == ring))
+    # the grains lie inside the ring: nearer the hole than the outer boundary (r = 1)
+    centroid_r = np.hypot(*stats.centroids[np.searchsorted(stats.ids, grains)].T)
+    assert centroid_r.max() < 0.75
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason="open (issue 5): at maxh 0.08 the disk falls apart into 19 pieces, "
-                   "none around the hole, then step 77 (x = 0.00453 of 0.00777) fails after 5 retries "
-                   "(max_iterations); 849 s")
 def test_disintegration_many_disjoint_fragments():
+    """Measured at maxh 0.08: 119 steps to the final load, 311 split vertices, 37 pieces of
+    the disk, none around the hole, overlap 1.8e-16; 1639 s on a loaded machine.
+    (Before the junction contact rows: step 77 failed after 5 retries, 19 pieces.)"""
     result = Simulation(scenes.disintegration(maxh=0.08), pictures="none").run()
-    assert result.ok, result.message
+    assert result.ok and result.reason == "load_max", result.message
     s = result.summary
+    assert s["max_overlap_area"] <= 1e-10 * s["area_initial"]
     stats = FragmentStatistics(result.problem.mesh)
     a = result.state.arrays
     disk_region = a.region_names.index("disk") + 1
