@@ -105,10 +105,13 @@ def test_disk_comminuted_zone_and_intact_ring(disk_run):
 
 
 @pytest.mark.slow
+@pytest.mark.xfail(strict=True, reason="open (issue 5): at maxh 0.08 the disk falls apart into 19 pieces, none "
+                   "around the hole, then step 75 (x = 0.00457 of 0.00777) fails after 7 retries (full Newton, "
+                   "up to 32 load steps: max_iterations, relative increment 3e-6)")
 def test_disintegration_many_disjoint_fragments():
-    """Measured at maxh 0.08: 119 steps to the final load, 311 split vertices, 37 pieces of
-    the disk, none around the hole, overlap 1.8e-16; 1639 s on a loaded machine.
-    (Before the junction contact rows: step 77 failed after 5 retries, 19 pieces.)"""
+    """Measured with an experimental separating-line row at four-way junctions (removed,
+    see ngfracture.seams): 119 steps to the final load, 311 split vertices, 37 pieces of the
+    disk, none around the hole, overlap 1.8e-16, 1639 s."""
     result = Simulation(scenes.disintegration(maxh=0.08), pictures="none").run()
     assert result.ok and result.reason == "load_max", result.message
     s = result.summary
