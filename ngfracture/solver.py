@@ -163,7 +163,7 @@ class NewtonSolver:
         "full" at every iterate (quadratic convergence).
     tol : float
         Relative increment tolerance of eq. 7. An increment that has stopped falling
-        (not below half the smallest of the three before it) below 1e3 tol counts as
+        (not below the smallest of the three before it) below 1e3 tol counts as
         converged too: rounding, not the method, sets that floor.
     maxit : int
         Maximum iterations per load step.
@@ -421,7 +421,7 @@ class NewtonSolver:
             # below anything physical (measured: modified Newton with many contact rows
             # stagnated at 9.8e-10 for 60 iterations and the disintegration run stopped)
             hist = status.increment_history
-            stalled = ratio < 1e3 * self.tol and len(hist) >= 4 and ratio >= 0.5 * min(hist[-4:-1])
+            stalled = ratio < 1e3 * self.tol and len(hist) >= 4 and ratio >= min(hist[-4:-1])
             if ratio < self.tol or norm == 0.0 or exact or rounding or stalled:
                 status.converged, status.reason = True, "converged"
                 status.message = f"stalled at relative increment {ratio:.1e}" if stalled and ratio >= self.tol else ""

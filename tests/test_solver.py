@@ -393,3 +393,32 @@ def test_3d_mesh_is_refused():
     mesh3d = ng.Mesh(unit_cube.GenerateMesh(maxh=0.5))
     with pytest.raises(ValueError, match="2D meshes; this mesh has dimension 3"):
         nf.ElasticProblem(mesh3d, nf.LinearElastic(1.0, 0.3))
+
+
+@pytest.mark.parametrize("noise, converges", [(1e-9, True), (1e-5, False)])
+def test_stall_at_the_rounding_floor(noise, converges, monkeypatch):
+    """A residual with noise of relative size `noise` (as rounding in a badly conditioned
+    contact solve): full Newton stalls at about that relative increment. Below 1e3 tol the
+    stall counts as converged and the state is the clean solution to about the noise;
+    above, it is max_iterations as before."""
+    clean = stretch_problem(nf.StVenantKirchhoff, stretch=0.1)
+    assert clean.solve(method="full", tol=1e-12).converged
+    prob = stretch_problem(nf.StVenantKirchhoff, stretch=0.1)
+    true_residual = prob.out_of_balance
+    reactions = clean.out_of_balance()          # the force scale: the reactions of the solution
+    scale = np.linalg.norm(reactions) / math.sqrt(reactions.size)
+    calls = []
+
+    def noisy():
+        calls.append(1)
+        r = true_residual()
+        return r + noise * scale * np.random.default_rng(len(calls)).standard_normal(r.size)
+    monkeypatch.setattr(prob, "out_of_balance", noisy)
+    status = prob.solve(method="full", tol=1e-10, maxit=30)
+    if converges:
+        assert status.converged and status.message.startswith("stalled"), status.increment_history
+        assert 1e-10 <= status.increment_history[-1] < 1e-7
+        u, u0 = prob.u.vec.FV().NumPy(), clean.u.vec.FV().NumPy()
+        assert np.abs(u - u0).max() <= 1e3 * noise * np.abs(u0).max()
+    else:
+        assert status.reason == "max_iterations", (status.reason, status.increment_history)
