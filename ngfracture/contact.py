@@ -427,10 +427,9 @@ def independent_rows(C, fixed_dofs=None, G=None, rtol=1e-8, method="auto", dense
         pattern.data = np.ones_like(pattern.data)
         order = reverse_cuthill_mckee(sp.csr_matrix(pattern @ pattern.T), symmetric_mode=True)
         position[order] = np.arange(len(alive))
-    ndof = n
     code = {"auto": 0, "pivoted": 1, "banded": 2}[method]
     kept = _ext.IndependentRowsSparse(
-        ndof, Ca.indptr.astype(np.int64), Ca.indices.astype(np.int32), Ca.data,
+        n, Ca.indptr.astype(np.int64), Ca.indices.astype(np.int32), Ca.data,
         lab_c[alive].astype(np.int32), position, Gn.indptr.astype(np.int64),
         Gn.indices.astype(np.int32), Gn.data, lab_g.astype(np.int32), float(rtol), code,
         int(dense_limit))

@@ -284,15 +284,14 @@ class ContactSolver:
         set, or None if the problem cannot be solved (then the primal-dual update goes on).
         """
         t0 = time.perf_counter()
-        cand = candidates
         prob = self.problem
         prob.constraints.clear_rows(LABEL)
-        prob.constraints.add_rows(_space_columns(pool.C[cand], nv, n), -pool.g[cand], label=LABEL)
+        prob.constraints.add_rows(_space_columns(pool.C[candidates], nv, n), -pool.g[candidates], label=LABEL)
         offset = self._contact_offset()
         options = {k: v for k, v in self.options.items() if k != "load_steps"}
         try:
             _, closed = NewtonSolver(prob, tangent=tangent, **options).unilateral_multipliers(
-                np.arange(offset, offset + len(cand)))
+                np.arange(offset, offset + len(candidates)))
         except (SingularSystem, QPError, np.linalg.LinAlgError):
             return None
         finally:
@@ -302,7 +301,7 @@ class ContactSolver:
         # the rows that press and those that touch without force: the latter place pieces
         # that no force holds where the solution has them (else their modes are frozen);
         # dependent ones hold with the others, as equalities they would make K singular
-        choice = cand[closed[offset:offset + len(cand)]]
+        choice = candidates[closed[offset:offset + len(candidates)]]
         return choice[contact.independent_rows(pool.C[choice], fixed_dofs=fixed, G=self._holds,
                                                rtol=self.rank_tol)] if len(choice) else choice
 

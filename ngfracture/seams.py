@@ -160,7 +160,9 @@ def _reflex_edge_rows(X, S, copy_id, facets):
     out_twin, in_twin = np.full(nv, -1), np.full(nv, -1)
     p, q, p2, q2 = facets.T
     out_twin[p], in_twin[q], in_twin[p2], out_twin[q2] = p2, q2, p, q
-    reflex = _wedge_width(X, out_end, in_start) > np.pi + KINK_ANGLE
+    reflex = np.zeros(nv, dtype=bool)
+    copies = np.unique(P)
+    reflex[copies] = _wedge_width(X, copies, out_end, in_start) > np.pi + KINK_ANGLE
     rows = []
     for owner, other in (P.T, P[:, ::-1].T):
         r = reflex[owner]
@@ -170,11 +172,10 @@ def _reflex_edge_rows(X, S, copy_id, facets):
     return np.vstack(rows).astype(np.int64)
 
 
-def _wedge_width(x, out_end, in_start):
-    """Counter-clockwise angle (0, 2 pi] of every vertex's wedge (-1 ends: meaningless)."""
-    v = np.arange(len(x))
-    a = x[out_end] - x[v]
-    b = x[in_start] - x[v]
+def _wedge_width(x, v, out_end, in_start):
+    """Counter-clockwise angle (0, 2 pi] of the wedges of vertices v (one segment out, one in)."""
+    a = x[out_end[v]] - x[v]
+    b = x[in_start[v]] - x[v]
     width = np.mod(np.arctan2(b[:, 1], b[:, 0]) - np.arctan2(a[:, 1], a[:, 0]), 2 * np.pi)
     return np.where(width == 0.0, 2 * np.pi, width)
 
@@ -199,13 +200,12 @@ def seam_constraints(seams, points, displacement, kink_angle=KINK_ANGLE, slip=SL
     rows : ContactConstraints
         Facet rows: a = c = the lower-numbered twin (master), slave = the other, normal
         from the master's lip towards the slave's. Junction rows: master the owner of the
-        reflex wedge. xi = 1, dist the
-        gap at the given configuration; master_tri, slave_tri and pair are -1.
+        reflex wedge. xi = 1, dist the gap at the given configuration; master_tri,
+        slave_tri and pair are -1.
     keys : numpy.ndarray of int, shape (m, 3)
         (lower vertex, higher vertex, kind) identifying each row: kind is the facet, -1 for
         the merged row of a straight node, -3 - v for the edge row of the reflex wedge's
-        edge ending in v. The same seams give the same keys in every
-        configuration.
+        edge ending in v. The same seams give the same keys in every configuration.
     """
     X = np.asarray(points, dtype=np.float64)
     x = X + np.asarray(displacement, dtype=np.float64)
