@@ -87,7 +87,9 @@ class ContactResult:
         The last Newton solve (its reason says why a failure happened).
     converged : bool
     reason : str
-        "converged", a Newton reason, or "active_set" if the set did not settle.
+        "converged", a Newton reason, "active_set" if the set did not settle, or
+        "penetration" if the rows, re-linearised ``max_updates`` times at a settled set,
+        still penetrate by more than ``penetration_tol`` (``max_penetration`` says how much).
     rounds : int
         Detect-and-solve rounds.
     constraints : contact.ContactConstraints
@@ -159,7 +161,8 @@ class ContactSolver:
         in the displacement (measured 1.6e-9 of the area on the plate scene, from a free
         one-triangle fragment sliding along its seams). When the true gaps at the
         solution penetrate by more than penetration_tol, the rows are linearised again
-        there (same rows, current normals and projections) and the solve repeated.
+        there (same rows, current normals and projections) and the solve repeated; after
+        ``max_updates`` such repetitions the solve fails with reason "penetration".
     kink_angle : float
         Seam facets meeting at a larger angle (radians, in the reference configuration)
         get a row each at their common node (see :mod:`ngfracture.seams`). The default
@@ -323,8 +326,10 @@ class ContactSolver:
         Returns
         -------
         ContactResult
-            Converged, or reason: the Newton reason of a failed solve, or "active_set" when
-            ``max_rounds`` rounds passed without a settled set. Failures are not raised.
+            Converged, or reason: the Newton reason of a failed solve, "active_set" when
+            ``max_rounds`` rounds passed without a settled set, "penetration" when the
+            settled rows still overlap after ``max_updates`` re-linearisations. Failures
+            are not raised.
         """
         prob = self.problem
         prob.constraints.clear_rows(LABEL)
@@ -351,6 +356,7 @@ class ContactSolver:
         imposed = set()                         # every set imposed so far
         tried = set()                           # every row imposed so far
         exact = False                           # the complementarity problem chooses the set
+        force_scale = 0.0                       # the largest force of any round so far
         for rnd in range(1, self.max_rounds + 1):
             result.rounds = rnd
             t0 = time.perf_counter()
@@ -405,9 +411,15 @@ class ContactSolver:
                 gap = fresh.C @ U.T.ravel() + fresh.g
                 penetration = float(max(0.0, -gap[other].min(initial=0.0)))
                 result.timings["contact"] += time.perf_counter() - t0
-                if penetration <= self.penetration_tol or result.updates == self.max_updates:
+                result.max_penetration = penetration
+                if penetration <= self.penetration_tol:
                     result.converged, result.reason = True, "converged"
-                    result.max_penetration = penetration
+                    return result
+                if result.updates == self.max_updates:
+                    # the linearisations do not converge to a state without overlap (large
+                    # relative motion for one solve): a failure, which a caller cures with
+                    # a smaller step, not an overlap passed off as a solution
+                    result.reason = "penetration"
                     return result
                 # a geometric fixed point: solve again with the rows linearised here
                 # (the overlap falls from second to fourth order in the displacement)
@@ -427,11 +439,14 @@ class ContactSolver:
                 return result
             offset = self._contact_offset()
             multipliers = status.multipliers[offset:offset + len(cs)]
-            # adhesive beyond rounding: relative to the largest force the constraints carry
+            # adhesive beyond rounding: relative to the largest force the constraints carried
+            # in any round of this solve. A set that lets the pieces drift apart carries no
+            # force at all; its multipliers are rounding noise of either sign, and measured
+            # against themselves they made the set cycle (tutorial 5's broken beam).
             r = tangent.residual[2]     # the out-of-balance where the solve ended
-            scale = max(float(np.abs(multipliers).max(initial=0.0)),
-                        float(np.linalg.norm(r[fixed_all])), 1e-300)
-            rounded = np.where(np.abs(multipliers) <= 1e-10 * scale, 0.0, multipliers)
+            force_scale = max(force_scale, float(np.abs(multipliers).max(initial=0.0)),
+                              float(np.linalg.norm(r[fixed_all])))
+            rounded = np.where(np.abs(multipliers) <= 1e-10 * force_scale, 0.0, multipliers)
             result.released += int(np.count_nonzero(rounded > 0))
             lam = {keys[i]: x for i, x in zip(kept.tolist(), rounded.tolist())}
             result.constraints, result.multipliers = cs, multipliers

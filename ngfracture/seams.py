@@ -44,12 +44,17 @@ pi), the other copy must stay in its complement, a convex cone: one row per edge
 reflex wedge (exact; the edges shared as facets already have their row), identified by
 (copy, copy, edge) and built at the prediction like the facet rows.
 
-Two convex wedges without a shared facet (the diagonal of a four-way junction) are left
-alone: their exact condition, "outside edge 1 or outside edge 2", is not convex. Tried
-and removed: one row across the separating line of widest margin. It is conservative and
-holds the two pieces apart when the pieces between them leave, which over-constrains:
-tutorial 5's beam stopped with an active set that did not settle and the disk with
-diverging Newton solves, both of which ran to the end without it.
+Two convex wedges without a shared facet (the diagonal of a four-way junction): r must
+stay outside the cone K = W_i - W_j (convex, narrower than pi, because the wedges were
+disjoint), i.e. beyond one of K's two edges. That is not convex. At the prediction we
+take the edge of K with the larger signed distance of r (the least penetration if r is
+inside K): one row, frozen for the solve like the other seam rows and identified by
+(copy, copy, side of K) so that re-linearisation keeps the choice. Exact while r stays
+on that side; the pieces may slide along the chosen edge both ways and separate freely
+(`tests/test_seams.py`: shear along a crack through a cross junction in either
+direction). Tried before and removed: one row across the separating line of widest
+margin (a normal anywhere between K's edge normals; one strictly between them blocks
+sliding along either crack one way), and tutorial 5's beam and the disk stopped early.
 """
 from dataclasses import dataclass, field
 
@@ -61,6 +66,8 @@ __all__ = ["Seams", "find_seams", "seam_constraints", "KINK_ANGLE", "SLIP"]
 
 #: facets meeting at a larger angle (radians) get a row each at their common node
 KINK_ANGLE = 1e-6
+#: key kinds of the rows of a diagonal pair: the right edge of K, and the left one is one less
+DIAGONAL_RIGHT = -(2 ** 40)
 #: rows are used while the tangential slip of the twins is below this fraction of the facet
 SLIP = 0.5
 
@@ -82,11 +89,15 @@ class Seams:
     edge_rows : numpy.ndarray of int, shape (k, 4)
         (owner, other, tail, head): at a junction, copy ``other`` stays outside boundary
         segment tail -> head of the reflex wedge of copy ``owner`` (owner is tail or head).
+    diagonal : numpy.ndarray of int, shape (k, 6)
+        (i, j, out_i, in_i, out_j, in_j): copies i < j with convex wedges and no shared
+        facet, with the far ends of their outgoing and incoming boundary segments.
     """
     facets: np.ndarray
     copy_id: np.ndarray
     seam_edge: set
     edge_rows: np.ndarray = field(default_factory=lambda: np.zeros((0, 4), dtype=np.int64))
+    diagonal: np.ndarray = field(default_factory=lambda: np.zeros((0, 6), dtype=np.int64))
 
     def __len__(self):
         return len(self.facets)
@@ -126,8 +137,9 @@ def find_seams(points, segments):
     a, b = a[keep], b[keep]
     facets = np.column_stack([S[a, 0], S[a, 1], S[b, 1], S[b, 0]])
     edges = np.sort(np.vstack([S[a], S[b]]), axis=1) if len(a) else np.zeros((0, 2), np.int64)
+    edge_rows, diagonal = _junctions(X, S, copy_id, facets)
     return Seams(facets=facets, copy_id=copy_id, seam_edge=set(map(tuple, edges.tolist())),
-                 edge_rows=_reflex_edge_rows(X, S, copy_id, facets))
+                 edge_rows=edge_rows, diagonal=diagonal)
 
 
 def _copy_pairs(copy_id, candidates):
@@ -142,10 +154,10 @@ def _copy_pairs(copy_id, candidates):
     return np.vstack(pairs) if pairs else np.zeros((0, 2), dtype=np.int64)
 
 
-def _reflex_edge_rows(X, S, copy_id, facets):
-    """The edge rows of :class:`Seams`: (owner, other, tail, head), see the module notes."""
+def _junctions(X, S, copy_id, facets):
+    """The ``edge_rows`` and ``diagonal`` of :class:`Seams`, see the module notes."""
     nv = len(X)
-    none = np.zeros((0, 4), dtype=np.int64)
+    none = np.zeros((0, 4), dtype=np.int64), np.zeros((0, 6), dtype=np.int64)
     if len(S) == 0:
         return none
     # the wedge of a copy lies between its one outgoing and one incoming boundary segment
@@ -169,7 +181,11 @@ def _reflex_edge_rows(X, S, copy_id, facets):
         o, t = owner[r], other[r]
         rows.append(np.column_stack([o, t, o, out_end[o]])[out_twin[o] != t])
         rows.append(np.column_stack([o, t, in_start[o], o])[in_twin[o] != t])
-    return np.vstack(rows).astype(np.int64)
+    i, j = P.T
+    apart = ~reflex[i] & ~reflex[j] & (out_twin[i] != j) & (in_twin[i] != j)
+    i, j = i[apart], j[apart]
+    diagonal = np.column_stack([i, j, out_end[i], in_start[i], out_end[j], in_start[j]])
+    return np.vstack(rows).astype(np.int64), diagonal.astype(np.int64)
 
 
 def _wedge_width(x, v, out_end, in_start):
@@ -180,7 +196,7 @@ def _wedge_width(x, v, out_end, in_start):
     return np.where(width == 0.0, 2 * np.pi, width)
 
 
-def seam_constraints(seams, points, displacement, kink_angle=KINK_ANGLE, slip=SLIP):
+def seam_constraints(seams, points, displacement, kink_angle=KINK_ANGLE, slip=SLIP, choose=True):
     """Node-to-node rows across the seams, linearised at points + displacement.
 
     Parameters
@@ -194,6 +210,9 @@ def seam_constraints(seams, points, displacement, kink_angle=KINK_ANGLE, slip=SL
     slip : float
         Rows whose twins slid tangentially by more than ``slip`` times the facet length
         are left out.
+    choose : bool
+        Pick the edge of each diagonal pair at this configuration (the prediction). False
+        gives the rows of both edges, for re-linearising rows chosen before (by key).
 
     Returns
     -------
@@ -205,11 +224,15 @@ def seam_constraints(seams, points, displacement, kink_angle=KINK_ANGLE, slip=SL
     keys : numpy.ndarray of int, shape (m, 3)
         (lower vertex, higher vertex, kind) identifying each row: kind is the facet, -1 for
         the merged row of a straight node, -3 - v for the edge row of the reflex wedge's
-        edge ending in v. The same seams give the same keys in every configuration.
+        edge ending in v, DIAGONAL_RIGHT (- 1) for the right (left) edge of a diagonal pair.
+        A diagonal pair's edge is named by its side of K, not by a vertex: where two
+        segments are collinear, which of them bounds K flips with rounding. The same seams
+        give the same keys in every configuration.
     """
     X = np.asarray(points, dtype=np.float64)
     x = X + np.asarray(displacement, dtype=np.float64)
-    parts = [_facet_rows(seams, X, x, kink_angle, slip), _edge_rows(seams, X, x, slip)]
+    parts = [_facet_rows(seams, X, x, kink_angle, slip), _edge_rows(seams, X, x, slip),
+             _diagonal_rows(seams, X, x, slip, choose)]
     master, slave, key3, normal = (np.concatenate([part[k] for part in parts]) for k in range(4))
     keys = np.column_stack([np.minimum(master, slave), np.maximum(master, slave), key3]).astype(np.int64)
     return _rows(X, x, master, slave, normal.reshape(-1, 2)), keys
@@ -265,6 +288,38 @@ def _edge_rows(seams, X, x, slip):
     far = np.where(tail == owner, head, tail)
     ok = _facing(x, owner, other, normal, slip * np.linalg.norm(X[head] - X[tail], axis=1))
     return owner[ok], other[ok], -3 - far[ok], normal[ok]
+
+
+def _diagonal_rows(seams, X, x, slip, choose):
+    """Rows of the diagonal pairs: copy j outside one edge of the cone K = W_i - W_j."""
+    i, j, out_i, in_i, out_j, in_j = seams.diagonal.T
+    m = len(i)
+    # K is spanned by the four edge directions of the two wedges (those of W_j reversed)
+    apex = np.concatenate([i, i, j, j])
+    far = np.concatenate([out_i, in_i, out_j, in_j])
+    e = (x[far] - x[apex]) * np.repeat([1.0, 1.0, -1.0, -1.0], m)[:, None]
+    e /= np.maximum(np.linalg.norm(e, axis=1), 1e-300)[:, None]
+    e = e.reshape(4, m, 2)
+    # a direction inside K: the sum of the bisectors of W_i and -W_j
+    d = e[0] + e[1] + e[2] + e[3]
+    turn = np.arctan2(d[:, 0] * e[..., 1] - d[:, 1] * e[..., 0], np.einsum("ij,kij->ki", d, e))
+    right, left = np.argmin(turn, axis=0), np.argmax(turn, axis=0)
+    cols = np.arange(m)
+    e_right, e_left = e[right, cols], e[left, cols]
+    # outward normals of K: clockwise of its right edge, counter-clockwise of its left one
+    normal = np.concatenate([_outward(e_right), -_outward(e_left)])
+    edge = np.concatenate([right, left])
+    ii, jj, cols, side = np.tile(i, 2), np.tile(j, 2), np.tile(cols, 2), np.repeat([0, 1], m)
+    pick = np.ones(2 * m, dtype=bool)
+    if choose:
+        # the edge the relative position is farther outside of (or less inside)
+        margin = np.einsum("ij,ij->i", x[jj] - x[ii], normal).reshape(2, m)
+        pick = np.concatenate([margin[0] >= margin[1], margin[0] < margin[1]])
+    ii, jj, cols, side, normal, edge = ii[pick], jj[pick], cols[pick], side[pick], normal[pick], edge[pick]
+    v, w = apex.reshape(4, m)[edge, cols], far.reshape(4, m)[edge, cols]
+    ok = _facing(x, ii, jj, normal, slip * np.linalg.norm(X[w] - X[v], axis=1))
+    # i < j (pairs are listed so): i is the master, the normal points from i to j
+    return ii[ok], jj[ok], DIAGONAL_RIGHT - side[ok], normal[ok]
 
 
 def _outward(v):

@@ -246,7 +246,8 @@ class StepFailed(Exception):
     Parameters
     ----------
     reason : str
-        The solver's reason (nan, diverged, inverted_element, singular, active_set, ...).
+        The solver's reason (nan, diverged, inverted_element, singular, active_set,
+        penetration, ...).
     phase : {"increment", "relaxation"}
         The solve of the increment, or one at fixed load after a split.
     message : str
@@ -463,8 +464,14 @@ class Simulation:
             status = result.status
             self._iterations += status.iterations
             if not result.converged:
-                raise StepFailed(result.reason, phase, status.message if result.reason == status.reason
-                                 else f"contact active set did not settle in {result.rounds} rounds")
+                if result.reason == "penetration":
+                    message = (f"contact rows still penetrate by {result.max_penetration:.3g} after "
+                               f"{result.updates} re-linearisations")
+                elif result.reason == "active_set":
+                    message = f"contact active set did not settle in {result.rounds} rounds"
+                else:
+                    message = status.message
+                raise StepFailed(result.reason, phase, message)
             return status
         t0 = time.perf_counter()
         status = prob.solve(fix_free_modes=self.scene.fix_free_modes, **options)

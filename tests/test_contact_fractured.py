@@ -96,23 +96,79 @@ def test_pressed_zigzag_crack_does_not_overlap(d):
     assert fragment_overlap_area(prob) < 1e-10 * 2.0
 
 
-def test_zigzag_junction_rows_are_what_prevents_the_overlap(monkeypatch):
-    """The same solve without the junction rows overlaps beyond the bound (3.3e-10 of 2.0
-    measured): the rows of reflex wedges at three-copy points are the reason it does not."""
+def without_junction_rows(monkeypatch, kind):
+    """Make ContactSolver see seams without the junction rows of one kind ("edge_rows" of
+    reflex wedges or "diagonal" pairs), checking that the mesh had some."""
     import ngfracture.contact_solver as contact_solver
     from ngfracture import seams as seams_module
 
-    def without_junctions(points, segments):
-        s = seams_module.find_seams(points, segments)
-        assert len(s.edge_rows) > 0                 # the crack has three-copy junctions
-        s.edge_rows = s.edge_rows[:0]
-        return s
-    monkeypatch.setattr(contact_solver, "find_seams", without_junctions)
+    def find_seams(points, segments):
+        found = seams_module.find_seams(points, segments)
+        assert len(getattr(found, kind)) > 0
+        setattr(found, kind, getattr(found, kind)[:0])
+        return found
+    monkeypatch.setattr(contact_solver, "find_seams", find_seams)
+
+
+def test_zigzag_junction_rows_are_what_prevents_the_overlap(monkeypatch):
+    """The same solve without the junction rows overlaps beyond the bound (3.3e-10 of 2.0
+    measured): the rows of reflex wedges at three-copy points are the reason it does not."""
+    without_junction_rows(monkeypatch, "edge_rows")     # the crack has three-copy junctions
     h = 0.1
     prob = pressed(crack_bands(plate_mesh(h), [(0, 1.0)], 0.6 * h).mesh, 1e-3)
     result = ContactSolver(prob, tol=0.1 * h).solve()
     assert result.converged, (result.reason, result.history)
     assert fragment_overlap_area(prob) > 1e-10 * 2.0
+
+
+def pinwheel(h, s):
+    """The plate cut by a cross into four quarters, each moved rigidly on its outer edges:
+    top right held, top left up by s, bottom left by (s, s), bottom right right by s.
+    Every pair of neighbours slides along its crack, and the bottom-left quarter is
+    pushed diagonally into the top-right one: only rows between the opposite copies of
+    a four-way junction can stop it."""
+    res = crack_bands(plate_mesh(h), [(0, 1.0), (1, 0.5)], 0.6 * h)
+    prob = nf.ElasticProblem(res.mesh, nf.LinearElastic(1.0, 0.3, plane="stress"))
+    right, top = ng.IfPos(ng.x - 1.0, 1.0, 0.0), ng.IfPos(ng.y - 0.5, 1.0, 0.0)
+    prob.add_dirichlet(["left", "right", "top", "bottom"], ng.CF((s * (1 - top), s * (1 - right))))
+    return prob
+
+
+@pytest.mark.parametrize("s", [1e-4, 1e-3])
+def test_pinwheel_opposite_quarters_do_not_overlap(s):
+    """Measured (h = 0.1): overlap 1.7e-16 (s = 1e-4) and 8.1e-16 (s = 1e-3) of the area
+    2.0; without the diagonal rows 3.6e-9 and 3.6e-7 (a test below)."""
+    h = 0.1
+    prob = pinwheel(h, s)
+    result = ContactSolver(prob, tol=0.1 * h).solve()
+    assert result.converged, (result.reason, result.history)
+    adhesive, penetration, complementarity = kuhn_tucker(prob, result, h)
+    assert adhesive <= 1e-10 and penetration <= 1e-10 and complementarity <= 1e-10
+    assert result.max_penetration <= result_penetration_tol(h)
+    assert fragment_overlap_area(prob) < 1e-10 * 2.0
+
+
+def test_pinwheel_too_large_for_one_solve_fails_with_a_reason():
+    """At s = 1e-2 (a tenth of h of sliding at every kink of the zigzag cracks) the rows,
+    re-linearised max_updates times, still penetrate: the solve says so (reason
+    "penetration", the amount in max_penetration) instead of reporting convergence with
+    the overlap it leaves (measured 2.4e-6 of the area 2.0)."""
+    h = 0.1
+    prob = pinwheel(h, 1e-2)
+    result = ContactSolver(prob, tol=0.1 * h).solve()
+    assert not result.converged and result.reason == "penetration", (result.reason, result.history)
+    assert result.updates == 5 and result.max_penetration > result_penetration_tol(h)
+    assert fragment_overlap_area(prob) > 1e-10 * 2.0
+
+
+def test_pinwheel_diagonal_rows_are_what_prevents_the_overlap(monkeypatch):
+    """The same solve (s = 1e-3) without the rows of diagonal pairs overlaps by far more
+    than the bound: the test above can fail."""
+    without_junction_rows(monkeypatch, "diagonal")      # the cross has four-way junctions
+    prob = pinwheel(0.1, 1e-3)
+    result = ContactSolver(prob, tol=0.01).solve()
+    assert result.converged, (result.reason, result.history)
+    assert fragment_overlap_area(prob) > 1e-8 * 2.0
 
 
 def result_penetration_tol(h):

@@ -7,7 +7,7 @@ adjacent wedges share a facet.
 import numpy as np
 import pytest
 
-from ngfracture.seams import find_seams, seam_constraints
+from ngfracture.seams import DIAGONAL_RIGHT, find_seams, seam_constraints
 
 
 def junction(angles_deg):
@@ -46,16 +46,93 @@ def test_reflex_wedge_keeps_the_other_copies_in_its_complement():
     assert np.all(rows.a[junction_rows] == 0)
 
 
-def test_cross_junction_has_facet_rows_only():
-    """Four 90-degree wedges: no wedge is reflex, so no junction rows; opposite copies
-    share no facet and have no row (their exact condition is not convex, see seams)."""
+def test_cross_junction_gets_one_row_per_diagonal_pair():
+    """Four 90-degree wedges: no wedge is reflex, so no reflex-edge rows; adjacent copies
+    share a facet (its row), opposite ones get one row on an edge of K = W_i - W_j."""
     X, S, _ = junction([0.0, 90.0, 180.0, 270.0])
     seams = find_seams(X, S)
     assert len(seams) == 4 and len(seams.edge_rows) == 0
+    assert sorted(map(tuple, seams.diagonal[:, :2].tolist())) == [(0, 2), (1, 3)]
     rows, keys = seam_constraints(seams, X, np.zeros_like(X))
     apex = keys[:, 1] < 4                          # rows between copies of the origin
-    assert sorted(map(tuple, keys[apex, :2].tolist())) == [(0, 1), (0, 3), (1, 2), (2, 3)]
-    assert np.all(keys[:, 2] >= 0)
+    assert sorted(map(tuple, keys[apex, :2].tolist())) == [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)]
+    diagonal = keys[:, 2] <= DIAGONAL_RIGHT
+    assert sorted(map(tuple, keys[diagonal, :2].tolist())) == [(0, 2), (1, 3)]
+    assert np.all(keys[~diagonal, 2] >= 0)
+
+
+def cones_overlap(X, x, i, j, far_i, far_j):
+    """Whether the wedges of copies i and j, translated to x[i] and x[j], share interior
+    points: r = x[j] - x[i] lies in the interior of W_i - W_j, the cone of the four edge
+    directions (those of j reversed). A linear programme, independent of seams."""
+    from scipy.optimize import linprog
+    E = np.column_stack([X[far_i[0]] - X[i], X[far_i[1]] - X[i], X[j] - X[far_j[0]], X[j] - X[far_j[1]]])
+    r = x[j] - x[i]
+    # strictly inside: r = E c with c >= 1e-9 |r| after scaling (a margin against the boundary)
+    res = linprog(np.zeros(4), A_eq=E, b_eq=r, bounds=[(1e-9 * np.linalg.norm(r), None)] * 4, method="highs")
+    return res.status == 0
+
+
+@pytest.mark.parametrize("angles", [[0.0, 90.0, 180.0, 270.0], [10.0, 70.0, 200.0, 250.0], [0.0, 100.0, 135.0, 300.0]],
+                         ids=["cross", "skew", "narrow"])
+def test_diagonal_row_is_exact_on_the_side_it_is_chosen_for(angles):
+    """Copy j (with its wedge) moved rigidly by r relative to copy i: the chosen row's gap
+    is >= 0 exactly when the two wedges do not overlap (checked by a linear programme),
+    for 200 random directions of r; and a gap < 0 is the distance into the nearer edge."""
+    X, S, far = junction(angles)
+    seams = find_seams(X, S)
+    rng = np.random.default_rng(7)
+    for i, j in seams.diagonal[:, :2]:
+        wedge_j = [j, *far[j]]
+        for phi in rng.uniform(0, 2 * np.pi, 200):
+            r = 1e-3 * np.array([np.cos(phi), np.sin(phi)])
+            U = np.zeros_like(X)
+            U[wedge_j] = r
+            rows, keys = seam_constraints(seams, X, U, slip=np.inf)
+            k = np.flatnonzero((keys[:, 0] == i) & (keys[:, 1] == j) & (keys[:, 2] <= DIAGONAL_RIGHT))
+            assert len(k) == 1
+            gap = rows.dist[k[0]]
+            if abs(gap) < 1e-12:
+                continue                           # on an edge of K: both answers are right
+            assert (gap >= 0) == (not cones_overlap(X, X + U, i, j, far[i], far[j])), (phi, gap)
+
+
+@pytest.mark.parametrize("shear", [1e-3, -1e-3])
+def test_cross_junction_slides_both_ways_along_a_crack(shear):
+    """The upper half (copies 0, 1) slides along the horizontal crack: every row between
+    copies of the origin stays satisfied (gaps >= 0, none is violated by the sliding), so
+    the diagonal rows do not lock the crack against shear in either direction."""
+    X, S, far = junction([0.0, 90.0, 180.0, 270.0])
+    seams = find_seams(X, S)
+    U = np.zeros_like(X)
+    upper = [0, 1, *far[0], *far[1]]
+    U[upper, 0] = shear
+    rows, keys = seam_constraints(seams, X, U)
+    apex = keys[:, 1] < 4
+    assert np.all(rows.dist[apex] >= -1e-18)
+    # one diagonal pair slides along the crack (its row is the crack's edge, gap 0), the
+    # other moves apart by the shear
+    diagonal = keys[:, 2] <= DIAGONAL_RIGHT
+    np.testing.assert_allclose(np.sort(rows.dist[diagonal]), [0.0, abs(shear)], atol=1e-18)
+
+
+def test_relinearised_diagonal_rows_keep_their_edge():
+    """Two collinear segments bound K (the straight crack of a cross): which one is
+    extreme flips with rounding, the key names the side of K, so the row chosen at the
+    prediction is found again, with the same normal, among the rows of both sides."""
+    X, S, far = junction([0.0, 90.0, 180.0, 270.0])
+    seams = find_seams(X, S)
+    U = np.zeros_like(X)
+    U[[2, *far[2]], 0] = 1e-3                      # copy 2 slides right under copy 0
+    rows, keys = seam_constraints(seams, X, U)
+    chosen = {tuple(k): n for k, n in zip(keys.tolist(), rows.normal) if k[2] <= DIAGONAL_RIGHT}
+    for tilt in (1e-13, -1e-13):
+        V = U.copy()
+        V[far[0][0], 1] += tilt                    # the 0-degree edge of copy 0 tilts a little
+        both, both_keys = seam_constraints(seams, X, V, choose=False)
+        found = {tuple(k): n for k, n in zip(both_keys.tolist(), both.normal)}
+        for key, n in chosen.items():
+            np.testing.assert_allclose(found[key], n, atol=1e-12)
 
 
 @pytest.mark.parametrize("turn", [0.3, -1.0, 2.5])
