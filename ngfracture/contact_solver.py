@@ -233,7 +233,8 @@ class ContactSolver:
 
     def _relinearised(self, pool, n_seam, seam_keys, seams, X, U):
         """The rows of pool (seam rows first) linearised at X + U, in the same order."""
-        fresh_seams, k = seam_constraints(seams, X, U, kink_angle=self.kink_angle)
+        # both sides of every diagonal pair: the side chosen at the prediction is found by key
+        fresh_seams, k = seam_constraints(seams, X, U, kink_angle=self.kink_angle, choose=False)
         where = {("s",) + tuple(r): i for i, r in enumerate(k.tolist())}
         # a seam row whose twins slid too far for a fresh one keeps its old linearisation
         present = [i for i, key in enumerate(seam_keys) if key in where]

@@ -283,8 +283,7 @@ def _facet_rows(seams, X, x, kink_angle, slip):
 def _edge_rows(seams, X, x, slip):
     """Junction rows of a reflex wedge: the other copy outside the edge tail -> head."""
     owner, other, tail, head = seams.edge_rows.T
-    normal = _outward(x[head] - x[tail])
-    normal /= np.maximum(np.linalg.norm(normal, axis=1), 1e-300)[:, None]
+    normal = _unit(_outward(x[head] - x[tail]))
     far = np.where(tail == owner, head, tail)
     ok = _facing(x, owner, other, normal, slip * np.linalg.norm(X[head] - X[tail], axis=1))
     return owner[ok], other[ok], -3 - far[ok], normal[ok]
@@ -297,9 +296,7 @@ def _diagonal_rows(seams, X, x, slip, choose):
     # K is spanned by the four edge directions of the two wedges (those of W_j reversed)
     apex = np.concatenate([i, i, j, j])
     far = np.concatenate([out_i, in_i, out_j, in_j])
-    e = (x[far] - x[apex]) * np.repeat([1.0, 1.0, -1.0, -1.0], m)[:, None]
-    e /= np.maximum(np.linalg.norm(e, axis=1), 1e-300)[:, None]
-    e = e.reshape(4, m, 2)
+    e = _unit((x[far] - x[apex]) * np.repeat([1.0, 1.0, -1.0, -1.0], m)[:, None]).reshape(4, m, 2)
     # a direction inside K: the sum of the bisectors of W_i and -W_j
     d = e[0] + e[1] + e[2] + e[3]
     turn = np.arctan2(d[:, 0] * e[..., 1] - d[:, 1] * e[..., 0], np.einsum("ij,kij->ki", d, e))
@@ -320,6 +317,11 @@ def _diagonal_rows(seams, X, x, slip, choose):
     ok = _facing(x, ii, jj, normal, slip * np.linalg.norm(X[w] - X[v], axis=1))
     # i < j (pairs are listed so): i is the master, the normal points from i to j
     return ii[ok], jj[ok], DIAGONAL_RIGHT - side[ok], normal[ok]
+
+
+def _unit(v):
+    """Rows of v scaled to unit length (zero rows stay zero)."""
+    return v / np.maximum(np.linalg.norm(v, axis=1), 1e-300)[:, None]
 
 
 def _outward(v):
