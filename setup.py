@@ -60,6 +60,7 @@ setup(
         "scipy",
         "pyvista",
         "matplotlib",
+        "threadpoolctl",   # one BLAS thread for the small dense solves (see README)
     ],
     # nbclient + nbformat + ipykernel: the smallest set that executes the tutorial
     # notebooks headless (tests/test_tutorials.py); no Jupyter server or UI

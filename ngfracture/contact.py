@@ -68,6 +68,7 @@ gap it adds are what the active set must release when their multiplier is adhesi
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.linalg as sla
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components, reverse_cuthill_mckee
 
@@ -420,6 +421,8 @@ def independent_rows(C, fixed_dofs=None, G=None, rtol=1e-8, method="auto", dense
     Ca.sort_indices()
     Gn = sp.csr_matrix((gval, (grow, gcol)), shape=(p, n))
     Gn.sort_indices()
+    if _clearly_independent(Ca, Gn, rtol):
+        return alive.astype(np.int64)
     position = np.zeros(len(alive), dtype=np.int64)
     if method != "pivoted" and len(alive):
         # processing order for the banded QR: reverse Cuthill-McKee of the row graph
@@ -434,6 +437,35 @@ def independent_rows(C, fixed_dofs=None, G=None, rtol=1e-8, method="auto", dense
         Gn.indices.astype(np.int32), Gn.data, lab_g.astype(np.int32), float(rtol), code,
         int(dense_limit))
     return alive[kept].astype(np.int64)
+
+
+def _clearly_independent(C, G, rtol, limit=1500):
+    """True if every row of [G; C] is farther than rtol from the span of all the others.
+
+    Then any QR of the rows, pivoted or not, has |R_kk| >= sigma_min > rtol and keeps them
+    all, so the pivoted QR can be skipped: a Cholesky factorisation of the Gram matrix
+    minus (rtol^2 + rounding) I succeeds when sigma_min^2 exceeds that shift. The usual
+    case in a contact round (measured on the disintegrating disk: 165 rows in one
+    component joined by 84 hold rows over 1714 dofs, 0.33 s of pivoted QR a call, 45 % of
+    the run; the Cholesky of the 249 x 249 Gram matrix takes milliseconds). Rows with a
+    dependence fall through to the QR, which decides which to drop. Not tried above
+    ``limit`` rows, nor where rtol^2 is within ten times the rounding of the test.
+    """
+    M = sp.vstack([G, C]).tocsr()
+    k = M.shape[0]
+    if k == 0 or k > limit:
+        return k == 0
+    gram = (M @ M.T).toarray()
+    # backward error of forming and factorising the Gram matrix: a few k eps |Gram|
+    rounding = 4 * k * np.finfo(float).eps * np.abs(gram).sum(axis=1).max()
+    if rtol ** 2 < 10 * rounding:
+        return False
+    gram[np.diag_indices(k)] -= rtol ** 2 + rounding
+    try:
+        sla.cholesky(gram, lower=True, check_finite=False)
+    except np.linalg.LinAlgError:
+        return False
+    return True
 
 
 def contact_constraints(coords, displacement, tris, boundary_edges, fragment=None,

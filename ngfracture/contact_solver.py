@@ -58,7 +58,7 @@ from .collision import detect_collisions
 from .crack import vertex_displacement
 from .meshio import boundary_only, mesh_to_arrays
 from .seams import KINK_ANGLE, find_seams, seam_constraints
-from .kkt import SingularSystem
+from .kkt import SingularSystem, single_threaded_blas
 from .qp import QPError
 from .solver import NewtonSolver, SavedTangent, SolveStatus
 
@@ -88,8 +88,9 @@ class ContactResult:
     converged : bool
     reason : str
         "converged", a Newton reason, "active_set" if the set did not settle, or
-        "penetration" if the rows, re-linearised ``max_updates`` times at a settled set,
-        still penetrate by more than ``penetration_tol`` (``max_penetration`` says how much).
+        "penetration" if the rows, re-linearised at a settled set, still penetrate by more
+        than ``penetration_tol`` when a re-linearisation did not reduce the penetration or
+        after ``max_updates`` of them (``max_penetration`` says how much).
     rounds : int
         Detect-and-solve rounds.
     constraints : contact.ContactConstraints
@@ -161,8 +162,12 @@ class ContactSolver:
         in the displacement (measured 1.6e-9 of the area on the plate scene, from a free
         one-triangle fragment sliding along its seams). When the true gaps at the
         solution penetrate by more than penetration_tol, the rows are linearised again
-        there (same rows, current normals and projections) and the solve repeated; after
-        ``max_updates`` such repetitions the solve fails with reason "penetration".
+        there (same rows, current normals and projections) and the solve repeated. This
+        fixed point contracts fast where the step is small enough (measured: a factor 20
+        to 500 per update on the disintegration disk, 1e-5 to 8e-15 in five updates; less
+        where the active set changes between updates). When one update does not reduce the
+        penetration, or after ``max_updates`` of them, the solve fails with reason
+        "penetration".
     kink_angle : float
         Seam facets meeting at a larger angle (radians, in the reference configuration)
         get a row each at their common node (see :mod:`ngfracture.seams`). The default
@@ -188,7 +193,7 @@ class ContactSolver:
         If ``tol`` is NaN, infinite or negative. The other arguments are not checked here.
     """
 
-    def __init__(self, problem, tol, penetration_tol=None, max_rounds=20, rank_tol=1e-5, max_updates=5,
+    def __init__(self, problem, tol, penetration_tol=None, max_rounds=20, rank_tol=1e-5, max_updates=10,
                  kink_angle=KINK_ANGLE, pdas_rounds=6, **solve_options):
         if not np.isfinite(tol) or tol < 0:
             raise ValueError(f"contact detection tol must be finite and >= 0, got {tol!r}")
@@ -317,6 +322,7 @@ class ContactSolver:
         result.timings["linear"] += status.timings["factorize"] + status.timings["solve"]
         return status
 
+    @single_threaded_blas()
     def solve(self):
         """Solve for equilibrium with contact.
 
@@ -329,7 +335,7 @@ class ContactSolver:
         ContactResult
             Converged, or reason: the Newton reason of a failed solve, "active_set" when
             ``max_rounds`` rounds passed without a settled set, "penetration" when the
-            settled rows still overlap after ``max_updates`` re-linearisations. Failures
+            settled rows still overlap and re-linearising them stopped contracting. Failures
             are not raised.
         """
         prob = self.problem
@@ -358,6 +364,7 @@ class ContactSolver:
         tried = set()                           # every row imposed so far
         exact = False                           # the complementarity problem chooses the set
         force_scale = 0.0                       # the largest force of any round so far
+        last_penetration = np.inf               # at the last re-linearisation
         for rnd in range(1, self.max_rounds + 1):
             result.rounds = rnd
             t0 = time.perf_counter()
@@ -416,12 +423,13 @@ class ContactSolver:
                 if penetration <= self.penetration_tol:
                     result.converged, result.reason = True, "converged"
                     return result
-                if result.updates == self.max_updates:
+                if result.updates == self.max_updates or penetration >= last_penetration:
                     # the linearisations do not converge to a state without overlap (large
                     # relative motion for one solve): a failure, which a caller cures with
                     # a smaller step, not an overlap passed off as a solution
                     result.reason = "penetration"
                     return result
+                last_penetration = penetration
                 # a geometric fixed point: solve again with the rows linearised here
                 # (the overlap falls from second to fourth order in the displacement)
                 result.updates += 1
@@ -537,8 +545,11 @@ def overlap_area(x, triangles, pairs):
     """
     total = 0.0
     for i, j in np.asarray(pairs, dtype=np.int64).reshape(-1, 2):
-        poly = [tuple(p) for p in x[triangles[i]]]
-        clip = x[triangles[j]]
+        # relative to a vertex of the pair: areas from coordinates far from the origin
+        # would carry the rounding of their products (2e-8 at 1e4), not of the overlap
+        origin = x[triangles[j][0]]
+        poly = [tuple(p) for p in x[triangles[i]] - origin]
+        clip = x[triangles[j]] - origin
         if _signed_area(clip) < 0:
             clip = clip[::-1]
         for k in range(3):

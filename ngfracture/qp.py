@@ -9,9 +9,11 @@ finitely many steps (unlike the primal-dual active set, which can cycle when the
 constraint response is not an M-matrix). No feasible start is needed.
 
 Used by the contact solver for the linear complementarity problem of one linearisation
-(:meth:`ngfracture.kkt.ConstrainedSolver.solve_unilateral`): a few hundred unknowns at
-most, so the working set's QR factorisation is recomputed at every step instead of
-updated; O(m^3) per step.
+(:meth:`ngfracture.kkt.ConstrainedSolver.solve_unilateral`): a few hundred unknowns. The
+QR factorisation of the working set is updated by Givens rotations when a constraint
+enters or leaves (scipy.linalg.qr_insert / qr_delete), O(n k) per step for k active
+constraints. It was recomputed at every step before: 73 % of the run time of the
+disintegrating disk's late steps (4400 factorisations of 0.12 s in five load steps).
 """
 import numpy as np
 import scipy.linalg as sla
@@ -75,11 +77,12 @@ def convex_qp(H, c, A_eq, b_eq, A_in, b_in, tol=1e-12, max_steps=None):
     norm = np.maximum(np.linalg.norm(N, axis=0), 1e-300)
     sign = np.ones(len(b))              # equalities are entered from the side they miss
     active, u = [], []
+    Q, R = np.zeros((n, 0)), np.zeros((0, 0))   # thin QR of the active columns sign_j N[:, j]
+    c_size = np.linalg.norm(sla.solve_triangular(L, c, lower=True))
     max_steps = 10 * (n + len(b)) + 100 if max_steps is None else max_steps
     for _ in range(max_steps):
         s = (A @ x - b) / norm          # signed misses, scaled to the metric of H
-        level = tol * max(np.abs(b / norm).max(initial=0.0), np.linalg.norm(L.T @ x), np.linalg.norm(
-            sla.solve_triangular(L, c, lower=True)), 1e-300)
+        level = tol * max(np.abs(b / norm).max(initial=0.0), np.linalg.norm(L.T @ x), c_size, 1e-300)
         todo = [j for j in range(p) if j not in active]
         if todo:
             j_new = todo[0]
@@ -95,9 +98,9 @@ def convex_qp(H, c, A_eq, b_eq, A_in, b_in, tol=1e-12, max_steps=None):
         u_new = 0.0
         while True:
             if active:
-                Q, R = np.linalg.qr(N[:, active] * sign[active])
-                r = sla.solve_triangular(R, Q.T @ n_new)
-                w = n_new - Q @ (Q.T @ n_new)
+                projection = Q.T @ n_new
+                r = sla.solve_triangular(R, projection)
+                w = n_new - Q @ projection
             else:
                 r, w = np.zeros(0), n_new
             # the largest dual step before an active inequality's multiplier reaches zero
@@ -116,9 +119,11 @@ def convex_qp(H, c, A_eq, b_eq, A_in, b_in, tol=1e-12, max_steps=None):
             u = [uk - t * rk for uk, rk in zip(u, r)]
             u_new += t
             if t == t_full:
+                Q, R = _append_column(Q, R, n_new)
                 active.append(j_new)
                 u.append(u_new)
                 break
+            Q, R = sla.qr_delete(Q, R, k_drop, 1, which="col", check_finite=False)
             del active[k_drop], u[k_drop]
     else:
         raise QPError(f"convex_qp: no solution in {max_steps} steps")
@@ -127,3 +132,11 @@ def convex_qp(H, c, A_eq, b_eq, A_in, b_in, tol=1e-12, max_steps=None):
     active_in = np.zeros(len(b) - p, dtype=bool)
     active_in[[j - p for j in active if j >= p]] = True
     return x, mult[:p], mult[p:], active_in
+
+
+def _append_column(Q, R, column):
+    """The thin QR factorisation of [Q R, column] (column independent of Q's span)."""
+    if Q.shape[1] == 0:
+        size = np.linalg.norm(column)
+        return (column / size)[:, None], np.array([[size]])
+    return sla.qr_insert(Q, R, column, Q.shape[1], which="col", check_finite=False)

@@ -52,6 +52,7 @@ from . import checkpoint
 from .contact_solver import ContactSolver, fragment_overlap_area
 from .crack import StrainCriterion, split_by_tensor, transfer
 from .fragments import FragmentStatistics
+from .kkt import single_threaded_blas
 from .materials import Material
 from .meshio import MeshArrays, mesh_from_arrays, mesh_to_arrays
 from .problem import ElasticProblem
@@ -628,6 +629,7 @@ class Simulation:
             self._substeps = substeps
             return attempt, dx, None
 
+    @single_threaded_blas()
     def run(self):
         """Run to the end.
 

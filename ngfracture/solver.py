@@ -19,7 +19,7 @@ import scipy.sparse as sp
 
 from . import rigid
 from .constraints import ConstraintRows
-from .kkt import ConstrainedSolver, EliminatedFactor, SingularSystem
+from .kkt import ConstrainedSolver, EliminatedFactor, SingularSystem, single_threaded_blas
 
 METHODS = ("modified", "full")
 REASONS = ("converged", "max_iterations", "diverged", "nan", "singular", "inverted_element")
@@ -206,6 +206,7 @@ class NewtonSolver:
         self.fix_free_modes = fix_free_modes
         self.tangent = tangent
 
+    @single_threaded_blas()
     def solve(self, load_steps=1):
         """Bring the problem from its current state to the prescribed constraint values.
 

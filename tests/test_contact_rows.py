@@ -156,6 +156,43 @@ def test_banded_and_pivoted_agree_on_long_chains():
         assert np.linalg.matrix_rank(C[keep].toarray()) == rank
 
 
+@pytest.mark.parametrize("distance", [None, 0.5e-5, 2e-5, 1e-3])
+def test_gram_shortcut_agrees_with_the_pivoted_qr(monkeypatch, distance):
+    """Rows that are clearly independent skip the pivoted QR (contact._clearly_independent)
+    and the answer must be the QR's. 150 sparse rows, 20 fixed dofs and 6 dense hold rows G
+    (one component, like the contact solver's rigid-mode holds); with `distance` the last
+    row is a combination of two others moved off by that much (rtol = 1e-5): at 0.5 rtol
+    the QR drops a row, so the shortcut must have declined; without it, it must answer."""
+    rng = np.random.default_rng(3)
+    ndof, m, rtol = 400, 150, 1e-5
+    C = np.zeros((m, ndof))
+    for i in range(m):
+        C[i, rng.choice(np.arange(20, ndof), 4, replace=False)] = rng.uniform(-1, 1, 4)
+    fixed = np.arange(20)                             # C rows do not touch them, G rows do
+    G = sp.csr_matrix(rng.normal(size=(6, ndof)))
+    if distance is not None:
+        combo = C[0] / np.linalg.norm(C[0]) + C[1] / np.linalg.norm(C[1])
+        kick = np.zeros(ndof)
+        kick[np.setdiff1d(np.arange(20, ndof), np.flatnonzero(C[:-1].any(axis=0)))[0]] = 1.0
+        C[-1] = combo / np.linalg.norm(combo) + distance * kick
+    C = sp.csr_matrix(C)
+    answered = []
+    shortcut = contact._clearly_independent
+
+    def spy(*args):
+        answered.append(shortcut(*args))
+        return answered[-1]
+    monkeypatch.setattr(contact, "_clearly_independent", spy)
+    fast = contact.independent_rows(C, fixed_dofs=fixed, G=G, rtol=rtol)
+    monkeypatch.setattr(contact, "_clearly_independent", lambda *args: False)
+    qr = contact.independent_rows(C, fixed_dofs=fixed, G=G, rtol=rtol)
+    assert np.array_equal(fast, qr)
+    if distance is None:
+        assert answered == [True] and len(qr) == m
+    if distance == 0.5e-5:
+        assert answered == [False] and len(qr) == m - 1
+
+
 # ------------------------------------------------------------------ redundancy
 @pytest.mark.parametrize("method", ["pivoted", "banded", "auto"])
 def test_2000_coincident_rows_rank_r_and_kkt(method):
