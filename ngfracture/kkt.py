@@ -463,6 +463,28 @@ class ConstrainedSolver:
         """
         if self.m and self._coarse is None:
             raise SingularSystem("made with dependent_rows=True: only solve_unilateral is available")
+        du, lam = self._solve_once(r, du_fixed, h)
+        load_norm = self.last_load_norm
+        if self.m:
+            # Iterative refinement: the Schur complement through K^+ and the coarse problem
+            # of the modes is not backward stable when pieces hang on contact and hold rows.
+            # Measured on the disintegrating disk at maxh 0.06 (step 33, three pieces):
+            # Newton's residual stalled at 1.5e-6 with increments of 1e-7 to 1e-6 in 60
+            # iterations, full Newton and 32 substeps alike; with one refinement step it
+            # converges in a few iterations. A K product per solve decides whether it is needed.
+            for _ in range(self.REFINEMENTS):
+                res, res_rows, force_scale, row_scale = self._residual(r, du_fixed, h, du, lam)
+                if np.linalg.norm(res) <= 1e-11 * force_scale and np.linalg.norm(res_rows) <= 1e-11 * row_scale:
+                    break
+                ddu, dlam = self._solve_once(res, np.zeros_like(du), res_rows)
+                du, lam = du + ddu, lam + dlam
+        self.last_load_norm = load_norm
+        return du, lam
+
+    #: refinement steps at most per solve (each: one K product and one solve with K^+)
+    REFINEMENTS = 2
+
+    def _solve_once(self, r, du_fixed, h):
         q, du = self._unconstrained(r, du_fixed)
         lam = np.zeros(self.m)
         if self.m:
@@ -472,6 +494,18 @@ class ConstrainedSolver:
             du -= self._Z @ lam
             du += self._R @ alpha
         return du, lam
+
+    def _residual(self, r, du_fixed, h, du, lam):
+        """Residuals of the free rows and of the general rows, each with its size scale."""
+        self._tmp.FV().NumPy()[:] = du
+        Kdu = (self.K * self._tmp).Evaluate().FV().NumPy()
+        Ct_lam = self.C.T @ lam
+        res = r - Kdu - Ct_lam
+        res[~self.free] = 0.0
+        Cdu = self.C @ du
+        free = self.free
+        force_scale = (np.linalg.norm(r[free]) + np.linalg.norm(Kdu[free]) + np.linalg.norm(Ct_lam[free]))
+        return res, h - Cdu, max(force_scale, 1e-300), max(np.linalg.norm(h) + np.linalg.norm(Cdu), 1e-300)
 
     def _unconstrained(self, r, du_fixed):
         """The load q with the prescribed increments moved over, and du = du_fixed + K^+ q."""
