@@ -421,7 +421,7 @@ def independent_rows(C, fixed_dofs=None, G=None, rtol=1e-8, method="auto", dense
     Ca.sort_indices()
     Gn = sp.csr_matrix((gval, (grow, gcol)), shape=(p, n))
     Gn.sort_indices()
-    if _clearly_independent(Ca, Gn, rtol):
+    if _clearly_independent(Ca, Gn, rtol, lab_c[alive], lab_g):
         return alive.astype(np.int64)
     position = np.zeros(len(alive), dtype=np.int64)
     if method != "pivoted" and len(alive):
@@ -439,7 +439,7 @@ def independent_rows(C, fixed_dofs=None, G=None, rtol=1e-8, method="auto", dense
     return alive[kept].astype(np.int64)
 
 
-def _clearly_independent(C, G, rtol, limit=1500):
+def _clearly_independent(C, G, rtol, labels_c, labels_g, limit=1500):
     """True if every row of [G; C] is farther than rtol from the span of all the others.
 
     Then any QR of the rows, pivoted or not, has |R_kk| >= sigma_min > rtol and keeps them
@@ -448,13 +448,22 @@ def _clearly_independent(C, G, rtol, limit=1500):
     case in a contact round (measured on the disintegrating disk: 165 rows in one
     component joined by 84 hold rows over 1714 dofs, 0.33 s of pivoted QR a call, 45 % of
     the run; the Cholesky of the 249 x 249 Gram matrix takes milliseconds). Rows with a
-    dependence fall through to the QR, which decides which to drop. Not tried above
-    ``limit`` rows, nor where rtol^2 is within ten times the rounding of the test.
+    dependence fall through to the QR, which decides which to drop. Tried only where the
+    QR would cost more (sum over the components of rows^2 x columns above rows^3 of the
+    test: many small components, as along the cuts of benchmarks/contact.py, are cheap to
+    QR, and there a failed test only added time), not above ``limit`` rows, and not where
+    rtol^2 is within ten times the rounding of the test.
     """
     M = sp.vstack([G, C]).tocsr()
     k = M.shape[0]
     if k == 0 or k > limit:
         return k == 0
+    labels = np.concatenate([labels_g, labels_c]).astype(np.int64)
+    rows_per = np.bincount(labels).astype(float)
+    pairs = np.unique(np.repeat(labels, np.diff(M.indptr)) * M.shape[1] + M.indices)
+    columns_per = np.bincount(pairs // M.shape[1], minlength=len(rows_per))
+    if np.sum(rows_per ** 2 * columns_per) < float(k) ** 3:
+        return False
     gram = (M @ M.T).toarray()
     # backward error of forming and factorising the Gram matrix: a few k eps |Gram|
     rounding = 4 * k * np.finfo(float).eps * np.abs(gram).sum(axis=1).max()
