@@ -473,7 +473,7 @@ class ConstrainedSolver:
             # iterations, full Newton and 32 substeps alike; with one refinement step it
             # converges in a few iterations. A K product per solve decides whether it is needed.
             for _ in range(self.REFINEMENTS):
-                res, res_rows, force_scale, row_scale = self._residual(r, du_fixed, h, du, lam)
+                res, res_rows, force_scale, row_scale = self._residual(r, h, du, lam)
                 if np.linalg.norm(res) <= 1e-11 * force_scale and np.linalg.norm(res_rows) <= 1e-11 * row_scale:
                     break
                 ddu, dlam = self._solve_once(res, np.zeros_like(du), res_rows)
@@ -495,15 +495,14 @@ class ConstrainedSolver:
             du += self._R @ alpha
         return du, lam
 
-    def _residual(self, r, du_fixed, h, du, lam):
+    def _residual(self, r, h, du, lam):
         """Residuals of the free rows and of the general rows, each with its size scale."""
         self._tmp.FV().NumPy()[:] = du
         Kdu = (self.K * self._tmp).Evaluate().FV().NumPy()
         Ct_lam = self.C.T @ lam
-        res = r - Kdu - Ct_lam
-        res[~self.free] = 0.0
-        Cdu = self.C @ du
         free = self.free
+        res = np.where(free, r - Kdu - Ct_lam, 0.0)
+        Cdu = self.C @ du
         force_scale = (np.linalg.norm(r[free]) + np.linalg.norm(Kdu[free]) + np.linalg.norm(Ct_lam[free]))
         return res, h - Cdu, max(force_scale, 1e-300), max(np.linalg.norm(h) + np.linalg.norm(Cdu), 1e-300)
 

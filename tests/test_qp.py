@@ -29,6 +29,22 @@ def test_random_bound_and_equality_constrained_qps(seed):
     assert np.all(u_in[~active] == 0.0)
 
 
+@pytest.mark.parametrize("seed", range(3))
+def test_contact_sized_qps_with_updated_factorisations(seed):
+    """A few hundred unknowns, as the contact LCP of the disintegrating disk: hundreds of
+    working-set changes, entries and drops, each updating the QR by Givens rotations
+    (qr_insert / qr_delete) instead of refactorising; Kuhn-Tucker still to 1e-10."""
+    rng = np.random.default_rng(100 + seed)
+    n = 250
+    B = rng.standard_normal((n, n)) / np.sqrt(n)
+    H, c = B @ B.T + 1e-2 * np.eye(n), rng.standard_normal(n)
+    A_eq, b_eq = rng.standard_normal((6, n)), rng.standard_normal(6)
+    A_in, b_in = -np.eye(n), np.zeros(n)
+    x, u_eq, u_in, active = convex_qp(H, c, A_eq, b_eq, A_in, b_in)
+    assert 20 < active.sum() < n - 20                    # many bounds active, many not
+    assert kuhn_tucker_error(H, c, A_eq, b_eq, A_in, b_in, x, u_eq, u_in) < 1e-10
+
+
 def test_lcp_matches_enumeration_of_all_active_sets():
     """min 1/2 x^T H x - c^T x, x <= 0 for an SPD H that is no M-matrix (mixed-sign
     coupling, as nearly parallel contact rows give): the unique KT point, found by trying
