@@ -16,8 +16,7 @@ A failed solve (diverged, NaN, singular, inverted element, contact set that does
 settle) sends the step back to the saved state: with modified Newton, the first retry
 solves the same attempt with full Newton (the tangent factorised at the start of a solve
 can be too far from the state that new contact rows impose: measured on the disk, Newton
-diverged with the saved tangent and converged with fresh ones), except after a contact
-failure (active set, penetration), which a fresh tangent does not cure; then a failure of the
+diverged with the saved tangent and converged with fresh ones); then a failure of the
 increment solve is retried with the same target in twice as many Newton load steps (the
 load path does not change), a failure at fixed load after a split with dx * cut; after ``max_retries``
 failures the run stops with the last good state written and a reason.  The run ends when x reaches the scene's ``load_max``, after ``max_steps``
@@ -57,9 +56,6 @@ from .kkt import single_threaded_blas
 from .materials import Material
 from .meshio import MeshArrays, mesh_from_arrays, mesh_to_arrays
 from .problem import ElasticProblem
-
-#: contact solve failures that a fresh tangent does not cure (a smaller step does)
-CONTACT_FAILURES = ("active_set", "penetration")
 
 #: wall time per phase; "linear" (factorisations and triangular solves) is part of "solve"
 PHASES = ("solve", "linear", "strain", "split", "rebuild", "collision", "contact", "output")
@@ -600,10 +596,7 @@ class Simulation:
         """Attempts of one step until one is accepted: (attempt, dx, None) or (None, dx, last failure).
 
         Too many cracks: dx * cut. A failed solve with modified Newton: the same attempt with
-        full Newton (from then on for this step), unless the contact solve failed
-        (CONTACT_FAILURES: its active set or its geometry, not the tangent; measured on the
-        default disintegration, steps 58 and 59: "active_set" with modified and again with
-        full Newton, 30 s and 120 s, then passed at dx * cut). A failed solve of the increment: the same target in twice
+        full Newton (from then on for this step). A failed solve of the increment: the same target in twice
         as many substeps (load steps of the Newton solver, no crack pass between them), so
         a passing trouble does not change the load path. A failed solve at fixed load
         (relaxation on a split mesh): dx * cut, substeps reset. Every attempt starts from
@@ -621,7 +614,7 @@ class Simulation:
                 self._failures.append(err.reason)
                 if self._retries > c.max_retries:
                     return None, dx, err
-                if self._method == "modified" and err.reason not in CONTACT_FAILURES:
+                if self._method == "modified":
                     self._method = "full"           # the same attempt with fresh tangents
                 elif err.phase == "increment":
                     substeps *= 2
