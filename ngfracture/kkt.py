@@ -463,8 +463,8 @@ class ConstrainedSolver:
         """
         if self.m and self._coarse is None:
             raise SingularSystem("made with dependent_rows=True: only solve_unilateral is available")
-        du, lam = self._solve_once(r, du_fixed, h)
-        load_norm = self.last_load_norm
+        du, lam, q = self._solve_once(r, du_fixed, h)
+        self.last_load_norm = float(np.linalg.norm(q[self.free]))
         if self.m:
             # Iterative refinement: the Schur complement through K^+ and the coarse problem
             # of the modes is not backward stable when pieces hang on contact and hold rows.
@@ -476,15 +476,15 @@ class ConstrainedSolver:
                 res, res_rows, force_scale, row_scale = self._residual(r, h, du, lam)
                 if np.linalg.norm(res) <= 1e-11 * force_scale and np.linalg.norm(res_rows) <= 1e-11 * row_scale:
                     break
-                ddu, dlam = self._solve_once(res, np.zeros_like(du), res_rows)
+                ddu, dlam, _ = self._solve_once(res, np.zeros_like(du), res_rows)
                 du, lam = du + ddu, lam + dlam
-        self.last_load_norm = load_norm
         return du, lam
 
     #: refinement steps at most per solve (each: one K product and one solve with K^+)
     REFINEMENTS = 2
 
     def _solve_once(self, r, du_fixed, h):
+        """One pass of the eliminated solve: (du, lam, the load q of :meth:`_unconstrained`)."""
         q, du = self._unconstrained(r, du_fixed)
         lam = np.zeros(self.m)
         if self.m:
@@ -493,7 +493,7 @@ class ConstrainedSolver:
             lam, alpha = sol[:self.m], sol[self.m:]
             du -= self._Z @ lam
             du += self._R @ alpha
-        return du, lam
+        return du, lam, q
 
     def _residual(self, r, h, du, lam):
         """Residuals of the free rows and of the general rows, each with its size scale."""
@@ -512,7 +512,6 @@ class ConstrainedSolver:
         if np.any(du_fixed):
             self._tmp.FV().NumPy()[:] = du_fixed
             q = r - (self.K * self._tmp).Evaluate().FV().NumPy()
-        self.last_load_norm = float(np.linalg.norm(q[self.free]))
         return q, du_fixed + self.factor.solve(q)
 
     def solve_unilateral(self, r, du_fixed, h, unilateral):

@@ -149,9 +149,10 @@ def test_refinement_repairs_an_inaccurate_solve(pinned, monkeypatch):
     exact_once, refinements = ConstrainedSolver._solve_once, ConstrainedSolver.REFINEMENTS
 
     def inaccurate(self, r, du_fixed, h):
-        du, lam = exact_once(self, r, du_fixed, h)
+        du, lam, q = exact_once(self, r, du_fixed, h)
         wobble = np.random.default_rng(len(du))
-        return du * (1 + 1e-6 * wobble.standard_normal(len(du))), lam * (1 + 1e-6 * wobble.standard_normal(len(lam)))
+        return (du * (1 + 1e-6 * wobble.standard_normal(len(du))),
+                lam * (1 + 1e-6 * wobble.standard_normal(len(lam))), q)
     monkeypatch.setattr(ConstrainedSolver, "_solve_once", inaccurate)
 
     def relative_residuals(refinements):
