@@ -8,17 +8,23 @@ writing its outputs into a temporary folder (no pictures). Reported per case:
   phases       seconds per phase of Simulation (solve, strain, split, rebuild, collision,
                contact, output) and wall
   linear       seconds in factorisations and triangular solves (part of "solve")
+  assembly     seconds in NGSolve's residual and tangent assembly (part of "solve")
   outside_solve_share    1 - solve / wall: everything outside the Newton solves (assembly,
                factorisation, triangular solves, residuals): crack criterion, splitting,
-               rebuilding, collision, contact rows, output
+               rebuilding, collision, contact rows, output. The floor's reading.
+  outside_fe_share       1 - (linear + assembly) / wall: everything but NGSolve's finite
+               element work (counts the Python of the Newton and KKT loops as overhead)
   outside_linear_share   1 - linear / wall: everything but factorisations and triangular
-               solves (stricter: it counts assembly and residuals as overhead)
+               solves (strictest: it counts the residual assembly as overhead)
   t_plain      one linear-elastic factorise + solve of plain NGSolve on the initial mesh,
                measured in the same run (the baseline)
   wall_over_plain        wall / t_plain
 
 Prints JSON {"cases": [...]}. Floors (issue 5): the plate at f = 1 under 60 s, and
-outside_solve_share under 0.3 (see the README for the measured figures).
+outside_solve_share under 0.3 (see the README for the measured figures and why this share
+is the one the floor is read as). The modules the run loads on first use (pyvista,
+matplotlib) are imported before the first case, as NGSolve itself is: a once-per-process
+cost that would otherwise land in the first case's "output" phase only.
 
 Usage: python benchmarks/scenes.py [--scenes plate disk] [--factors 1 4 16] [--steps N] [--json FILE]
 """
@@ -62,10 +68,12 @@ def run_case(name, factor, steps=None):
     s = result.summary
     wall = s["timings"]["wall"]
     linear = s["timings"].get("linear", float("nan"))
+    assembly = s["timings"].get("assembly", float("nan"))
     return {"scene": name, "factor": factor, "ntri": scene.mesh.ne, "reason": result.reason, "max_steps": steps,
             "nsteps": s["n_steps"], "n_split_vertices": s["n_split_vertices"],
             "n_fragments": s["n_fragments"], "phases": s["timings"], "linear": linear,
-            "outside_solve_share": 1.0 - s["timings"]["solve"] / wall,
+            "assembly": assembly, "outside_solve_share": 1.0 - s["timings"]["solve"] / wall,
+            "outside_fe_share": 1.0 - (linear + assembly) / wall,
             "outside_linear_share": 1.0 - linear / wall, "t_plain": t_plain,
             "wall_over_plain": wall / t_plain}
 
@@ -79,6 +87,7 @@ def main(argv=None):
                         "shares are then those of the first steps)")
     p.add_argument("--json", default=None, help="also write the JSON to this file")
     args = p.parse_args(argv)
+    import pyvista, matplotlib.figure  # noqa: F401  (see the module docstring)
     cases = []
     for name in args.scenes:
         for f in args.factors:

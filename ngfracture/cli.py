@@ -127,7 +127,10 @@ def _run_run(args):
     if args.force and args.resume:
         raise ValueError("--force and --resume exclude each other")
     out = args.out if args.out is not None else os.path.join("out", args.scene)
-    Simulation.check_output(out, force=args.force, resume=args.resume)   # before meshing
+    try:
+        Simulation.check_output(out, force=args.force, resume=args.resume)   # before meshing
+    except FileExistsError as err:
+        raise FileExistsError(str(err).replace("use force", "use --force").replace("or resume", "or --resume")) from None
     options = {} if args.maxh is None else {"maxh": args.maxh}
     scene = scenes.SCENES[args.scene](**options)
     if args.load_max is not None:
@@ -143,7 +146,9 @@ def _run_run(args):
     print(f"{scene.name}: {s['n_steps']} steps, {s['n_split_vertices']} split vertices, crack length "
           f"{s['crack_length']:.4g}, {s['n_fragments']} fragments, {s['timings']['wall']:.1f} s; "
           f"{result.reason}: {result.message}")
-    print(f"results in {out}/ (results.pvd, cracks.pvd, summary.json, final.png)")
+    files = ["results.pvd", "cracks.pvd", "summary.json"] + sorted(
+        v for k, v in s.get("pictures", {}).items() if k in ("final", "fragment_sizes"))
+    print(f"results in {out}/ ({', '.join(files)})")
     if not result.ok:
         raise RuntimeError(result.message)
     return 0

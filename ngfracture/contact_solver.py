@@ -106,7 +106,8 @@ class ContactResult:
     timings : dict
         Seconds: "contact" all contact work (detection, row selection, assembly, QR),
         "collision" the detection part of it, "solve" the Newton solves, "linear" the
-        factorisations and triangular solves within them.
+        factorisations and triangular solves within them, "assembly" the residual and
+        tangent assembly within them.
     history : list of (int, float)
         Active rows and max_penetration at the start of every round.
     updates : int
@@ -122,7 +123,7 @@ class ContactResult:
     multipliers: np.ndarray = field(default_factory=lambda: np.zeros(0))
     released: int = 0
     max_penetration: float = 0.0
-    timings: dict = field(default_factory=lambda: dict.fromkeys(("contact", "collision", "solve", "linear"), 0.0))
+    timings: dict = field(default_factory=lambda: dict.fromkeys(("contact", "collision", "solve", "linear", "assembly"), 0.0))
     history: list = field(default_factory=list)
     updates: int = 0
     lcp: int = 0
@@ -320,6 +321,7 @@ class ContactSolver:
         result.status = status
         result.timings["solve"] += time.perf_counter() - t0
         result.timings["linear"] += status.timings["factorize"] + status.timings["solve"]
+        result.timings["assembly"] += status.timings["residual"] + status.timings["assemble"]
         return status
 
     @single_threaded_blas()

@@ -606,6 +606,29 @@ def render_png(mesh, u, fragment, path, window_size=(1200, 900), scale=1.0, crac
     return path
 
 
+def fragment_size_bins(areas):
+    """Logarithmic bin edges that hold every area: 5 to 50 bins, about sqrt(n).
+
+    Parameters
+    ----------
+    areas : numpy.ndarray
+        Fragment areas, finite and > 0, at least one.
+
+    Returns
+    -------
+    numpy.ndarray
+        Increasing edges; the first is the smallest area and the last the largest exactly
+        (``10 ** log10(a)`` can miss ``a`` by a rounding and drop that fragment from the
+        histogram: one set in three of random areas lost one), or a bin around a single size.
+    """
+    lo, hi = float(areas.min()), float(areas.max())
+    if hi <= lo * (1 + 1e-12):          # one size only: a bin around it
+        lo, hi = lo / 1.5, hi * 1.5
+    bins = np.logspace(np.log10(lo), np.log10(hi), max(5, min(50, int(np.sqrt(areas.size)) + 1)))
+    bins[0], bins[-1] = lo, hi
+    return bins
+
+
 def plot_fragment_sizes(areas, path, force=False, title="Fragment-size distribution"):
     """Histogram and cumulative distribution of fragment areas, log scale (matplotlib, Agg).
 
@@ -645,10 +668,7 @@ def plot_fragment_sizes(areas, path, force=False, title="Fragment-size distribut
     path = Path(path)
     if path.exists() and not force:
         raise FileExistsError(f"plot_fragment_sizes: {path} exists; pass force=True to overwrite it")
-    lo, hi = A.min(), A.max()
-    if hi <= lo * (1 + 1e-12):          # one size only: a bin around it
-        lo, hi = lo / 1.5, hi * 1.5
-    bins = np.logspace(np.log10(lo), np.log10(hi), max(5, min(50, int(np.sqrt(A.size)) + 1)))
+    bins = fragment_size_bins(A)
     fig = Figure(figsize=(9, 4))
     FigureCanvasAgg(fig)
     ax1, ax2 = fig.subplots(1, 2)

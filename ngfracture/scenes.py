@@ -222,7 +222,7 @@ def disk(maxh=0.06, expansion=None, dx=None, core_stiffness=0.1, name="disk", co
                              "radius": 1.0, "hole": hole, "core_inner": core_inner})
 
 
-def disintegration(maxh=0.06, expansion=None, dx=None, core_stiffness=0.1):
+def disintegration(maxh=0.08, expansion=None, dx=None, core_stiffness=0.1):
     """The disk of :func:`disk`, free outside, expanded until it falls apart (paper Fig. 10).
 
     Without the confining ring, radial cracks run through to the outside; the pieces
@@ -242,7 +242,12 @@ def disintegration(maxh=0.06, expansion=None, dx=None, core_stiffness=0.1):
 
     Parameters
     ----------
-    maxh, expansion, dx, core_stiffness
+    maxh : float
+        Mesh size. Coarser than :func:`disk`'s by default (0.08, about 1000 triangles), as
+        the paper ran this case "using a coarse initial mesh": measured on a busy 2-core
+        machine, 118 steps and 32 pieces in 5 minutes; maxh 0.06 needs 155 steps and 40
+        minutes (the README's table).
+    expansion, dx, core_stiffness
         As for :func:`disk`.
 
     Returns

@@ -57,8 +57,9 @@ from .materials import Material
 from .meshio import MeshArrays, mesh_from_arrays, mesh_to_arrays
 from .problem import ElasticProblem
 
-#: wall time per phase; "linear" (factorisations and triangular solves) is part of "solve"
-PHASES = ("solve", "linear", "strain", "split", "rebuild", "collision", "contact", "output")
+#: wall time per phase; "linear" (factorisations and triangular solves) and "assembly"
+#: (NGSolve's residual and tangent assembly) are parts of "solve"
+PHASES = ("solve", "linear", "assembly", "strain", "split", "rebuild", "collision", "contact", "output")
 
 
 @dataclass
@@ -462,6 +463,7 @@ class Simulation:
             self.timings["contact"] += result.timings["contact"] - result.timings.get("collision", 0.0)
             self.timings["collision"] += result.timings.get("collision", 0.0)
             self.timings["linear"] += result.timings.get("linear", 0.0)
+            self.timings["assembly"] += result.timings.get("assembly", 0.0)
             status = result.status
             self._iterations += status.iterations
             if not result.converged:
@@ -478,6 +480,7 @@ class Simulation:
         status = prob.solve(fix_free_modes=self.scene.fix_free_modes, **options)
         self.timings["solve"] += time.perf_counter() - t0
         self.timings["linear"] += status.timings["factorize"] + status.timings["solve"]
+        self.timings["assembly"] += status.timings["residual"] + status.timings["assemble"]
         self._iterations += status.iterations
         if not status.converged:
             raise StepFailed(status.reason, phase, status.message)
@@ -734,6 +737,7 @@ class Simulation:
                 "x": state.x, "dx": state.dx, "step": state.step, "quiet": state.quiet, "work": state.work,
                 "peak_energy": state.peak_energy, "history": state.history,
                 "area_initial": self.area_initial,
+                "control": self._path_options(),
                 "timings": self.timings}
         checkpoint.write(self.out, state.step, arrays, meta)
         self.timings["output"] += time.perf_counter() - t0
@@ -744,12 +748,26 @@ class Simulation:
             raise checkpoint.CheckpointError(
                 f"{self.out}: the checkpoint is of scene {meta.get('scene')!r} with parameters "
                 f"{meta.get('parameters')!r}, not {self.scene.name!r} with {self.scene.parameters!r}")
+        saved, now = meta.get("control"), _jsonish(self._path_options())
+        if saved is not None and saved != now:
+            name = next(k for k in sorted(set(saved) | set(now)) if saved.get(k) != now.get(k))
+            raise checkpoint.CheckpointError(
+                f"{self.out}: the checkpoint was written with {name} = {saved.get(name)!r}, this run has "
+                f"{now.get(name)!r}; resume with the options of the interrupted run (only max_steps may differ)")
         self.area_initial = meta["area_initial"]
         self.timings.update(meta.get("timings", {}))
         return State(arrays=MeshArrays.from_dict(arrays), u=arrays["u"], x=meta["x"], dx=meta["dx"],
                      step=meta["step"], quiet=meta["quiet"], work=meta["work"], reactions=arrays["reactions"],
                      fixed_values=arrays["fixed_values"], fixed_dofs=arrays["fixed_dofs"],
                      peak_energy=meta["peak_energy"], history=meta["history"])
+
+    def _path_options(self):
+        """The options that decide the load path: a resumed run must have the same ones.
+
+        ``max_steps`` only says where to stop (a run may be resumed to go further);
+        pictures and the checkpoint interval do not touch the result.
+        """
+        return {**{k: v for k, v in asdict(self.control).items() if k != "max_steps"}, "contact": self.contact}
 
     def _picture_scale(self, state):
         """Magnification that shows the largest displacement as 2% of the body's size."""
@@ -773,8 +791,10 @@ class Simulation:
             # matplotlib's import and first figure cost 2-3 s, a fifth of a plate run
             plot_fragment_sizes(stats.areas, self.out / "fragment_sizes.png", force=True)
             pictures["fragment_sizes"] = "fragment_sizes.png"
-        self.timings["output"] += time.perf_counter() - t0
+        seconds = time.perf_counter() - t0
+        self.timings["output"] += seconds
         summary["timings"]["output"] = round(self.timings["output"], 6)
+        summary["timings"]["wall"] = round(summary["timings"]["wall"] + seconds, 6)   # the pictures too
         summary["pictures"] = pictures
         write_summary(self.out / "summary.json", summary, force=True)
 

@@ -101,7 +101,7 @@ def no_meshing(monkeypatch):
 def test_folder_with_results_is_kept_byte_for_byte(plate_results, capsys, no_meshing):
     out, before = plate_results
     err = refused(["run", "plate", *SMALL, "--out", str(out)], capsys)
-    assert str(out) in err and "already holds results" in err and "force" in err
+    assert str(out) in err and "already holds results" in err and "use --force to replace them or --resume to continue" in err
     assert snapshot(out.parent) == before
 
 

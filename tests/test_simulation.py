@@ -109,6 +109,31 @@ def test_too_many_cracks_cut_the_increment():
     assert control.dx_min <= cracked[0]["dx"] < control.dx_min / control.cut
 
 
+def test_quiet_steps_grow_the_increment():
+    """After grow_after crack-free steps in a row dx grows by grow, up to dx_max (paper 4.2)."""
+    scene = scenes.plate(maxh=0.1, critical=1.0, dx=1e-5)   # uncrackable: every step is quiet
+    control = StepControl(grow=1.5, grow_after=2, dx_max=2 * scene.dx, max_steps=5)
+    result = Simulation(scene, control, pictures="none").run()
+    hist = result.summary["history"]
+    assert all(h["split_vertices"] == 0 for h in hist)
+    dx = [h["dx"] for h in hist]
+    assert dx == pytest.approx([scene.dx, scene.dx, 1.5 * scene.dx, 1.5 * scene.dx, 2 * scene.dx], rel=1e-15)
+
+
+def test_resume_with_other_options_is_refused_and_keeps_the_files(tmp_path):
+    """Options that change the load path must be those of the interrupted run; max_steps may grow."""
+    Simulation(scenes.plate(maxh=0.1), StepControl(max_steps=1), out=tmp_path, pictures="none").run()
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
+    with pytest.raises(checkpoint.CheckpointError, match="cut = 0.5, this run has 0.25"):
+        Simulation(scenes.plate(maxh=0.1), StepControl(cut=0.25), out=tmp_path, resume=True)
+    with pytest.raises(checkpoint.CheckpointError, match="contact = 'auto', this run has 'never'"):
+        Simulation(scenes.plate(maxh=0.1), out=tmp_path, resume=True, contact="never")
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
+    again = Simulation(scenes.plate(maxh=0.1), StepControl(max_steps=2), out=tmp_path, resume=True,
+                       pictures="none").run()
+    assert again.summary["n_steps"] == 2
+
+
 def test_resume_equals_uninterrupted(tmp_path):
     scene = lambda: scenes.plate(maxh=0.06)
     full = tmp_path / "full"
@@ -194,6 +219,10 @@ def test_resuming_a_finished_run_redraws_its_final_outputs(tmp_path):
     control = lambda: StepControl(max_steps=2)
     first = Simulation(scenes.plate(maxh=0.1), control(), out=tmp_path).run()
     assert first.reason == "max_steps"
+    # the phases are disjoint parts of the wall time, the final pictures included
+    t = json.loads((tmp_path / "summary.json").read_text())["timings"]
+    phases = ("solve", "strain", "split", "rebuild", "collision", "contact", "output")
+    assert sum(t[k] for k in phases) <= t["wall"] + 1e-5
     (tmp_path / "summary.json").unlink()                 # as if killed before the summary
     again = Simulation(scenes.plate(maxh=0.1), control(), out=tmp_path, resume=True).run()
     assert again.reason == "max_steps" and again.summary["n_steps"] == 2
