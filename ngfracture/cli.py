@@ -12,6 +12,7 @@ import argparse
 import json
 import math
 import os
+import re
 import sys
 import tempfile
 
@@ -87,7 +88,7 @@ def _add_run(subparsers):
                     "normally, 1 when a step fails after all retries (the last good state is "
                     "written), 2 on bad input.")
     p.add_argument("scene", choices=sorted(scenes.SCENES),
-                   help="; ".join(f"{k}: {v.__doc__.splitlines()[0].rstrip('.')}"
+                   help="; ".join(f"{k}: {_plain(v.__doc__.splitlines()[0].rstrip('.'))}"
                                   for k, v in sorted(scenes.SCENES.items())))
     p.add_argument("--maxh", type=_positive_float, default=None,
                    help="mesh size (default: the scene's, about the paper's resolution)")
@@ -113,10 +114,22 @@ def _add_run(subparsers):
     p.set_defaults(func=_run_run)
 
 
+def progress_bar(info, width=20):
+    """One line: a bar of the load reached, the step, split vertices, fragments, seconds."""
+    done = min(max(info["x"] / info["load_max"], 0.0), 1.0) if info["load_max"] > 0 else 0.0
+    filled = int(done * width)
+    return (f"[{'#' * filled}{'.' * (width - filled)}] {100 * done:3.0f}%  step {info['step']:4d}  "
+            f"split vertices {info['split_vertices']:6d}  fragments {info['fragments']:4d}  "
+            f"{info['seconds']:7.1f} s")
+
+
+def _plain(text):
+    """Docstring text without Sphinx roles (":func:`disk`" -> "disk") for --help."""
+    return re.sub(r":\w+:`([^`]*)`", r"\1", text)
+
+
 def _progress_line(info):
-    sys.stderr.write(f"\rstep {info['step']:4d}  load {info['x']:.4e}  split vertices "
-                     f"{info['split_vertices']:6d}  fragments {info['fragments']:4d}  "
-                     f"{info['seconds']:7.1f} s")
+    sys.stderr.write("\r" + progress_bar(info))
     sys.stderr.flush()
 
 

@@ -223,7 +223,7 @@ def disk(maxh=0.06, expansion=None, dx=None, core_stiffness=0.1, name="disk", co
 
 
 def disintegration(maxh=0.08, expansion=None, dx=None, core_stiffness=0.1):
-    """The disk of :func:`disk`, free outside, expanded until it falls apart (paper Fig. 10).
+    """The disk scene free outside, expanded until it falls apart (paper Fig. 10).
 
     Without the confining ring, radial cracks run through to the outside; the pieces
     are held on all their rigid modes by multiplier rows (the paper pins two points

@@ -333,7 +333,8 @@ class Simulation:
     checkpoint_every : int
         Write a checkpoint after every this many accepted steps (and at the end).
     progress : callable(dict), optional
-        Called after every accepted step with step, x, cracks, fragments, seconds.
+        Called after every accepted step with a dict: step, x, load_max, split_vertices,
+        fragments, seconds.
     contact : {"auto", "never"}
         "auto": contact from the first crack on (or from the start for separate bodies);
         "never": no contact rows at all (faster where pieces only separate; the summary's
@@ -683,7 +684,8 @@ class Simulation:
                 if state.step % self.checkpoint_every == 0:
                     self._checkpoint(state)
             if self.progress is not None:
-                self.progress({"step": state.step, "x": state.x, "split_vertices": sum(h["split_vertices"] for h in state.history),
+                self.progress({"step": state.step, "x": state.x, "load_max": self.scene.load_max,
+                               "split_vertices": sum(h["split_vertices"] for h in state.history),
                                "fragments": state.history[-1]["fragments"], "seconds": time.perf_counter() - t_start})
         if prob is None:
             prob = self._problem(self._mesh, state.x, state.u)

@@ -198,3 +198,12 @@ def test_failed_run_exits_1_with_the_last_good_state(tmp_path, capsys, monkeypat
 
 if __name__ == "__main__":
     raise SystemExit(pytest.main([__file__, "-q"]))
+
+
+def test_progress_bar_shows_the_load_reached():
+    from ngfracture.cli import progress_bar
+    info = {"x": 2.5e-4, "load_max": 1e-3, "step": 7, "split_vertices": 12, "fragments": 2, "seconds": 3.25}
+    line = progress_bar(info, width=20)
+    assert line.startswith("[" + "#" * 5 + "." * 15 + "]  25%")
+    assert "step    7" in line and "split vertices     12" in line and "fragments    2" in line and "3.2 s" in line
+    assert progress_bar({**info, "x": 2e-3}).startswith("[" + "#" * 20 + "] 100%")   # clipped
