@@ -26,11 +26,12 @@ is the one the floor is read as). The modules the run loads on first use (pyvist
 matplotlib) are imported before the first case, as NGSolve itself is: a once-per-process
 cost that would otherwise land in the first case's "output" phase only.
 
-Usage: python benchmarks/scenes.py [--scenes plate disk] [--factors 1 4 16] [--steps N] [--json FILE]
+Usage: python benchmarks/scenes.py [--scenes plate disk] [--factors 1 4 16] [--steps N] [--json FILE [--force]]
 """
 import argparse
 import json
 import math
+import os
 import sys
 import tempfile
 import time
@@ -85,8 +86,12 @@ def main(argv=None):
     p.add_argument("--steps", type=int, default=None,
                    help="stop every run after this many steps (for the finest meshes; the "
                         "shares are then those of the first steps)")
-    p.add_argument("--json", default=None, help="also write the JSON to this file")
+    p.add_argument("--json", default=None, help="also write the JSON to this file; refused if it exists, "
+                                                "unless --force")
+    p.add_argument("--force", action="store_true", help="overwrite the --json file")
     args = p.parse_args(argv)
+    if args.json and os.path.exists(args.json) and not args.force:
+        p.error(f"{args.json} exists; pass --force to overwrite it")   # before hours of runs
     import pyvista, matplotlib.figure  # noqa: F401  (see the module docstring)
     cases = []
     for name in args.scenes:
