@@ -57,20 +57,26 @@ def test_encircling_check_on_a_ring_and_a_c_shape():
     assert not encircles_origin(a.triangles, a.points, cut)
 
 
-@pytest.fixture(scope="module")
-def disk_run():
-    return Simulation(scenes.disk(maxh=0.06), pictures="none").run()
+#: the default resolution (slow: 13 minutes on a busy machine) and a coarse one for the
+#: fast suite (about a minute: 48 steps, 107 split vertices, 16 fragments); the issue's
+#: "more than 20 grains" is for the default scene, the coarse mesh has room for fewer
+DISK_CASES = [pytest.param((0.12, 10), id="coarse"),
+              pytest.param((0.06, 20), id="default", marks=pytest.mark.slow)]
 
 
-@pytest.mark.slow
+@pytest.fixture(scope="module", params=DISK_CASES)
+def disk_run(request):
+    maxh, min_grains = request.param
+    return Simulation(scenes.disk(maxh=maxh), pictures="none").run(), min_grains
+
+
 def test_disk_contact_leaves_no_overlap(disk_run):
-    """Measured: 3.2e-17 (8.2e-7 before the diagonal rows at four-way junctions, all of it
-    in 38 triangle pairs across their diagonals)."""
-    s = disk_run.summary
+    """Measured at maxh 0.06: 3.2e-17 (8.2e-7 before the diagonal rows at four-way
+    junctions, all of it in 38 triangle pairs across their diagonals)."""
+    s = disk_run[0].summary
     assert s["max_overlap_area"] <= 1e-10 * s["area_initial"]
 
 
-@pytest.mark.slow
 def test_disk_comminuted_zone_and_intact_ring(disk_run):
     """The issue's requirement: more than 20 grains, and an intact outer ring (one piece
     that holds the whole outer boundary and still goes around the hole).
@@ -81,7 +87,7 @@ def test_disk_comminuted_zone_and_intact_ring(disk_run):
     the radial cracks, and the bound is now the inner three quarters, with the intact
     outer boundary checked directly.
     """
-    result = disk_run
+    result, min_grains = disk_run
     assert result.ok and result.reason == "load_max", result.message
     s = result.summary
     assert s["area_final"] == s["area_initial"]
@@ -91,7 +97,7 @@ def test_disk_comminuted_zone_and_intact_ring(disk_run):
     on_disk = [f for f in stats.ids if np.all(a.regions[stats.fragment == f] == disk_region)]
     ring = max(on_disk, key=lambda f: stats.areas[np.searchsorted(stats.ids, f)])
     grains = [f for f in on_disk if f != ring]
-    assert len(grains) > 20, len(grains)
+    assert len(grains) > min_grains, len(grains)
     # the outer ring is one piece: every triangle on the outer boundary belongs to it ...
     outer = a.segments[a.seg_bc == a.bc_names.index("outer") + 1]
     on_outer = np.flatnonzero(np.isin(a.triangles, outer).sum(axis=1) >= 2)
