@@ -115,7 +115,21 @@ def _add_run(subparsers):
 
 
 def progress_bar(info, width=20):
-    """One line: a bar of the load reached, the step, split vertices, fragments, seconds."""
+    """One line: a bar of the load reached, the step, split vertices, fragments, seconds.
+
+    Parameters
+    ----------
+    info : dict
+        As passed to ``Simulation(progress=...)``: step, x, load_max, split_vertices,
+        fragments, seconds.
+    width : int
+        Characters of the bar.
+
+    Returns
+    -------
+    str
+        Without a line end; the bar is full from x >= load_max on.
+    """
     done = min(max(info["x"] / info["load_max"], 0.0), 1.0) if info["load_max"] > 0 else 0.0
     filled = int(done * width)
     return (f"[{'#' * filled}{'.' * (width - filled)}] {100 * done:3.0f}%  step {info['step']:4d}  "
