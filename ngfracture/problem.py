@@ -454,7 +454,7 @@ class ElasticProblem:
         return self.mesh.MaterialCF({name: make(m) for name, m in self.materials.items()})
 
     def solve(self, method="modified", load_steps=1, tol=1e-10, maxit=50, linear_solver="direct",
-              inverse="sparsecholesky", fix_free_modes=False, tangent=None):
+              inverse="auto", fix_free_modes=False, tangent=None):
         """Solve for equilibrium with the current constraints and loads.
 
         Parameters
@@ -469,7 +469,8 @@ class ElasticProblem:
             Iterations allowed per load step.
         linear_solver : {"direct", "gmres"}
         inverse : str
-            NGSolve direct solver for "direct".
+            Direct solver for "direct": "auto", "superlu" or an NGSolve name (see
+            kkt.ConstrainedSolver).
         fix_free_modes : bool or "all"
             Hold free fragments by multiplier rows on their unheld rigid modes
             instead of reporting them as floating bodies; "all": on all their rigid modes

@@ -169,7 +169,7 @@ class NewtonSolver:
         Maximum iterations per load step.
     linear_solver : {"direct", "gmres"}
     inverse : str
-        NGSolve direct solver name.
+        Direct solver: "auto", "superlu" or an NGSolve name (see kkt.ConstrainedSolver).
     divergence_factor : float
         An increment this many times larger than the first one means divergence.
     fix_free_modes : bool or "all"
@@ -190,7 +190,7 @@ class NewtonSolver:
     """
 
     def __init__(self, problem, method="modified", tol=1e-10, maxit=50, linear_solver="direct",
-                 inverse="sparsecholesky", divergence_factor=1e4, fix_free_modes=False, tangent=None):
+                 inverse="auto", divergence_factor=1e4, fix_free_modes=False, tangent=None):
         if method not in METHODS:
             raise ValueError(f"method must be one of {METHODS}, got {method!r}")
         if fix_free_modes not in (False, True, "all"):

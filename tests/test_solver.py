@@ -163,6 +163,37 @@ def test_gmres_option_agrees_with_direct():
     assert np.linalg.norm(ua - ub) < 1e-8 * np.linalg.norm(ua)
 
 
+@pytest.mark.parametrize("inverse", ["superlu", "sparsecholesky"])
+def test_direct_solvers_agree(inverse):
+    """SuperLU (the default up to kkt.SUPERLU_MAX_DOFS) and NGSolve's sparse Cholesky solve
+    the same Newton steps: the converged states agree to the tolerance of eq. 7."""
+    a, b = stretch_problem(nf.StVenantKirchhoff, 0.1), stretch_problem(nf.StVenantKirchhoff, 0.1)
+    assert a.solve(tol=1e-11, inverse="umfpack").converged
+    sb = b.solve(tol=1e-11, inverse=inverse)
+    assert sb.converged, sb.message
+    ua, ub = a.u.vec.FV().NumPy(), b.u.vec.FV().NumPy()
+    assert np.linalg.norm(ua - ub) < 1e-10 * np.linalg.norm(ua)
+
+
+def test_auto_inverse_picks_by_size(monkeypatch):
+    from ngfracture import kkt
+    prob = stretch_problem(nf.StVenantKirchhoff, 0.1)
+    K = prob.tangent()
+    assert kkt.EliminatedFactor(K, []).inverse == "superlu"
+    monkeypatch.setattr(kkt, "SUPERLU_MAX_DOFS", prob.fes.ndof - 1)
+    assert kkt.EliminatedFactor(K, []).inverse == "sparsecholesky"
+
+
+def test_singular_stiffness_is_reported_by_superlu():
+    """A stiffness with a free rigid mode, factorised without a pin: reported, not solved."""
+    from ngfracture import kkt
+    prob = stretch_problem(nf.LinearElastic, 0.1)
+    K = prob.tangent()
+    with pytest.raises(kkt.SingularSystem):
+        f = kkt.EliminatedFactor(K, [], inverse="superlu")      # all dofs free: three rigid modes
+        f.solve(np.random.default_rng(0).standard_normal(prob.fes.ndof))
+
+
 def test_body_force_and_traction_balance():
     """Clamped bar under a traction: the reaction equals the applied load (linear, exact in total)."""
     mesh = square_mesh(0.25)
