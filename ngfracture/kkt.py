@@ -271,12 +271,19 @@ class EliminatedFactor:
                 if info != 0 or not np.all(np.isfinite(x)):
                     raise SingularSystem(f"GMRES did not converge (info={info})")
                 X[self.factor_free, j] = x
-        elif self._lu is not None:
-            X[self.factor_free] = self._lu.solve(np.asfortranarray(B[self.factor_free]))
+        else:
+            self._direct_solve(B, X)
             if not np.all(np.isfinite(X)):
                 raise SingularSystem("the factorised stiffness produced NaN/inf: singular (a floating body?)")
             if not self._checked:
                 self._check(B, X)
+        self.seconds += time.perf_counter() - t0
+        return X[:, 0] if single else X
+
+    def _direct_solve(self, B, X):
+        """X[factor_free] = K_ff^-1 B[factor_free] with the direct factorisation."""
+        if self._lu is not None:
+            X[self.factor_free] = self._lu.solve(np.asfortranarray(B[self.factor_free]))
         else:
             # one multi-vector solve instead of a Python loop over columns
             rhs = ng.MultiVector(self._tmp, B.shape[1])
@@ -286,12 +293,6 @@ class EliminatedFactor:
             out[:] = self._inv * rhs
             for j in range(B.shape[1]):
                 X[:, j] = out[j].FV().NumPy()
-            if not np.all(np.isfinite(X)):
-                raise SingularSystem("the factorised stiffness produced NaN/inf: singular (a floating body?)")
-            if not self._checked:
-                self._check(B, X)
-        self.seconds += time.perf_counter() - t0
-        return X[:, 0] if single else X
 
     def _check(self, B, X):
         """One residual check per factorisation: sparse Cholesky of a singular or
