@@ -245,8 +245,8 @@ def disintegration(maxh=0.08, expansion=None, dx=None, core_stiffness=0.1):
     maxh : float
         Mesh size. Coarser than :func:`disk`'s by default (0.08, about 1000 triangles), as
         the paper ran this case "using a coarse initial mesh": measured on a busy 2-core
-        machine, 118 steps and 32 pieces in 5 minutes; maxh 0.06 needs 155 steps and 40
-        minutes (the README's table).
+        machine, 118 steps and 32 pieces in about 3 minutes; maxh 0.06 needs 155 steps and
+        about 20 minutes (the README's table).
     expansion, dx, core_stiffness
         As for :func:`disk`.
 
