@@ -65,8 +65,11 @@ def _compare(a, b):
     for key in sb:
         if key not in ("timings",):
             assert sa[key] == sb[key], key
-    n = sb["n_steps"]
-    for name in (f"step_{n:06d}.vtu", f"cracks_{n:06d}.vtp"):
+    # every step's files, not only the last: a resumed run rewrites none of them differently
+    names = sorted(p.name for pattern in ("step_*.vtu", "cracks_*.vtp") for p in b.glob(pattern))
+    assert names == sorted(p.name for pattern in ("step_*.vtu", "cracks_*.vtp") for p in a.glob(pattern))
+    assert len(names) == 2 * (sb["n_steps"] + 1)
+    for name in names:
         ga, gb = pv.read(a / name), pv.read(b / name)
         assert np.array_equal(ga.points, gb.points), name
         for k in gb.point_data:

@@ -146,13 +146,13 @@ def test_resume_equals_uninterrupted(tmp_path):
     for key in b:
         if key not in ("timings", "control"):
             assert a[key] == b[key], key
-    n = b["n_steps"]
-    ga, gb = pv.read(part / f"step_{n:06d}.vtu"), pv.read(full / f"step_{n:06d}.vtu")
-    assert np.array_equal(ga.points, gb.points)
-    for name in gb.point_data:
-        assert np.array_equal(ga.point_data[name], gb.point_data[name]), name
-    for name in gb.cell_data:
-        assert np.array_equal(ga.cell_data[name], gb.cell_data[name]), name
+    for n in range(b["n_steps"] + 1):       # every step, those before the interruption too
+        ga, gb = pv.read(part / f"step_{n:06d}.vtu"), pv.read(full / f"step_{n:06d}.vtu")
+        assert np.array_equal(ga.points, gb.points), n
+        for name in gb.point_data:
+            assert np.array_equal(ga.point_data[name], gb.point_data[name]), (n, name)
+        for name in gb.cell_data:
+            assert np.array_equal(ga.cell_data[name], gb.cell_data[name]), (n, name)
 
 
 def test_existing_results_are_refused_and_kept(tmp_path):
