@@ -187,18 +187,18 @@ class EliminatedFactor:
         self._tmp = K.CreateColVector()
         self._columns = {}        # row key -> K^+ row^T, for the rows of the last Schur complement
         self._lu = None
+        self._checked = False     # direct solvers: the first solve checks its residual
         if inverse == "auto":
             inverse = "superlu" if np.count_nonzero(self.factor_free) <= SUPERLU_MAX_DOFS else "sparsecholesky"
         self.inverse = inverse
         if linear_solver == "direct" and inverse == "superlu":
-            Kff = to_scipy(K)[self.factor_free][:, self.factor_free].tocsc()
+            Kff = self._factorised_block()
             try:
                 # symmetric ordering, diagonal pivots unless one is 100 times below its column
                 self._lu = spla.splu(Kff, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.01,
                                      options={"SymmetricMode": True})
             except RuntimeError as err:
                 raise SingularSystem(f"the sparse LU factorisation failed: {err}") from None
-            self._checked = False
         elif linear_solver == "direct":
             factor_dofs = ng.BitArray(self.ndof)
             factor_dofs.Set()
@@ -206,9 +206,8 @@ class EliminatedFactor:
                 factor_dofs.Clear(d)
             with reproducible_threads():
                 self._inv = K.Inverse(factor_dofs, inverse=inverse)
-            self._checked = False
         else:
-            Kff = to_scipy(K)[self.factor_free][:, self.factor_free].tocsc()
+            Kff = self._factorised_block()
             self._Kff = Kff
             try:
                 ilu = spla.spilu(Kff, drop_tol=1e-5, fill_factor=20, permc_spec="MMD_AT_PLUS_A")
@@ -216,6 +215,10 @@ class EliminatedFactor:
                 raise SingularSystem(f"ILU factorisation failed: {err}") from None
             self._precond = spla.LinearOperator(Kff.shape, ilu.solve)
         self.seconds = time.perf_counter() - t0
+
+    def _factorised_block(self):
+        """K on the factorised dofs (without fixed dofs and pins), scipy CSC."""
+        return to_scipy(self.K)[self.factor_free][:, self.factor_free].tocsc()
 
     def matches(self, fixed_dofs, pins):
         """True if this factorisation leaves out exactly these fixed dofs and pins.
