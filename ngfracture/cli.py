@@ -154,10 +154,8 @@ def _run_run(args):
     if args.force and args.resume:
         raise ValueError("--force and --resume exclude each other")
     out = args.out if args.out is not None else os.path.join("out", args.scene)
-    try:
-        Simulation.check_output(out, force=args.force, resume=args.resume)   # before meshing
-    except FileExistsError as err:
-        raise FileExistsError(str(err).replace("use force", "use --force").replace("or resume", "or --resume")) from None
+    Simulation.check_output(out, force=args.force, resume=args.resume,     # before meshing
+                            option_names=("--force", "--resume"))
     options = {} if args.maxh is None else {"maxh": args.maxh}
     scene = scenes.SCENES[args.scene](**options)
     if args.load_max is not None:

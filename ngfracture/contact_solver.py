@@ -320,8 +320,8 @@ class ContactSolver:
         status = self.problem.solve(tangent=tangent, **self.options)
         result.status = status
         result.timings["solve"] += time.perf_counter() - t0
-        result.timings["linear"] += status.timings["factorize"] + status.timings["solve"]
-        result.timings["assembly"] += status.timings["residual"] + status.timings["assemble"]
+        for part, seconds in status.phase_seconds().items():
+            result.timings[part] += seconds
         return status
 
     @single_threaded_blas()

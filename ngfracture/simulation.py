@@ -385,7 +385,7 @@ class Simulation:
                     ".checkpoint_*.tmp")
 
     @classmethod
-    def check_output(cls, out, force=False, resume=False):
+    def check_output(cls, out, force=False, resume=False, option_names=("force", "resume")):
         """Refuse an output folder before any work; returns the files of ours in it.
 
         Parameters
@@ -394,6 +394,8 @@ class Simulation:
             The output folder (need not exist).
         force, resume : bool
             As for :class:`Simulation`.
+        option_names : (str, str)
+            How the refusal names the two options (the CLI passes "--force", "--resume").
 
         Returns
         -------
@@ -415,7 +417,7 @@ class Simulation:
             raise checkpoint.CheckpointError(f"{out}: no checkpoint to resume from")
         if own and not (force or resume):
             raise FileExistsError(f"output folder {out} already holds results ({own[0].name}, ...); "
-                                  f"use force to replace them or resume to continue")
+                                  f"use {option_names[0]} to replace them or {option_names[1]} to continue")
         return own
 
     def _prepare_output(self):
@@ -480,8 +482,8 @@ class Simulation:
         t0 = time.perf_counter()
         status = prob.solve(fix_free_modes=self.scene.fix_free_modes, **options)
         self.timings["solve"] += time.perf_counter() - t0
-        self.timings["linear"] += status.timings["factorize"] + status.timings["solve"]
-        self.timings["assembly"] += status.timings["residual"] + status.timings["assemble"]
+        for part, seconds in status.phase_seconds().items():
+            self.timings[part] += seconds
         self._iterations += status.iterations
         if not status.converged:
             raise StepFailed(status.reason, phase, status.message)

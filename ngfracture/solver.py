@@ -75,6 +75,18 @@ class SolveStatus:
     def __bool__(self):
         return self.converged
 
+    def phase_seconds(self):
+        """Seconds in "linear" (factorisations, triangular solves) and "assembly" (residuals,
+        tangents): the parts of a solve that Simulation and ContactSolver report.
+
+        Returns
+        -------
+        dict
+            {"linear": float, "assembly": float}
+        """
+        t = self.timings
+        return {"linear": t["factorize"] + t["solve"], "assembly": t["residual"] + t["assemble"]}
+
     def fail(self, reason, message):
         """Record a failure: converged becomes False, reason and message are set.
 
