@@ -112,7 +112,7 @@ def test_disk_comminuted_zone_and_intact_ring(disk_run):
 @pytest.mark.slow
 @pytest.mark.parametrize("maxh", [0.08, 0.06])
 def test_disintegration_many_disjoint_fragments(maxh):
-    """Measured: see the README's table (maxh 0.08 is the scene's default, the paper's
+    """Measured: see the table in docs/verification.md (maxh 0.08 is the scene's default, the paper's
     "coarse initial mesh": 118 steps, about 5 minutes on a busy machine; 0.06, the disk's
     resolution: 155 steps, 53 disk pieces, about 20 minutes). Without the diagonal
     rows at four-way junctions (ngfracture.seams) 0.08 stopped at step 75 (x = 0.00457)
