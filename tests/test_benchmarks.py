@@ -1,5 +1,6 @@
 """Every benchmark takes ``--json FILE``, refuses an existing FILE before any work, and writes JSON."""
 import json
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -11,7 +12,7 @@ BENCHMARKS = ["contact", "crack", "lshape", "meshcheck", "scenes"]
 
 
 def run_benchmark(name, *args):
-    env = {"PYTHONPATH": str(ROOT), "OMP_NUM_THREADS": "1", "PATH": "/usr/bin:/bin"}
+    env = {**os.environ, "PYTHONPATH": str(ROOT), "OMP_NUM_THREADS": "1"}
     return subprocess.run([sys.executable, str(ROOT / "benchmarks" / f"{name}.py"), *args],
                           capture_output=True, text=True, env=env, timeout=600)
 
