@@ -56,8 +56,8 @@ from . import checkpoint
 from .contact_solver import ContactSolver, fragment_overlap_area
 from .crack import StrainCriterion, split_by_tensor, transfer
 from .fragments import FragmentStatistics
-from .loadpath import load_path_cut, prescribed_increment
 from .kkt import single_threaded_blas
+from .loadpath import load_path_cut, prescribed_increment
 from .materials import Material
 from .meshio import MeshArrays, mesh_from_arrays, mesh_to_arrays
 from .problem import ElasticProblem
@@ -136,7 +136,9 @@ class Scene:
         ------
         ValueError
             Naming the first bad field (a non-positive load or increment, an unknown
-            region, a bad critical strain, no region that can crack, a bad material).
+            region, a bad critical strain, no region that can crack, a bad material), or
+            what ``apply_load`` cannot add on the mesh (an unknown boundary name,
+            conflicting prescribed values).
         """
         if not isinstance(self.name, str) or not self.name:
             raise ValueError(f"Scene.name must be a non-empty string, got {self.name!r}")
