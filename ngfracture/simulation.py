@@ -20,8 +20,11 @@ diverged with the saved tangent and converged with fresh ones); then a failure o
 increment solve is retried with the same target in twice as many Newton load steps (the
 load path does not change), a failure at fixed load after a split with dx * cut; after ``max_retries``
 failures the run stops with the last good state written and a reason.  The run ends when x reaches the scene's ``load_max``, after ``max_steps``
-steps, or, for scenes that ask for it, once the body is broken through (the elastic
-energy has fallen below ``unloaded_fraction`` of its peak after cracks appeared).
+steps, or, for scenes that ask for it, once the body is broken through: no fragment
+connects boundaries that the prescribed displacements move against each other
+(loadpath.py; pieces that only push on each other by contact, such as the interlocking
+halves of the plate, do not count), or the elastic energy has fallen below
+``unloaded_fraction`` of its peak after cracks appeared.
 
 Where the paper is vague, we chose:
 
@@ -41,6 +44,7 @@ Where the paper is vague, we chose:
 """
 import math
 import time
+import warnings
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Callable
@@ -53,6 +57,7 @@ from .contact_solver import ContactSolver, fragment_overlap_area
 from .crack import StrainCriterion, split_by_tensor, transfer
 from .fragments import FragmentStatistics
 from .kkt import single_threaded_blas
+from .loadpath import load_path_cut, prescribed_increment
 from .materials import Material
 from .meshio import MeshArrays, mesh_from_arrays, mesh_to_arrays
 from .problem import ElasticProblem
@@ -91,8 +96,10 @@ class Scene:
         Solve with contact from the start (separate bodies); otherwise contact starts
         with the first crack.
     stop_when_unloaded : bool
-        End the run once the body is broken through (elastic energy below
-        ``unloaded_fraction`` of its peak after cracks appeared).
+        End the run once the body is broken through: no fragment is deformed by the
+        prescribed displacements any more although they deform the body (each piece
+        follows its share of them rigidly, see loadpath.py), or the elastic energy has
+        fallen below ``unloaded_fraction`` of its peak after cracks appeared.
     parameters : dict
         The numbers that define the scene, copied into summary.json.
     control : dict
@@ -129,7 +136,9 @@ class Scene:
         ------
         ValueError
             Naming the first bad field (a non-positive load or increment, an unknown
-            region, a bad critical strain, no region that can crack, a bad material).
+            region, a bad critical strain, no region that can crack, a bad material), or
+            what ``apply_load`` cannot add on the mesh (an unknown boundary name,
+            conflicting prescribed values).
         """
         if not isinstance(self.name, str) or not self.name:
             raise ValueError(f"Scene.name must be a non-empty string, got {self.name!r}")
@@ -157,6 +166,16 @@ class Scene:
             raise ValueError(f"Scene {self.name!r}: fix_free_modes must be True or 'all', got {self.fix_free_modes!r}")
         if not isinstance(self.material, (Material, dict)):
             raise ValueError(f"Scene {self.name!r}: material must be a Material or a dict of them")
+        # the constraints apply_load adds (a boundary name that is not in the mesh, values that
+        # conflict) fail here, not at the first step of a run
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")   # mesh quality: the run's own problems warn
+                prob = ElasticProblem(self.mesh, self.material, order=1)
+            self.apply_load(prob, self.load_max)
+            prob.assemble_constraints()
+        except ValueError as err:
+            raise ValueError(f"Scene {self.name!r}: apply_load(problem, load_max) fails: {err}") from err
         return crit
 
 
@@ -561,9 +580,11 @@ class Simulation:
     def _accept(self, state, prob, dx, first, total):
         arrays, mesh = round_trip(prob.mesh)
         u = prob.u.vec.FV().NumPy().copy()
+        # the solve ended at u (kept by the problem, no assembly); the round trip keeps the dof numbers
+        out_of_balance = prob.out_of_balance()
         prob = self._problem(mesh, self._x_try, u)   # the state as a resume would see it
         rows = prob.assemble_constraints()
-        reactions = -prob.out_of_balance()[rows.fixed_dofs]   # for the work of the next increment
+        reactions = -out_of_balance[rows.fixed_dofs]   # for the work of the next increment
         dwork = self._dwork
         energy = float(prob.energy())
         stats = FragmentStatistics(mesh)
@@ -666,9 +687,9 @@ class Simulation:
             if state.step >= c.max_steps:
                 reason, message = "max_steps", f"stopped after {c.max_steps} steps"
                 break
-            if self.scene.stop_when_unloaded and state.history and state.history[-1]["crack_length"] > 0 and \
-                    state.history[-1]["elastic_energy"] < c.unloaded_fraction * state.peak_energy:
-                reason, message = "broken", "the body is broken through (elastic energy released)"
+            broken = self._broken(state) if self.scene.stop_when_unloaded and state.history else ""
+            if broken:
+                reason, message = "broken", broken
                 break
             remaining = self.scene.load_max - state.x
             # no sliver of a last step: a remainder below dx_min joins this one
@@ -700,6 +721,20 @@ class Simulation:
             self._final_outputs(state, prob, stats, summary)
         return RunResult(ok=reason in ("load_max", "max_steps", "broken"), reason=reason, message=message,
                          summary=summary, problem=prob, state=state)
+
+    def _broken(self, state):
+        """Why the accepted state is broken through (Scene.stop_when_unloaded), or ""."""
+        last = state.history[-1]
+        if last["fragments"] > 1:
+            # the prescribed values at x (state.fixed_*, on this mesh) against those at 0
+            unloaded = self._problem(self._mesh, 0.0).assemble_constraints()
+            dofs, increment = prescribed_increment(unloaded.fixed_dofs, unloaded.fixed_values,
+                                                   state.fixed_dofs, state.fixed_values)
+            if load_path_cut(state.arrays.points, state.arrays.triangles, dofs, increment):
+                return "the body is broken through (no fragment connects boundaries the load moves apart)"
+        if last["crack_length"] > 0 and last["elastic_energy"] < self.control.unloaded_fraction * state.peak_energy:
+            return "the body is broken through (elastic energy released)"
+        return ""
 
     def _summary(self, state, prob, stats, area_initial, reason, message, wall):
         hist = state.history

@@ -37,6 +37,10 @@ def test_critical_strain_1e_12_shatters_once_and_stops():
     scene.critical = 1e-12          # 1e8 times below the strain of the first increment
     nv0, ne = scene.mesh.nv, scene.mesh.ne
     control = StepControl(max_steps=3, max_relax_passes=20)
+    # the shattered plate is broken through: the run ends after the step that shattered it
+    broken = Simulation(scene, control, contact="never").run()
+    assert broken.reason == "broken" and broken.summary["n_steps"] == 1, broken.message
+    scene.stop_when_unloaded = False     # go on: the steps after shattering stay quiet
     result = Simulation(scene, control, contact="never").run()
     s, hist = result.summary, result.summary["history"]
     assert result.ok and result.reason == "max_steps" and s["n_steps"] == 3
