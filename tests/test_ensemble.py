@@ -21,7 +21,10 @@ from ngfracture.ensemble import KILL_HOOK, Ensemble
 from ngfracture.statistics import fit_fragment_sizes, fragment_size_statistics
 
 FACTORY = functools.partial(scenes.plate, maxh=0.15, weibull_m=8)
-OPTIONS = dict(control={"max_steps": 14}, contact="never", progress=False, replicates=200)
+OPTIONS = dict(control={"max_steps": 14}, contact="never", progress=False)
+#: the same ensemble from the command line
+CLI_ARGS = ["ensemble", "plate", "--samples", "3", "--set", "weibull_m=8", "--set", "maxh=0.15", "--steps", "14",
+            "--contact", "never", "--workers", "1", "--quiet"]
 SEEDS = [0, 1, 2]
 
 
@@ -70,18 +73,19 @@ def test_a_killed_worker_has_its_sample_resumed_to_the_same_result(reference, tm
 
 
 CHILD = """
-import functools, sys
-from ngfracture import scenes
-from ngfracture.ensemble import Ensemble
+import sys
+from ngfracture.cli import main
 if __name__ == "__main__":
-    Ensemble(functools.partial(scenes.plate, maxh=0.15, weibull_m=8), [0, 1, 2], out=sys.argv[1], workers=1,
-             control={"max_steps": 14}, contact="never", progress=False, replicates=200).run()
+    sys.exit(main(sys.argv[1:]))
 """
 
 
-def test_a_killed_command_reruns_without_rerunning_finished_samples(reference, tmp_path):
+def test_a_killed_command_reruns_without_rerunning_finished_samples(reference, tmp_path, capsys):
+    """``ngfracture ensemble`` killed (with its cluster) after the first sample; the rerun skips it,
+    resumes or runs the others, and gives the reference ensemble."""
+    from ngfracture.cli import main
     out = tmp_path / "ens"
-    child = subprocess.Popen([sys.executable, "-c", CHILD, str(out)], start_new_session=True,
+    child = subprocess.Popen([sys.executable, "-c", CHILD, *CLI_ARGS, "--out", str(out)], start_new_session=True,
                              env={**os.environ, "OMP_NUM_THREADS": "1"})
     first = out / "sample_0000" / "summary.json"
     deadline = time.monotonic() + 240
@@ -91,10 +95,30 @@ def test_a_killed_command_reruns_without_rerunning_finished_samples(reference, t
     child.wait()
     assert first.exists() and not (out / "ensemble.json").exists()
     stamp = first.stat().st_mtime_ns
-    report = Ensemble(FACTORY, SEEDS, out=out, workers=1, **OPTIONS).run()
+    assert main(CLI_ARGS + ["--out", str(out)]) == 0
+    report = json.loads((out / "ensemble.json").read_text())
     assert 0 in report["execution"]["status"]["skipped"]
     assert first.stat().st_mtime_ns == stamp
     assert comparable(report) == comparable(reference)
+    assert "3 of 3 samples finished" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--samples", "0"], "--samples: must be >= 1"),
+    (["--samples", "2"], "--set weibull_m=8"),
+    (["--samples", "2", "--set", "weibull_m=8", "--set", "nonsense=1"], "no parameter 'nonsense'"),
+    (["--samples", "2", "--set", "weibull_m=8", "--set", "seed=4"], "--seed S"),
+    (["--samples", "2", "--set", "weibull_m=0"], "weibull_m must be a finite number > 0"),
+    (["--samples", "2", "--set", "weibull_m=8", "--scheduler", "tcp://127.0.0.1:1"], "cannot reach the dask scheduler"),
+])
+def test_command_line_bad_input_is_refused_before_any_file(tmp_path, capsys, args, message):
+    from ngfracture.cli import main
+    out = tmp_path / "ens"
+    with pytest.raises(SystemExit) as exit_:
+        main(["ensemble", "plate", "--set", "maxh=0.3", *args, "--out", str(out)])
+    assert exit_.value.code == 2
+    assert message in capsys.readouterr().err
+    assert not out.exists()
 
 
 def test_bad_input_is_refused_before_any_file(tmp_path):
