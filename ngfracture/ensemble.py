@@ -144,10 +144,10 @@ def run_sample(scene_factory, seed, index, out, options):
     Returns
     -------
     dict
-        :func:`sample_record` plus ``timings.task`` (the whole task) and ``resumed`` /
-        ``skipped`` flags.
+        :func:`sample_record` plus ``timings.task`` and ``timings.task_cpu`` (wall and CPU
+        seconds of the whole task) and ``status`` (run, resumed or skipped).
     """
-    t0 = time.perf_counter()
+    t0, cpu0 = time.perf_counter(), time.process_time()
     import ngsolve
     ngsolve.SetNumThreads(1)        # one thread per worker process: results do not depend on it
     from . import checkpoint
@@ -167,6 +167,7 @@ def run_sample(scene_factory, seed, index, out, options):
         status = "resumed" if resume else "run"
     record = sample_record(summary, index, seed)
     record["timings"]["task"] = time.perf_counter() - t0
+    record["timings"]["task_cpu"] = time.process_time() - cpu0    # below "task": the core was shared
     record["status"] = status
     return record
 
@@ -329,6 +330,7 @@ class Ensemble:
                     records[i] = {"index": i, "seed": self.seeds[i], "reason": "error", "ok": False,
                                   "message": f"{type(err).__name__}: {err}", "timings": {}, "status": "error"}
                 self._show(len(records), len(futures))
+            t_samples = time.perf_counter()
             workers = len(client.scheduler_info().get("workers", {}))
             scheduler = client.scheduler.address
         finally:
@@ -341,11 +343,13 @@ class Ensemble:
                                "status": {status: [s["index"] for s in samples if s["status"] == status]
                                           for status in ("run", "resumed", "skipped", "error")},
                                "cluster_start_seconds": t_started - t0,
+                               "samples_seconds": t_samples - t_started,
                                "wall_seconds": time.perf_counter() - t0}
         for s in samples:
             s.pop("status")
         from .statistics import plot_ensemble
         report["pictures"] = plot_ensemble(report, self.out)
+        report["execution"]["report_seconds"] = time.perf_counter() - t_samples
         report["execution"]["wall_seconds"] = time.perf_counter() - t0
         write_summary(self.out / "ensemble.json", report, force=True)
         return report
