@@ -20,6 +20,9 @@ no contact rows) runs on a LocalCluster of 1 and of K single-threaded worker pro
   busy_share        task_sum / (K wall): the share of the workers' time spent in tasks
   slowdown          mean task seconds / mean task seconds with 1 worker: how much slower a
                     sample runs next to others (cores shared with other processes)
+  cpu_seconds       CPU seconds of all tasks; cpu_efficiency = cpu_seconds(1) / cpu_seconds(K):
+                    1 when K workers do the same work as one (the efficiency on dedicated
+                    cores, where a task's CPU seconds are its wall seconds)
   cpu_share         CPU seconds of the tasks over their wall seconds: below 1 when a
                     worker's core was shared with other processes
   load_before, load_after   os.getloadavg() (1 minute): the machine is shared
@@ -64,6 +67,7 @@ def measure(workers, samples, maxh, steps):
     return report, {"workers": workers, "samples": samples, "wall": wall, "cluster_start": ex["cluster_start_seconds"],
                     "report": ex["report_seconds"], "busy_share": sum(tasks) / (workers * wall),
                     "cpu_share": sum(s["timings"]["task_cpu"] for s in report["samples"]) / sum(tasks),
+                    "cpu_seconds": sum(s["timings"]["task_cpu"] for s in report["samples"]),
                     "task_sum": sum(tasks), "run_sum": sum(runs), "overhead_per_sample": overhead,
                     "overhead_share": overhead / (sum(tasks) / samples), "task_share": 1 - sum(runs) / sum(tasks),
                     "steps": [s["steps"] for s in report["samples"]],
@@ -85,6 +89,7 @@ def main(argv=None):
     one["efficiency"] = 1.0
     many["efficiency"] = one["wall"] / (args.workers * many["wall"])
     many["slowdown"] = many["task_sum"] / one["task_sum"]
+    many["cpu_efficiency"] = one["cpu_seconds"] / many["cpu_seconds"]
     result = {"scene": "plate", "maxh": args.maxh, "weibull_m": 8, "contact": "never", "cpu_count": os.cpu_count(),
               "cases": [one, many], "same_result": comparable(one_report) == comparable(many_report)}
     text = json.dumps(result, indent=2)
