@@ -20,9 +20,9 @@ writing its outputs into a temporary folder (no pictures). Reported per case:
                measured in the same run (the baseline)
   wall_over_plain        wall / t_plain
 
-Prints JSON {"cases": [...]}. Floors (issue 5): the plate at f = 1 under 60 s, and
-outside_solve_share under 0.3 (see the README for the measured figures and why this share
-is the one the floor is read as). The modules the run loads on first use (pyvista,
+Writes JSON {"cases": [...]} (stdout, or the file of --json FILE). Floors: the plate at
+f = 1 under 60 s, and outside_solve_share under 0.3 (see docs/verification.md for the
+measured figures and why this share is the one the floor is read as). The modules the run loads on first use (pyvista,
 matplotlib) are imported before the first case, as NGSolve itself is: a once-per-process
 cost that would otherwise land in the first case's "output" phase only.
 
@@ -31,13 +31,13 @@ Usage: python benchmarks/scenes.py [--scenes plate disk] [--factors 1 4 16] [--s
 import argparse
 import json
 import math
-import os
 import sys
 import tempfile
 import time
 
 import ngsolve
 
+import benchmark_json
 from ngfracture import scenes
 from ngfracture.simulation import Simulation, StepControl
 
@@ -86,23 +86,16 @@ def main(argv=None):
     p.add_argument("--steps", type=int, default=None,
                    help="stop every run after this many steps (for the finest meshes; the "
                         "shares are then those of the first steps)")
-    p.add_argument("--json", default=None, help="also write the JSON to this file; refused if it exists, "
-                                                "unless --force")
-    p.add_argument("--force", action="store_true", help="overwrite the --json file")
+    benchmark_json.add_options(p)
     args = p.parse_args(argv)
-    if args.json and os.path.exists(args.json) and not args.force:
-        p.error(f"{args.json} exists; pass --force to overwrite it")   # before hours of runs
+    benchmark_json.refuse_existing(p, args)   # before hours of runs
     import pyvista, matplotlib.figure  # noqa: F401  (see the module docstring)
     cases = []
     for name in args.scenes:
         for f in args.factors:
             cases.append(run_case(name, f, args.steps))
             print(json.dumps(cases[-1]), file=sys.stderr)
-    text = json.dumps({"cases": cases}, indent=2)
-    print(text)
-    if args.json:
-        with open(args.json, "w") as fh:
-            fh.write(text + "\n")
+    benchmark_json.write(args, {"cases": cases})
     return 0
 
 

@@ -262,7 +262,7 @@ def disintegration(maxh=0.08, expansion=None, dx=None, core_stiffness=0.1,
         Mesh size. Coarser than :func:`disk`'s by default (0.08, about 1000 triangles), as
         the paper ran this case "using a coarse initial mesh": measured on a busy 2-core
         machine, 118 steps and 32 pieces in about 3 minutes; maxh 0.06 needs 155 steps and
-        about 20 minutes (the README's table).
+        about 20 minutes (docs/verification.md).
     expansion, dx, core_stiffness, weibull_m, weibull_scale, weibull_area, seed
         As for :func:`disk`.
 
