@@ -29,7 +29,7 @@ no contact rows) runs on a LocalCluster of 1 and of K single-threaded worker pro
 
 The two ensembles must be equal (timings aside); ``same_result`` says whether they are.
 
-Usage: python benchmarks/ensemble.py [--samples 8] [--maxh 0.12] [--workers 2] [--json FILE]
+Usage: python benchmarks/ensemble.py [--samples 8] [--maxh 0.12] [--workers 2] [--json FILE [--force]]
 """
 import argparse
 import functools
@@ -37,8 +37,8 @@ import json
 import os
 import sys
 import tempfile
-import time
 
+import benchmark_json
 from ngfracture import scenes
 from ngfracture.ensemble import Ensemble
 
@@ -80,10 +80,11 @@ def main(argv=None):
     parser.add_argument("--maxh", type=float, default=0.12)
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--steps", type=int, default=200, help="at most this many steps per sample")
-    parser.add_argument("--json", metavar="FILE", default=None)
+    benchmark_json.add_options(parser)
     args = parser.parse_args(argv)
     if args.samples < 1 or args.workers < 2 or args.maxh <= 0:
         parser.error("need --samples >= 1, --workers >= 2, --maxh > 0")
+    benchmark_json.refuse_existing(parser, args)
     one_report, one = measure(1, args.samples, args.maxh, args.steps)
     many_report, many = measure(args.workers, args.samples, args.maxh, args.steps)
     one["efficiency"] = 1.0
@@ -92,11 +93,7 @@ def main(argv=None):
     many["cpu_efficiency"] = one["cpu_seconds"] / many["cpu_seconds"]
     result = {"scene": "plate", "maxh": args.maxh, "weibull_m": 8, "contact": "never", "cpu_count": os.cpu_count(),
               "cases": [one, many], "same_result": comparable(one_report) == comparable(many_report)}
-    text = json.dumps(result, indent=2)
-    print(text)
-    if args.json:
-        with open(args.json, "w") as f:
-            f.write(text + "\n")
+    benchmark_json.write(args, result)
     return 0
 
 
