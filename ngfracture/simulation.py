@@ -106,6 +106,9 @@ class Scene:
         Critical strain per vertex of ``mesh`` (a random field, :mod:`ngfracture.strength`);
         it replaces the region's critical strain at the vertices of regions that can
         crack. The copies of a split vertex inherit its strength.
+    load_description : str
+        What the load parameter x is, with its unit (e.g. "total extension of the plate
+        (length)"); shown by ``ngfracture scenes`` and written to summary.json.
     """
     name: str
     mesh: object
@@ -121,6 +124,7 @@ class Scene:
     control: dict = field(default_factory=dict)
     fix_free_modes: object = True
     strength: object = None
+    load_description: str = ""
 
     def validate(self):
         """Check every field before any work.
@@ -729,6 +733,7 @@ class Simulation:
         overlap = fragment_overlap_area(prob) if stats.count > 1 or self.scene.contact else 0.0
         return {
             "scene": self.scene.name, "parameters": self.scene.parameters,
+            "load_description": self.scene.load_description,
             "control": {k: v for k, v in asdict(self.control).items()},
             "reason": reason, "message": message,
             "n_steps": state.step, "load": state.x,
