@@ -246,17 +246,6 @@ def _run_verify(args):
     return 0
 
 
-def _scene_assignment(text):
-    """``NAME=VALUE`` of ``--set``: VALUE as JSON where it parses (numbers, true/false/null), else text."""
-    name, sep, value = text.partition("=")
-    if not sep or not name.isidentifier():
-        raise argparse.ArgumentTypeError(f"expected NAME=VALUE, got {text!r}")
-    try:
-        return name, json.loads(value)
-    except ValueError:
-        return name, value
-
-
 def _add_ensemble(subparsers):
     from . import scenes
 
@@ -270,10 +259,12 @@ def _add_ensemble(subparsers):
                     "skips finished samples and resumes interrupted ones. The scene needs a random "
                     "strength: --set weibull_m=M. Exit status 0 when every sample ends normally, "
                     "1 when one fails, 2 on bad input.")
-    p.add_argument("scene", choices=sorted(scenes.SCENES))
+    p.add_argument("scene", metavar="SCENE",
+                   help=f"a built-in scene ({', '.join(sorted(scenes.SCENES))}), a file path/to/scene.py "
+                        f"defining scene(**params), or package.module:function; it needs a seed parameter")
     p.add_argument("--samples", type=_int_at_least(1), required=True, help="number of samples N (>= 1)")
     p.add_argument("--seed", type=_int_at_least(0), default=0, help="seed of the first sample (default 0)")
-    p.add_argument("--set", type=_scene_assignment, action="append", default=[], metavar="NAME=VALUE",
+    p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
                    help="a scene parameter, e.g. --set weibull_m=8 --set maxh=0.12 (repeatable)")
     p.add_argument("--out", metavar="DIR", default=None, help="output folder (default out/SCENE_ensemble)")
     where = p.add_mutually_exclusive_group()
@@ -288,26 +279,22 @@ def _add_ensemble(subparsers):
 
 
 def _run_ensemble(args):
-    import functools
-    import inspect
-    from . import scenes
-    from .ensemble import Ensemble
+    from .ensemble import Ensemble, SceneFactory
+    from .scene_source import load_scene_function, parse_assignments, scene_parameters
 
-    function = scenes.SCENES[args.scene]
-    accepted = inspect.signature(function).parameters
-    overrides = dict(args.set)
-    for name in overrides:
-        if name not in accepted:
-            raise ValueError(f"scene {args.scene} has no parameter {name!r}; it has {', '.join(accepted)}")
+    function = load_scene_function(args.scene)
+    accepted = scene_parameters(function)
+    overrides = parse_assignments(args.set, function)
     if "seed" not in accepted:
         raise ValueError(f"scene {args.scene} takes no seed parameter: its samples would not differ")
     if "seed" in overrides:
         raise ValueError("give the first seed with --seed S, not --set seed=...")
-    if "weibull_m" in accepted and overrides.get("weibull_m") is None:
+    if "weibull_m" in accepted and overrides.get("weibull_m", accepted["weibull_m"]) is None:
         raise ValueError(f"the samples of scene {args.scene} differ only by a random strength: "
                          f"set its Weibull modulus, e.g. --set weibull_m=8")
-    out = args.out if args.out is not None else os.path.join("out", f"{args.scene}_ensemble")
-    ensemble = Ensemble(functools.partial(function, **overrides),     # checks the scene, writes nothing
+    name = os.path.splitext(os.path.basename(args.scene.replace(":", "_")))[0]
+    out = args.out if args.out is not None else os.path.join("out", f"{name}_ensemble")
+    ensemble = Ensemble(SceneFactory(args.scene, overrides),           # checks the scene, writes nothing
                         list(range(args.seed, args.seed + args.samples)), out=out,
                         control={"max_steps": args.steps}, contact=args.contact, workers=args.workers,
                         progress=not args.quiet)

@@ -33,7 +33,7 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["Ensemble", "run_sample", "sample_record", "sample_directory", "KILL_HOOK"]
+__all__ = ["Ensemble", "SceneFactory", "run_sample", "sample_record", "sample_directory", "KILL_HOOK"]
 
 #: environment variable of a test hook: "MARKER:STEP" kills the worker process running a
 #: sample when it accepts step STEP, once (the first to create MARKER)
@@ -170,6 +170,42 @@ def run_sample(scene_factory, seed, index, out, options):
     record["timings"]["task_cpu"] = time.process_time() - cpu0    # below "task": the core was shared
     record["status"] = status
     return record
+
+
+class SceneFactory:
+    """A scene by its source and parameters, loaded where it is called (in the worker).
+
+    Parameters
+    ----------
+    spec : str
+        As for :func:`ngfracture.scene_source.load_scene_function`: a built-in name, a
+        file path (made absolute here: the workers must see the same file) or
+        ``package.module:function``.
+    parameters : dict
+        Keyword arguments of the scene function, without the seed.
+    """
+
+    def __init__(self, spec, parameters):
+        if spec.endswith(".py") or os.sep in spec:
+            spec = os.path.abspath(spec)
+        self.spec, self.parameters = spec, dict(parameters)
+
+    def __call__(self, seed):
+        """The scene of one seed.
+
+        Parameters
+        ----------
+        seed : int
+
+        Returns
+        -------
+        Scene
+        """
+        from .scene_source import load_scene_function
+        return load_scene_function(self.spec)(**self.parameters, seed=seed)
+
+    def __repr__(self):
+        return f"SceneFactory({self.spec!r}, {self.parameters!r})"
 
 
 def _check_seeds(seeds):

@@ -106,7 +106,7 @@ def test_a_killed_command_reruns_without_rerunning_finished_samples(reference, t
 @pytest.mark.parametrize("args, message", [
     (["--samples", "0"], "--samples: must be >= 1"),
     (["--samples", "2"], "--set weibull_m=8"),
-    (["--samples", "2", "--set", "weibull_m=8", "--set", "nonsense=1"], "no parameter 'nonsense'"),
+    (["--samples", "2", "--set", "weibull_m=8", "--set", "nonsense=1"], "unknown scene parameter 'nonsense'"),
     (["--samples", "2", "--set", "weibull_m=8", "--set", "seed=4"], "--seed S"),
     (["--samples", "2", "--set", "weibull_m=0"], "weibull_m must be a finite number > 0"),
     (["--samples", "2", "--set", "weibull_m=8", "--scheduler", "tcp://127.0.0.1:1"], "cannot reach the dask scheduler"),
@@ -116,6 +116,20 @@ def test_command_line_bad_input_is_refused_before_any_file(tmp_path, capsys, arg
     out = tmp_path / "ens"
     with pytest.raises(SystemExit) as exit_:
         main(["ensemble", "plate", "--set", "maxh=0.3", *args, "--out", str(out)])
+    assert exit_.value.code == 2
+    assert message in capsys.readouterr().err
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("scene, message", [
+    (str(Path(__file__).resolve().parent.parent / "examples" / "beam_scene.py"), "takes no seed parameter"),
+    ("no_such_scene", "unknown scene 'no_such_scene'"),
+])
+def test_command_line_refuses_a_scene_without_seed(tmp_path, capsys, scene, message):
+    from ngfracture.cli import main
+    out = tmp_path / "ens"
+    with pytest.raises(SystemExit) as exit_:
+        main(["ensemble", scene, "--samples", "2", "--out", str(out)])
     assert exit_.value.code == 2
     assert message in capsys.readouterr().err
     assert not out.exists()
