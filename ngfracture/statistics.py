@@ -273,6 +273,8 @@ def plot_ensemble(report, folder):
         ax = fig.subplots()
         ax.hist(counts, bins=np.arange(counts.min(), counts.max() + 2) - 0.5, color="tab:green",
                 edgecolor="black", linewidth=0.5)
+        from matplotlib.ticker import MaxNLocator
+        ax.xaxis.set_major_locator(MaxNLocator(integer=True))
         ax.set_xlabel("fragments per sample")
         ax.set_ylabel("samples")
         fig.subplots_adjust(left=0.12, right=0.97, bottom=0.13, top=0.95)
