@@ -23,6 +23,9 @@ meshcheck    is a mesh fit for use: bad meshes are a MeshError naming the culpri
 contact_solver  equilibrium with unilateral contact: active set around the Newton solver
 output       VTK time series, crack edges, headless PNG, fragment-size plot, summary JSON
 fragments    fragment statistics (count, areas, centroids)
+strength     random strength: a Weibull critical strain per vertex, weakest-link size effect
+ensemble     many seeds of a scene on dask.distributed, resumable, ensemble.json
+statistics   pooled fragment sizes with bootstrap intervals, distribution fits, ensemble plots
 """
 import ngsolve  # load NGSolve's shared libraries before the compiled add-on
 

@@ -4,6 +4,7 @@ Commands
 --------
 run      a fracture simulation of one of the paper's scenes (``run plate ...``)
 verify   convergence studies against exact solutions (``verify lshape ...``)
+ensemble many seeds of a scene with random strength on dask (``ensemble disk --samples 16``)
 
 Each command is one ``_add_<command>(subparsers)`` function that registers its
 parser and sets ``func``.
@@ -245,6 +246,82 @@ def _run_verify(args):
     return 0
 
 
+def _add_ensemble(subparsers):
+    from . import scenes
+
+    p = subparsers.add_parser(
+        "ensemble", help="many seeds of a scene with random strength, and their statistics",
+        description="Run N samples of a scene, seeds S, S+1, ..., S+N-1, each an ordinary run in "
+                    "DIR/sample_NNNN/, on dask.distributed: a local cluster of K single-threaded "
+                    "worker processes, or the scheduler at ADDRESS (any dask cluster). Writes "
+                    "DIR/ensemble.json (per-sample results, fragment-size statistics with bootstrap "
+                    "intervals, a fit of the fragment-size distribution) and three PNGs. A rerun "
+                    "skips finished samples and resumes interrupted ones. The scene needs a random "
+                    "strength: --set weibull_m=M. Exit status 0 when every sample ends normally, "
+                    "1 when one fails, 2 on bad input.")
+    p.add_argument("scene", metavar="SCENE",
+                   help=f"a built-in scene ({', '.join(sorted(scenes.SCENES))}), a file path/to/scene.py "
+                        f"defining scene(**params), or package.module:function; it needs a seed parameter")
+    p.add_argument("--samples", type=_int_at_least(1), required=True, help="number of samples N (>= 1)")
+    p.add_argument("--seed", type=_int_at_least(0), default=0, help="seed of the first sample (default 0)")
+    p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
+                   help="a scene parameter, e.g. --set weibull_m=8 --set maxh=0.12 (repeatable)")
+    p.add_argument("--out", metavar="DIR", default=None, help="output folder (default out/SCENE_ensemble)")
+    where = p.add_mutually_exclusive_group()
+    where.add_argument("--scheduler", metavar="ADDRESS", default=None,
+                       help="address of a running dask scheduler, e.g. tcp://host:8786")
+    where.add_argument("--workers", type=_int_at_least(1), default=2,
+                       help="worker processes of the local cluster (default 2)")
+    p.add_argument("--steps", type=_int_at_least(1), default=200, help="at most this many steps per sample")
+    p.add_argument("--contact", choices=["auto", "never"], default="auto", help="as for run")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(func=_run_ensemble)
+
+
+def _run_ensemble(args):
+    from .ensemble import Ensemble, SceneFactory
+    from .scene_source import load_scene_function, parse_assignments, scene_parameters
+
+    function = load_scene_function(args.scene)
+    accepted = scene_parameters(function)
+    overrides = parse_assignments(args.set, function)
+    if "seed" not in accepted:
+        raise ValueError(f"scene {args.scene} takes no seed parameter: its samples would not differ")
+    if "seed" in overrides:
+        raise ValueError("give the first seed with --seed S, not --set seed=...")
+    if "weibull_m" in accepted and overrides.get("weibull_m", accepted["weibull_m"]) is None:
+        raise ValueError(f"the samples of scene {args.scene} differ only by a random strength: "
+                         f"set its Weibull modulus, e.g. --set weibull_m=8")
+    name = os.path.splitext(os.path.basename(args.scene.replace(":", "_")))[0]
+    out = args.out if args.out is not None else os.path.join("out", f"{name}_ensemble")
+    ensemble = Ensemble(SceneFactory(args.scene, overrides),           # checks the scene, writes nothing
+                        list(range(args.seed, args.seed + args.samples)), out=out,
+                        control={"max_steps": args.steps}, contact=args.contact, workers=args.workers,
+                        progress=not args.quiet)
+    client = None
+    if args.scheduler is not None:
+        from distributed import Client
+        try:
+            client = Client(args.scheduler, timeout="5s")
+        except (OSError, ValueError) as err:
+            raise ValueError(f"cannot reach the dask scheduler at {args.scheduler}: {err}") from None
+    try:
+        report = ensemble.run(client)
+    finally:
+        if client is not None:
+            client.close()
+    counts, peaks, fit = report["fragment_counts"], report["peak_load"], report["fit"]
+    print(f"{report['scene']}: {report['finished']} of {len(report['samples'])} samples finished")
+    if counts.get("n"):
+        print(f"fragments per sample {counts['mean']:.3g} (95% interval {counts['mean_interval'][0]:.3g} to "
+              f"{counts['mean_interval'][1]:.3g}); peak load {peaks['mean']:.4g} +- {peaks['std']:.2g}; "
+              f"fragment sizes: {fit.get('family') or fit.get('reason')}")
+    print(f"results in {out}/ (ensemble.json, {', '.join(sorted(report['pictures'].values()))})")
+    if report["not_finished"]:
+        raise RuntimeError(f"samples {report['not_finished']} did not finish (see their summary.json)")
+    return 0
+
+
 def build_parser():
     """The argument parser of ``python -m ngfracture``.
 
@@ -258,6 +335,7 @@ def build_parser():
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     _add_run(subparsers)
     _add_verify(subparsers)
+    _add_ensemble(subparsers)
     return parser
 
 

@@ -17,6 +17,7 @@ from netgen.geom2d import SplineGeometry
 
 from .materials import StVenantKirchhoff
 from .simulation import Scene
+from .strength import scene_strength
 
 #: the paper's glass: E = 5 GPa, nu = 0.18, critical principal strain 1.3817e-4
 GLASS = dict(E=5e9, nu=0.18, critical=1.3817e-4)
@@ -86,7 +87,8 @@ def notched_plate_mesh(maxh=0.034, width=1.0, height=1.0, notch_depth=0.04, notc
     return ng.Mesh(geo.GenerateMesh(maxh=maxh))
 
 
-def plate(maxh=0.034, strain_max=1e-3, dx=None, material=None, critical=GLASS["critical"]):
+def plate(maxh=0.034, strain_max=1e-3, dx=None, material=None, critical=GLASS["critical"],
+          weibull_m=None, weibull_scale=None, weibull_area=None, seed=None):
     """The plate under tension of paper section 4.2 (Fig. 8).
 
     A 1 x 1 plate of glass (E = 5 GPa, nu = 0.18, plane stress, St Venant-Kirchhoff)
@@ -105,7 +107,11 @@ def plate(maxh=0.034, strain_max=1e-3, dx=None, material=None, critical=GLASS["c
         First increment of x; default a tenth of the uncracked failure extension.
     material : Material, optional
     critical : float
-        Critical principal strain.
+        Critical principal strain (the mean strength of a random one).
+    weibull_m, weibull_scale, weibull_area, seed
+        Random strength, see :func:`ngfracture.strength.scene_strength`: a Weibull
+        modulus (None: uniform strength), the scale (default: mean = ``critical``), the
+        reference area of the size effect, the seed (default 0).
 
     Returns
     -------
@@ -115,6 +121,8 @@ def plate(maxh=0.034, strain_max=1e-3, dx=None, material=None, critical=GLASS["c
     mesh = notched_plate_mesh(maxh)
     material = material if material is not None else StVenantKirchhoff(GLASS["E"], GLASS["nu"], plane="stress")
     dx = _positive("dx", dx) if dx is not None else critical / 10
+    strength, strength_parameters = scene_strength(mesh, ["plate"], critical, weibull_m, weibull_scale,
+                                                   weibull_area, seed)
 
     def apply_load(prob, x):
         prob.add_dirichlet("left", -x / 2, component="x")
@@ -124,7 +132,8 @@ def plate(maxh=0.034, strain_max=1e-3, dx=None, material=None, critical=GLASS["c
                  load_max=strain_max, dx=dx, contact_tol=1e-3 * maxh, stop_when_unloaded=True,
                  parameters={"maxh": maxh, "strain_max": strain_max, "dx": dx, "critical": critical,
                              "E": material.E, "nu": material.nu, "model": type(material).__name__,
-                             "notch_depth": 0.04, "notch_width": 0.02})
+                             "notch_depth": 0.04, "notch_width": 0.02, **strength_parameters},
+                 strength=strength)
 
 
 def cored_disk_mesh(maxh=0.06, radius=1.0, hole=0.25, core_inner=0.125):
@@ -168,7 +177,8 @@ def cored_disk_mesh(maxh=0.06, radius=1.0, hole=0.25, core_inner=0.125):
     return separate_region(mesh, "core", boundary="hole", region_boundary="core_surface")
 
 
-def disk(maxh=0.06, expansion=None, dx=None, core_stiffness=0.1, name="disk", confined=True):
+def disk(maxh=0.06, expansion=None, dx=None, core_stiffness=0.1, name="disk", confined=True,
+         weibull_m=None, weibull_scale=None, weibull_area=None, seed=None):
     """A brittle disk with a hole around an expanding softer core (paper Fig. 9).
 
     The disk (radius 1, hole radius 0.25) is the paper's glass (St Venant-Kirchhoff,
@@ -195,6 +205,8 @@ def disk(maxh=0.06, expansion=None, dx=None, core_stiffness=0.1, name="disk", co
     name : str
     confined : bool
         Hold the disk's outer boundary (a rigid ring); False leaves it free.
+    weibull_m, weibull_scale, weibull_area, seed
+        Random strength of the disk (the core never cracks), see :func:`plate`.
 
     Returns
     -------
@@ -212,17 +224,21 @@ def disk(maxh=0.06, expansion=None, dx=None, core_stiffness=0.1, name="disk", co
         if confined:
             prob.add_dirichlet("outer", (0.0, 0.0))
 
-    return Scene(name=name, mesh=cored_disk_mesh(maxh, 1.0, hole, core_inner),
+    mesh = cored_disk_mesh(maxh, 1.0, hole, core_inner)
+    strength, strength_parameters = scene_strength(mesh, ["disk"], c, weibull_m, weibull_scale, weibull_area, seed)
+    return Scene(name=name, mesh=mesh,
                  material={"disk": glass, "core": core}, critical={"disk": c}, apply_load=apply_load,
                  load_max=expansion, dx=dx, contact_tol=1e-3 * maxh, contact=True,
                  control={"max_new_cracks": 8}, fix_free_modes=True if confined else "all",
                  parameters={"maxh": maxh, "expansion": expansion, "dx": dx, "critical": c,
                              "confined": confined,
                              "E": glass.E, "nu": glass.nu, "core_E": core.E, "core_nu": core.nu,
-                             "radius": 1.0, "hole": hole, "core_inner": core_inner})
+                             "radius": 1.0, "hole": hole, "core_inner": core_inner, **strength_parameters},
+                 strength=strength)
 
 
-def disintegration(maxh=0.08, expansion=None, dx=None, core_stiffness=0.1):
+def disintegration(maxh=0.08, expansion=None, dx=None, core_stiffness=0.1,
+                   weibull_m=None, weibull_scale=None, weibull_area=None, seed=None):
     """The disk scene free outside, expanded until it falls apart (paper Fig. 10).
 
     Without the confining ring, radial cracks run through to the outside; the pieces
@@ -247,7 +263,7 @@ def disintegration(maxh=0.08, expansion=None, dx=None, core_stiffness=0.1):
         the paper ran this case "using a coarse initial mesh": measured on a busy 2-core
         machine, 118 steps and 32 pieces in about 3 minutes; maxh 0.06 needs 155 steps and
         about 20 minutes (docs/verification.md).
-    expansion, dx, core_stiffness
+    expansion, dx, core_stiffness, weibull_m, weibull_scale, weibull_area, seed
         As for :func:`disk`.
 
     Returns
@@ -255,7 +271,8 @@ def disintegration(maxh=0.08, expansion=None, dx=None, core_stiffness=0.1):
     Scene
     """
     expansion = expansion if expansion is not None else 150 * FIRST_CRACK
-    return disk(maxh, expansion, dx, core_stiffness, name="disintegration", confined=False)
+    return disk(maxh, expansion, dx, core_stiffness, name="disintegration", confined=False,
+                weibull_m=weibull_m, weibull_scale=weibull_scale, weibull_area=weibull_area, seed=seed)
 
 
 #: the scenes of ``python -m ngfracture run``

@@ -54,7 +54,7 @@ import ngsolve as ng
 
 from . import checkpoint
 from .contact_solver import ContactSolver, fragment_overlap_area
-from .crack import StrainCriterion, split_by_tensor, transfer
+from .crack import StrainCriterion, split_by_tensor, transfer, transfer_vertex_field
 from .fragments import FragmentStatistics
 from .kkt import single_threaded_blas
 from .loadpath import load_path_cut, prescribed_increment
@@ -109,6 +109,13 @@ class Scene:
         How pieces without Dirichlet support are held (``NewtonSolver``): True, on the
         rigid modes that contact leaves free; "all", on all their rigid modes (the paper's
         pinned fragments), for scenes where contact pushes pieces that nothing else holds.
+    strength : numpy.ndarray, optional
+        Critical strain per vertex of ``mesh`` (a random field, :mod:`ngfracture.strength`);
+        it replaces the region's critical strain at the vertices of regions that can
+        crack. The copies of a split vertex inherit its strength.
+    load_description : str
+        What the load parameter x is, with its unit (e.g. "total extension of the plate
+        (length)"); shown by ``ngfracture scenes`` and written to summary.json.
     """
     name: str
     mesh: object
@@ -123,6 +130,8 @@ class Scene:
     parameters: dict = field(default_factory=dict)
     control: dict = field(default_factory=dict)
     fix_free_modes: object = True
+    strength: object = None
+    load_description: str = ""
 
     def validate(self):
         """Check every field before any work.
@@ -166,6 +175,12 @@ class Scene:
             raise ValueError(f"Scene {self.name!r}: fix_free_modes must be True or 'all', got {self.fix_free_modes!r}")
         if not isinstance(self.material, (Material, dict)):
             raise ValueError(f"Scene {self.name!r}: material must be a Material or a dict of them")
+        if self.strength is not None:
+            s = np.asarray(self.strength)
+            if s.shape != (self.mesh.nv,) or not np.issubdtype(s.dtype, np.floating) \
+                    or not np.all(np.isfinite(s)) or not np.all(s > 0):
+                raise ValueError(f"Scene {self.name!r}: strength must be {self.mesh.nv} finite floats > 0 "
+                                 f"(one per vertex), got shape {s.shape}")
         # the constraints apply_load adds (a boundary name that is not in the mesh, values that
         # conflict) fail here, not at the first step of a run
         try:
@@ -302,6 +317,8 @@ class State:
         Largest elastic energy so far.
     history : list of dict
         One record per accepted step.
+    strength : numpy.ndarray or None
+        Critical strain per vertex (None: the regions' uniform ones).
     """
     arrays: MeshArrays
     u: np.ndarray            # P1 displacement vector, VectorH1 layout
@@ -315,6 +332,7 @@ class State:
     fixed_dofs: np.ndarray
     peak_energy: float
     history: list            # one dict per accepted step
+    strength: np.ndarray = None
 
 
 def round_trip(mesh):
@@ -508,8 +526,11 @@ class Simulation:
             raise StepFailed(status.reason, phase, status.message)
         return status
 
-    def _normalised_strain(self, prob):
-        """Vertex strain tensors divided by the vertex's critical strain (0: cannot crack)."""
+    def _normalised_strain(self, prob, strength=None):
+        """Vertex strain tensors divided by the vertex's critical strain (0: cannot crack).
+
+        ``strength`` (per vertex) replaces the regions' critical strains where they crack.
+        """
         t0 = time.perf_counter()
         mesh = prob.mesh
         tensors = StrainCriterion(1.0).vertex_tensor(mesh, prob.u)
@@ -520,25 +541,30 @@ class Simulation:
         # a vertex takes the smallest critical strain of its triangles (the weakest material)
         scale = np.zeros(mesh.nv)
         np.maximum.at(scale, arrays.triangles.ravel(), np.repeat(inv[arrays.regions], 3))
+        if strength is not None:
+            scale = np.where(scale > 0, 1.0 / strength, 0.0)
         self.timings["strain"] += time.perf_counter() - t0
         return tensors * scale[:, None]
 
-    def _crack_pass(self, prob):
-        """One splitting pass; returns (new problem or None, number of split vertices)."""
-        tensors = self._normalised_strain(prob)
+    def _crack_pass(self, prob, strength=None):
+        """One splitting pass; returns (new problem or None, number of split vertices, strength)."""
+        tensors = self._normalised_strain(prob, strength)
         t0 = time.perf_counter()
         res = split_by_tensor(prob.mesh, tensors, 1.0, skip_neighbours=self.control.split == "spread")
         self.timings["split"] += time.perf_counter() - t0 - sum(res.timings.get(k, 0.0) for k in ("netgen", "ngsolve_mesh"))
         self.timings["rebuild"] += res.timings.get("netgen", 0.0) + res.timings.get("ngsolve_mesh", 0.0)
         if res.nsplit == 0:
-            return None, 0
+            return None, 0, strength
         self._split_positions.append(res.record["position"][np.diff(res.record["new_offsets"]) > 0])
         u = transfer(prob.u, res)
-        return self._problem(res.mesh, self._x_try, u.vec.FV().NumPy()), res.nsplit
+        if strength is not None:
+            strength = transfer_vertex_field(strength, res)    # copies inherit the vertex's strength
+        return self._problem(res.mesh, self._x_try, u.vec.FV().NumPy()), res.nsplit, strength
 
     # -- one load step ----------------------------------------------------------------------------
     def _attempt(self, state, dx, substeps=1):
-        """Try the step x + dx from an accepted state; returns (problem, first-pass cracks, total cracks).
+        """Try the step x + dx from an accepted state; returns (problem, first-pass cracks, total cracks,
+        vertex strength).
 
         Raises StepFailed on a failed solve and returns None for too many cracks.
         """
@@ -547,7 +573,7 @@ class Simulation:
         prob = self._problem(self._mesh, self._x_try, state.u)
         self._equilibrium(prob, "increment", substeps)
         self._dwork = self._increment_work(state, prob)
-        new_prob, first = self._crack_pass(prob)
+        new_prob, first, strength = self._crack_pass(prob, state.strength)
         c = self.control
         if first > c.max_new_cracks and dx * c.cut >= c.dx_min:
             return None
@@ -558,9 +584,9 @@ class Simulation:
                 raise StepFailed("relaxation", "relaxation", f"cracks still grow after {c.max_relax_passes} passes at fixed load")
             prob = new_prob
             self._equilibrium(prob, "relaxation")
-            new_prob, n = self._crack_pass(prob)
+            new_prob, n, strength = self._crack_pass(prob, strength)
             total += n
-        return prob, first, total
+        return prob, first, total, strength
 
     @staticmethod
     def _increment_work(state, prob):
@@ -577,7 +603,7 @@ class Simulation:
         dg = rows.fixed_values[pos[same]] - state.fixed_values[same]
         return float(0.5 * np.dot(state.reactions[same] + r_new, dg))
 
-    def _accept(self, state, prob, dx, first, total):
+    def _accept(self, state, prob, dx, first, total, strength):
         arrays, mesh = round_trip(prob.mesh)
         u = prob.u.vec.FV().NumPy().copy()
         # the solve ended at u (kept by the problem, no assembly); the round trip keeps the dof numbers
@@ -606,7 +632,7 @@ class Simulation:
         new = State(arrays=arrays, u=u, x=self._x_try, dx=new_dx, step=state.step + 1, quiet=quiet,
                     work=state.work + dwork, reactions=reactions, fixed_values=rows.fixed_values.copy(),
                     fixed_dofs=rows.fixed_dofs.copy(), peak_energy=max(state.peak_energy, energy),
-                    history=state.history + [record])
+                    history=state.history + [record], strength=strength)
         return new, prob, mesh, stats
 
     # -- the run ----------------------------------------------------------------------------------
@@ -617,7 +643,8 @@ class Simulation:
         return State(arrays=arrays, u=np.zeros(prob.fes.ndof), x=0.0, dx=float(self.scene.dx), step=0,
                      quiet=0, work=0.0, reactions=np.zeros(len(rows.fixed_dofs)),
                      fixed_values=rows.fixed_values.copy(), fixed_dofs=rows.fixed_dofs.copy(),
-                     peak_energy=0.0, history=[])
+                     peak_energy=0.0, history=[],
+                     strength=None if self.scene.strength is None else np.array(self.scene.strength, dtype=float))
 
     def _step(self, state, dx):
         """Attempts of one step until one is accepted: (attempt, dx, None) or (None, dx, last failure).
@@ -700,8 +727,8 @@ class Simulation:
                 message = (f"step {state.step + 1} at x = {state.x + dx:.6g} failed {self._retries} time(s); "
                            f"last reason {failure.reason}: {failure.message}")
                 break
-            prob, first, total = attempt
-            state, prob, self._mesh, stats = self._accept(state, prob, dx, first, total)
+            prob, first, total, strength = attempt
+            state, prob, self._mesh, stats = self._accept(state, prob, dx, first, total, strength)
             if self.writer is not None:
                 self._write_step(state, prob, stats)
                 if state.step % self.checkpoint_every == 0:
@@ -741,6 +768,7 @@ class Simulation:
         overlap = fragment_overlap_area(prob) if stats.count > 1 or self.scene.contact else 0.0
         return {
             "scene": self.scene.name, "parameters": self.scene.parameters,
+            "load_description": self.scene.load_description,
             "control": {k: v for k, v in asdict(self.control).items()},
             "reason": reason, "message": message,
             "n_steps": state.step, "load": state.x,
@@ -772,6 +800,8 @@ class Simulation:
         t0 = time.perf_counter()
         arrays = {**state.arrays.as_dict(), "u": state.u, "reactions": state.reactions,
                   "fixed_values": state.fixed_values, "fixed_dofs": state.fixed_dofs}
+        if state.strength is not None:
+            arrays["strength"] = state.strength
         meta = {"scene": self.scene.name, "parameters": self.scene.parameters,
                 "x": state.x, "dx": state.dx, "step": state.step, "quiet": state.quiet, "work": state.work,
                 "peak_energy": state.peak_energy, "history": state.history,
@@ -798,7 +828,7 @@ class Simulation:
         return State(arrays=MeshArrays.from_dict(arrays), u=arrays["u"], x=meta["x"], dx=meta["dx"],
                      step=meta["step"], quiet=meta["quiet"], work=meta["work"], reactions=arrays["reactions"],
                      fixed_values=arrays["fixed_values"], fixed_dofs=arrays["fixed_dofs"],
-                     peak_energy=meta["peak_energy"], history=meta["history"])
+                     peak_energy=meta["peak_energy"], history=meta["history"], strength=arrays.get("strength"))
 
     def _path_options(self):
         """The options that decide the load path: a resumed run must have the same ones.

@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
-BENCHMARKS = ["contact", "crack", "lshape", "meshcheck", "scenes"]
+BENCHMARKS = ["contact", "crack", "ensemble", "lshape", "meshcheck", "scenes"]
 
 
 def run_benchmark(name, *args):
