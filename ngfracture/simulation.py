@@ -102,6 +102,9 @@ class Scene:
         How pieces without Dirichlet support are held (``NewtonSolver``): True, on the
         rigid modes that contact leaves free; "all", on all their rigid modes (the paper's
         pinned fragments), for scenes where contact pushes pieces that nothing else holds.
+    load_description : str
+        What the load parameter x is, with its unit (e.g. "total extension of the plate
+        (length)"); shown by ``ngfracture scenes`` and written to summary.json.
     """
     name: str
     mesh: object
@@ -116,6 +119,7 @@ class Scene:
     parameters: dict = field(default_factory=dict)
     control: dict = field(default_factory=dict)
     fix_free_modes: object = True
+    load_description: str = ""
 
     def validate(self):
         """Check every field before any work.
@@ -706,6 +710,7 @@ class Simulation:
         overlap = fragment_overlap_area(prob) if stats.count > 1 or self.scene.contact else 0.0
         return {
             "scene": self.scene.name, "parameters": self.scene.parameters,
+            "load_description": self.scene.load_description,
             "control": {k: v for k, v in asdict(self.control).items()},
             "reason": reason, "message": message,
             "n_steps": state.step, "load": state.x,
