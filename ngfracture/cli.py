@@ -145,7 +145,7 @@ def _add_run(subparsers):
     p.add_argument("--checkpoint-every", type=_int_at_least(1), default=1,
                    help="write a checkpoint after every N accepted steps (and at the end; default 1)")
     p.add_argument("--threads", type=_int_at_least(1), default=None,
-                   help="threads of NGSolve's task manager (assembly of problems from 20000 dofs "
+                   help="threads of NGSolve's task manager, for this process (assembly of problems from 20000 dofs "
                         "on; factorisations run on one thread for bitwise repeatable results)")
     p.add_argument("--out", metavar="DIR", default=None,
                    help="output folder (default out/NAME, NAME the scene's name or the file's "
@@ -260,20 +260,13 @@ def _run_run(args):
     if mode == "auto":
         mode = "bar" if sys.stderr.isatty() else "none"
     report = {"bar": _progress_line, "json": _print_json_progress, "none": None}[mode]
-    threads_before = None
     if args.threads is not None:
         import ngsolve
-        threads_before = ngsolve.GetNumThreads()
-        ngsolve.SetNumThreads(args.threads)
-    try:
-        sim = Simulation(scene, control, out=out, force=args.force, resume=args.resume,
-                         pictures=args.pictures, contact=args.contact, progress=report,
-                         checkpoint_every=args.checkpoint_every)
-        result = sim.run()
-    finally:
-        if threads_before is not None:
-            import ngsolve
-            ngsolve.SetNumThreads(threads_before)
+        ngsolve.SetNumThreads(args.threads)      # for every TaskManager of this process
+    sim = Simulation(scene, control, out=out, force=args.force, resume=args.resume,
+                     pictures=args.pictures, contact=args.contact, progress=report,
+                     checkpoint_every=args.checkpoint_every)
+    result = sim.run()
     if mode == "bar":
         sys.stderr.write("\n")
     closing = sys.stderr if mode == "json" else sys.stdout    # stdout stays JSON lines only
@@ -336,7 +329,8 @@ def _run_render(args):
     arrays, header = checkpoint.latest(folder)
     meta = header.get("meta", header)
     mesh = mesh_from_arrays(MeshArrays.from_dict(arrays))
-    u = arrays["u"]
+    # the checkpoint's vector is in VectorH1 layout: components blocked, vertex dofs first
+    u = np.asarray(arrays["u"]).reshape(2, -1)[:, :mesh.nv].T
     stats = FragmentStatistics(mesh)
     points = np.asarray(MeshArrays.from_dict(arrays).points)
     size = float(np.ptp(points, axis=0).max())

@@ -438,7 +438,7 @@ class ContactSolver:
                 # the exact solution of the complementarity problem of the linearisation.
                 exact = True
                 # candidates: the rows the update wants and every row imposed before
-                candidates = np.union1d(want, [i for i, k in enumerate(keys) if k in tried])
+                candidates = np.union1d(want, np.array([i for i, k in enumerate(keys) if k in tried], dtype=np.int64))
                 choice = self._complementarity(pool, candidates, fixed, nv, n, tangent, result)
                 if choice is not None and set(keys[i] for i in choice) != set(lam):
                     kept = choice
