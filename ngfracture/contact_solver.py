@@ -80,8 +80,9 @@ class ContactResult:
         every Newton solve in turn.
     converged, reason, rounds, constraints, multipliers, released, max_penetration
         Initial values of the attributes of the same names (below).
-    timings, history, updates, lcp
-        Likewise; by default zero timings for the four phases, an empty history, 0, 0.
+    timings, history, updates, lcp, notes
+        Likewise; by default zero timings for the four phases, an empty history, 0, 0, no
+        notes.
 
     Attributes
     ----------
@@ -330,7 +331,7 @@ class ContactSolver:
         try:
             _, closed = NewtonSolver(prob, tangent=tangent, **options).unilateral_multipliers(
                 np.arange(offset, offset + len(candidates)))
-        except (SingularSystem, QPError, np.linalg.LinAlgError) as exc:
+        except (SingularSystem, QPError, np.linalg.LinAlgError, ValueError) as exc:
             # recorded: the set then comes from the primal-dual update, not the exact solution
             result.notes.append(f"complementarity problem of {len(candidates)} candidate rows not solved "
                                 f"({type(exc).__name__}: {exc}); the primal-dual update chose the set")

@@ -202,8 +202,15 @@ class StepControl:
         next equilibrium, which the split has changed, instead of on their strain from
         before it.
 
-    Only the fields given to the constructor count as set (:attr:`explicit`): a
-    Simulation starts from the scene's ``control`` and overrides just those.
+    **settings
+        The fields above by name (keyword only); the others take their defaults. Only
+        these count as set (``explicit``): a Simulation starts from the scene's
+        ``control`` and overrides just those.
+
+    Raises
+    ------
+    TypeError
+        An unknown field name.
     """
     max_new_cracks: int = 2
     cut: float = 0.5
