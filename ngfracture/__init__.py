@@ -29,7 +29,17 @@ statistics   pooled fragment sizes with bootstrap intervals, distribution fits, 
 """
 import ngsolve  # load NGSolve's shared libraries before the compiled add-on
 
-from ._ngfracture import ElementAreas, VertexAverage
+try:
+    from ._ngfracture import ElementAreas, VertexAverage
+except ImportError as _exc:
+    import os as _os
+    import sys as _sys
+    _message = (f"ngfracture: the compiled extension is missing in {_os.path.dirname(__file__)}: this is "
+                f"the uncompiled source tree (e.g. run from the repository root, where it shadows the "
+                f"installed package); run from another folder, or build in place with tools/dev_build.sh")
+    if _sys.argv[:1] == ["-m"]:      # python -m ngfracture: one line, not a traceback
+        raise SystemExit(_message) from None
+    raise ImportError(_message) from _exc
 from .meshcheck import MeshError, MeshQualityWarning, validate_mesh
 from .materials import LinearElastic, NeoHookean, StVenantKirchhoff, lame_parameters, make_material
 from .problem import ElasticProblem

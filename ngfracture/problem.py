@@ -379,15 +379,15 @@ class ElasticProblem:
         k = support.modes.shape[1]
         if k == 0:
             return ""
-        held = (rows.C @ support.modes).toarray() if rows.C.shape[0] else np.zeros((0, k))
-        s = np.linalg.svd(held, compute_uv=False) if held.size else np.zeros(0)
-        rank = int(np.sum(s > 1e-10 * max(s.max(initial=0.0), 1.0)))
-        if rank == k:
+        # the solver's own test (per group of coupled modes, rigid.numerical_rank), so that
+        # a mode the solver counts as held is never called floating here, nor the reverse
+        unheld = rigid.unheld_mode_rows(rows.C, support.modes).shape[0]
+        if unheld == 0:
             return ""
         _, comp = self.fragments()
         described = ", ".join(f"piece {p} ({int(np.sum(comp == p))} vertices, {d} free mode(s))"
                               for p, d in support.unheld[:10])
-        return (f"floating body: {k - rank} rigid-body mode(s) are held by no constraint; "
+        return (f"floating body: {unheld} rigid-body mode(s) are held by no constraint; "
                 f"pieces without full support from single-dof rows: {described}")
 
     def inverted_elements(self):

@@ -43,9 +43,10 @@ Where the paper is vague, we chose:
   work - elastic energy is the energy released by cracking.
 """
 import math
+import numbers
 import time
 import warnings
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, fields
 from pathlib import Path
 from typing import Callable
 
@@ -145,9 +146,8 @@ class Scene:
         ------
         ValueError
             Naming the first bad field (a non-positive load or increment, an unknown
-            region, a bad critical strain, no region that can crack, a bad material), or
-            what ``apply_load`` cannot add on the mesh (an unknown boundary name,
-            conflicting prescribed values).
+            region, a bad critical strain, no region that can crack, a bad material).
+            What ``apply_load`` adds is checked by :class:`Simulation` before any work.
         """
         if not isinstance(self.name, str) or not self.name:
             raise ValueError(f"Scene.name must be a non-empty string, got {self.name!r}")
@@ -181,20 +181,10 @@ class Scene:
                     or not np.all(np.isfinite(s)) or not np.all(s > 0):
                 raise ValueError(f"Scene {self.name!r}: strength must be {self.mesh.nv} finite floats > 0 "
                                  f"(one per vertex), got shape {s.shape}")
-        # the constraints apply_load adds (a boundary name that is not in the mesh, values that
-        # conflict) fail here, not at the first step of a run
-        try:
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore")   # mesh quality: the run's own problems warn
-                prob = ElasticProblem(self.mesh, self.material, order=1)
-            self.apply_load(prob, self.load_max)
-            prob.assemble_constraints()
-        except ValueError as err:
-            raise ValueError(f"Scene {self.name!r}: apply_load(problem, load_max) fails: {err}") from err
         return crit
 
 
-@dataclass
+@dataclass(init=False)
 class StepControl:
     """Adaptive load increments (paper 4.2): cut on too many cracks or a failure, grow when quiet.
 
@@ -230,6 +220,16 @@ class StepControl:
         vertices next to one split earlier in the pass; they are judged again after the
         next equilibrium, which the split has changed, instead of on their strain from
         before it.
+
+    **settings
+        The fields above by name (keyword only); the others take their defaults. Only
+        these count as set (``explicit``): a Simulation starts from the scene's
+        ``control`` and overrides just those.
+
+    Raises
+    ------
+    TypeError
+        An unknown field name.
     """
     max_new_cracks: int = 2
     cut: float = 0.5
@@ -246,8 +246,60 @@ class StepControl:
     unloaded_fraction: float = 1e-3
     split: str = "spread"
 
+    def __init__(self, **settings):
+        names = [f.name for f in fields(self)]
+        unknown = sorted(set(settings) - set(names))
+        if unknown:
+            raise TypeError(f"StepControl got unknown option(s) {unknown}; the options are {names}")
+        for f in fields(self):
+            setattr(self, f.name, settings.get(f.name, f.default))
+        #: the names given to the constructor: what overrides a scene's defaults
+        self.explicit = frozenset(settings)
+
+    def over(self, defaults):
+        """This control laid over a scene's defaults: the fields set here win, the rest stay.
+
+        Parameters
+        ----------
+        defaults : dict
+            A scene's ``control`` (StepControl field -> value).
+
+        Returns
+        -------
+        StepControl
+            A new object; neither this one nor ``defaults`` is changed.
+        """
+        return StepControl(**{**defaults, **{k: getattr(self, k) for k in self.explicit}})
+
+    def resolved(self, dx):
+        """A checked copy with the default bounds of dx filled in from the first increment.
+
+        Parameters
+        ----------
+        dx : float
+            The scene's first increment.
+
+        Returns
+        -------
+        StepControl
+            A new object (this one is not changed), ``dx_min`` and ``dx_max`` set.
+
+        Raises
+        ------
+        ValueError
+            Naming the first field out of range.
+        """
+        settings = asdict(self)
+        if settings["dx_min"] is None:
+            settings["dx_min"] = dx / 64
+        if settings["dx_max"] is None:
+            settings["dx_max"] = 8 * dx
+        control = StepControl(**settings)
+        control.validate(dx)
+        return control
+
     def validate(self, dx):
-        """Fill in the default bounds of dx from the first increment and check every field.
+        """Check every field (the bounds of dx, if None, as :meth:`resolved` fills them in).
 
         Parameters
         ----------
@@ -259,17 +311,28 @@ class StepControl:
         ValueError
             Naming the first field out of range.
         """
-        if self.dx_min is None:
-            self.dx_min = dx / 64
-        if self.dx_max is None:
-            self.dx_max = 8 * dx
-        checks = [("max_new_cracks", self.max_new_cracks >= 0), ("cut", 0 < self.cut < 1),
-                  ("grow", self.grow >= 1), ("grow_after", self.grow_after >= 1),
-                  ("dx_min", 0 < self.dx_min <= dx), ("dx_max", self.dx_max >= dx),
-                  ("max_steps", self.max_steps >= 1), ("max_retries", self.max_retries >= 0),
-                  ("max_relax_passes", self.max_relax_passes >= 1),
-                  ("method", self.method in ("modified", "full")), ("tol", 0 < self.tol < 1),
-                  ("maxit", self.maxit >= 1), ("unloaded_fraction", 0 < self.unloaded_fraction < 1),
+        dx_min = self.dx_min if self.dx_min is not None else dx / 64
+        dx_max = self.dx_max if self.dx_max is not None else 8 * dx
+
+        def number(v):
+            return not isinstance(v, bool) and isinstance(v, numbers.Real) and math.isfinite(v)
+
+        def integer(v):
+            return not isinstance(v, bool) and isinstance(v, numbers.Integral)
+
+        checks = [("max_new_cracks", integer(self.max_new_cracks) and self.max_new_cracks >= 0),
+                  ("cut", number(self.cut) and 0 < self.cut < 1),
+                  ("grow", number(self.grow) and self.grow >= 1),
+                  ("grow_after", integer(self.grow_after) and self.grow_after >= 1),
+                  ("dx_min", number(dx_min) and 0 < dx_min <= dx),
+                  ("dx_max", number(dx_max) and dx_max >= dx),
+                  ("max_steps", integer(self.max_steps) and self.max_steps >= 1),
+                  ("max_retries", integer(self.max_retries) and self.max_retries >= 0),
+                  ("max_relax_passes", integer(self.max_relax_passes) and self.max_relax_passes >= 1),
+                  ("method", self.method in ("modified", "full")),
+                  ("tol", number(self.tol) and 0 < self.tol < 1),
+                  ("maxit", integer(self.maxit) and self.maxit >= 1),
+                  ("unloaded_fraction", number(self.unloaded_fraction) and 0 < self.unloaded_fraction < 1),
                   ("split", self.split in ("spread", "all"))]
         for name, ok in checks:
             if not ok:
@@ -391,9 +454,10 @@ class Simulation:
                  checkpoint_every=1, progress=None, contact="auto"):
         self.scene = scene
         self.critical = scene.validate()
-        self.control = control if control is not None else StepControl(**scene.control)
+        # the user's control overrides only the fields it sets; neither object is changed
+        user = control if control is not None else StepControl()
+        self.control = user.over(scene.control).resolved(scene.dx)
         self._method = self.control.method      # the Newton variant of the current attempt
-        self.control.validate(scene.dx)
         if pictures not in ("final", "every", "none"):
             raise ValueError(f"pictures must be 'final', 'every' or 'none', got {pictures!r}")
         if contact not in ("auto", "never"):
@@ -410,11 +474,34 @@ class Simulation:
         self.timings = dict.fromkeys(PHASES, 0.0)
         self.writer = None
         self._resumed_state = None
+        #: wall seconds of the run before a resume (from the checkpoint): summaries cover it all
+        self._wall_before = 0.0
         #: math.fsum of the triangle areas; splitting keeps every triangle and coordinate,
         #: so the final area must equal it to the last bit
         self.area_initial = FragmentStatistics(scene.mesh).total_area
+        self._check_load()              # before the output folder is touched
         if self.out is not None:
             self._prepare_output()
+
+    def _check_load(self):
+        """Build the problem at x = 0, at the first increment and at the final load: the scene's materials,
+        regions and the boundaries its ``apply_load`` names are checked before any work.
+
+        Raises
+        ------
+        ValueError
+            Naming the scene, the load and what was wrong.
+        """
+        for x in (0.0, float(self.scene.dx), float(self.scene.load_max)):
+            try:
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore")   # mesh quality: the run's own problems warn
+                    prob = ElasticProblem(self.scene.mesh, self.scene.material, order=1)
+                self.scene.apply_load(prob, x)
+                prob.assemble_constraints()
+            except Exception as exc:
+                raise ValueError(f"Scene {self.scene.name!r}: the problem at load x = {x:g} cannot be "
+                                 f"built: {type(exc).__name__}: {exc}") from exc
 
     # -- output folder ---------------------------------------------------------------------
     OWN_PATTERNS = ("step_*.vtu", "cracks_*.vtp", "results.pvd", "cracks.pvd", "checkpoint_*.npz",
@@ -506,6 +593,7 @@ class Simulation:
             self.timings["assembly"] += result.timings.get("assembly", 0.0)
             status = result.status
             self._iterations += status.iterations
+            self._notes.extend(n for n in result.notes if n not in self._notes)
             if not result.converged:
                 if result.reason == "penetration":
                     message = (f"contact rows still penetrate by {result.max_penetration:.3g} after "
@@ -625,7 +713,8 @@ class Simulation:
                   "released_energy": state.work + dwork - energy, "crack_length": crack_len,
                   "fragments": int(stats.count), "newton_iterations": int(self._iterations),
                   "retries": int(self._retries), "failures": list(self._failures),
-                  "substeps": int(self._substeps), "method": self._method, "relax_passes": max(len(self._split_positions) - 1, 0)}
+                  "substeps": int(self._substeps), "method": self._method, "relax_passes": max(len(self._split_positions) - 1, 0),
+                  "notes": list(self._notes)}
         if first and not any(h["split_vertices"] for h in state.history):
             # where cracking began: the vertices split by the first pass that split any
             record["initiation"] = self._split_positions[0].tolist()
@@ -660,7 +749,7 @@ class Simulation:
         self._retries, self._failures, substeps = 0, [], 1
         self._method = c.method
         while True:
-            self._iterations = 0
+            self._iterations, self._notes = 0, []
             try:
                 attempt = self._attempt(state, dx, substeps)
             except StepFailed as err:
@@ -694,7 +783,7 @@ class Simulation:
             last accepted problem and state. A failed run is a result with ``ok`` False,
             not an exception; the last good state is written.
         """
-        t_start = time.perf_counter()
+        t_start = time.perf_counter() - self._wall_before   # a resumed run counts the earlier part
         if self._resumed_state is not None:
             state = self._resumed_state
             self._mesh = mesh_from_arrays(state.arrays)
@@ -703,7 +792,7 @@ class Simulation:
             self._mesh = mesh_from_arrays(state.arrays)
             if self.writer is not None:
                 self._write_step(state, self._problem(self._mesh, 0.0, state.u), FragmentStatistics(self._mesh))
-                self._checkpoint(state)
+                self._checkpoint(state, time.perf_counter() - t_start)
         area_initial = self.area_initial
         reason, message = "load_max", "reached the final load"
         c = self.control
@@ -732,7 +821,7 @@ class Simulation:
             if self.writer is not None:
                 self._write_step(state, prob, stats)
                 if state.step % self.checkpoint_every == 0:
-                    self._checkpoint(state)
+                    self._checkpoint(state, time.perf_counter() - t_start)
             if self.progress is not None:
                 self.progress({"step": state.step, "x": state.x, "load_max": self.scene.load_max,
                                "split_vertices": sum(h["split_vertices"] for h in state.history),
@@ -741,7 +830,7 @@ class Simulation:
             prob = self._problem(self._mesh, state.x, state.u)
             stats = FragmentStatistics(self._mesh)
         if self.writer is not None and state.step % self.checkpoint_every != 0:
-            self._checkpoint(state)
+            self._checkpoint(state, time.perf_counter() - t_start)
         summary = self._summary(state, prob, stats, area_initial, reason, message,
                                 time.perf_counter() - t_start)
         if self.out is not None:
@@ -782,6 +871,8 @@ class Simulation:
             "energy": [{k: h[k] for k in ("step", "x", "elastic_energy", "external_work", "released_energy")}
                        for h in hist],
             "newton_iterations": [h["newton_iterations"] for h in hist],
+            # departures from the plain path of the solvers (see ContactResult.notes)
+            "notes": [{"step": h["step"], "note": n} for h in hist for n in h.get("notes", [])],
             "history": hist,
             "timings": {**{k: round(v, 6) for k, v in self.timings.items()}, "wall": round(wall, 6)},
         }
@@ -796,7 +887,7 @@ class Simulation:
                        scale=self._picture_scale(state))
         self.timings["output"] += time.perf_counter() - t0
 
-    def _checkpoint(self, state):
+    def _checkpoint(self, state, wall):
         t0 = time.perf_counter()
         arrays = {**state.arrays.as_dict(), "u": state.u, "reactions": state.reactions,
                   "fixed_values": state.fixed_values, "fixed_dofs": state.fixed_dofs}
@@ -807,7 +898,7 @@ class Simulation:
                 "peak_energy": state.peak_energy, "history": state.history,
                 "area_initial": self.area_initial,
                 "control": self._path_options(),
-                "timings": self.timings}
+                "timings": {**self.timings, "wall": wall}}
         checkpoint.write(self.out, state.step, arrays, meta)
         self.timings["output"] += time.perf_counter() - t0
 
@@ -824,7 +915,9 @@ class Simulation:
                 f"{self.out}: the checkpoint was written with {name} = {saved.get(name)!r}, this run has "
                 f"{now.get(name)!r}; resume with the options of the interrupted run (only max_steps may differ)")
         self.area_initial = meta["area_initial"]
-        self.timings.update(meta.get("timings", {}))
+        timings = dict(meta.get("timings", {}))
+        self._wall_before = float(timings.pop("wall", 0.0))
+        self.timings.update(timings)
         return State(arrays=MeshArrays.from_dict(arrays), u=arrays["u"], x=meta["x"], dx=meta["dx"],
                      step=meta["step"], quiet=meta["quiet"], work=meta["work"], reactions=arrays["reactions"],
                      fixed_values=arrays["fixed_values"], fixed_dofs=arrays["fixed_dofs"],
