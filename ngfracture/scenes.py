@@ -14,6 +14,7 @@ import math
 
 import ngsolve as ng
 from netgen.geom2d import SplineGeometry
+from netgen.meshing import MeshingParameters, Pnt
 
 from .materials import StVenantKirchhoff
 from .simulation import Scene
@@ -36,12 +37,13 @@ def _positive(name, value):
 
 
 def notched_plate_mesh(maxh=0.034, width=1.0, height=1.0, notch_depth=0.04, notch_width=0.02,
-                       notch_maxh=None):
+                       notch_maxh=None, notch_zone=0.0, path_maxh=None):
     """A rectangle with a V-notch in the middle of the top and of the bottom edge.
 
     Boundaries: ``left``, ``right``, ``top``, ``bottom`` (the notches belong to top and
     bottom); region ``plate``. Near the notch tips the mesh size is ``notch_maxh``
-    (default: a quarter of the notch depth, at most maxh).
+    (default: a quarter of the notch depth, at most maxh), within ``notch_zone`` of each
+    tip; along the line from tip to tip (where the crack runs) it is at most ``path_maxh``.
 
     Parameters
     ----------
@@ -53,6 +55,11 @@ def notched_plate_mesh(maxh=0.034, width=1.0, height=1.0, notch_depth=0.04, notc
         Depth and opening of each V-notch.
     notch_maxh : float, optional
         Mesh size at the notch tips.
+    notch_zone : float
+        Radius of the disks around the tips meshed with ``notch_maxh`` (0: only the tips
+        and the notch flanks; a critical-distance criterion needs about twice its radius).
+    path_maxh : float, optional
+        Mesh size along the segment between the tips.
 
     Returns
     -------
@@ -83,7 +90,19 @@ def notched_plate_mesh(maxh=0.034, width=1.0, height=1.0, notch_depth=0.04, notc
         geo.Append(["line", pts[i], pts[(i + 1) % len(pts)]], bc=bc, leftdomain=1, rightdomain=0,
                    **({"maxh": hn} if near_tip else {}))
     geo.SetMaterial(1, "plate")
-    return ng.Mesh(geo.GenerateMesh(maxh=maxh))
+    mp = MeshingParameters(maxh=maxh)
+    if notch_zone < 0 or not math.isfinite(notch_zone):
+        raise ValueError(f"notch_zone must be a finite number >= 0, got {notch_zone!r}")
+    n = int(math.ceil(notch_zone / hn))
+    for tip_y in (notch_depth, height - notch_depth):
+        for i in range(-n, n + 1):         # a grid of size restrictions fills the disk
+            for j in range(-n, n + 1):
+                if (i * i + j * j) * hn * hn <= notch_zone ** 2:
+                    mp.RestrictH(x=c + i * hn, y=tip_y + j * hn, z=0, h=hn)
+    if path_maxh is not None:
+        mp.RestrictHLine(p1=Pnt(c, notch_depth, 0), p2=Pnt(c, height - notch_depth, 0),
+                         maxh=_positive("path_maxh", path_maxh))
+    return ng.Mesh(geo.GenerateMesh(mp=mp))
 
 
 def plate(maxh=0.034, strain_max=1e-3, dx=None, material=None, critical=GLASS["critical"]):
