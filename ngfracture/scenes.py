@@ -105,7 +105,8 @@ def notched_plate_mesh(maxh=0.034, width=1.0, height=1.0, notch_depth=0.04, notc
     return ng.Mesh(geo.GenerateMesh(mp=mp))
 
 
-def plate(maxh=0.034, strain_max=1e-3, dx=None, material=None, critical=GLASS["critical"]):
+def plate(maxh=0.034, strain_max=1e-3, dx=None, material=None, critical=GLASS["critical"],
+          notch_maxh=None, radius=None):
     """The plate under tension of paper section 4.2 (Fig. 8).
 
     A 1 x 1 plate of glass (E = 5 GPa, nu = 0.18, plane stress, St Venant-Kirchhoff)
@@ -125,13 +126,26 @@ def plate(maxh=0.034, strain_max=1e-3, dx=None, material=None, critical=GLASS["c
     material : Material, optional
     critical : float
         Critical principal strain.
+    notch_maxh : float, optional
+        Mesh size at the notch tips; default a quarter of the notch depth (one-ring
+        criterion) or radius / 2 (critical distance), at most maxh.
+    radius : float, optional
+        Critical distance of the crack criterion (docs/criterion.md); the mesh is then
+        at most radius / 2 within 2 radius of the tips and along the line between them,
+        where the crack runs. None: the paper's one-ring nodal strain.
 
     Returns
     -------
     Scene
     """
     maxh, strain_max = _positive("maxh", maxh), _positive("strain_max", strain_max)
-    mesh = notched_plate_mesh(maxh)
+    if radius is None:
+        mesh = notched_plate_mesh(maxh, notch_maxh=notch_maxh)
+    else:
+        radius = _positive("radius", radius)
+        fine = min(maxh, radius / 2)
+        notch_maxh = fine if notch_maxh is None else _positive("notch_maxh", notch_maxh)
+        mesh = notched_plate_mesh(maxh, notch_maxh=notch_maxh, notch_zone=2 * radius, path_maxh=fine)
     material = material if material is not None else StVenantKirchhoff(GLASS["E"], GLASS["nu"], plane="stress")
     dx = _positive("dx", dx) if dx is not None else critical / 10
 
@@ -141,7 +155,9 @@ def plate(maxh=0.034, strain_max=1e-3, dx=None, material=None, critical=GLASS["c
 
     return Scene(name="plate", mesh=mesh, material=material, critical=critical, apply_load=apply_load,
                  load_max=strain_max, dx=dx, contact_tol=1e-3 * maxh, stop_when_unloaded=True,
+                 radius=radius,
                  parameters={"maxh": maxh, "strain_max": strain_max, "dx": dx, "critical": critical,
+                             "notch_maxh": notch_maxh, "radius": radius,
                              "E": material.E, "nu": material.nu, "model": type(material).__name__,
                              "notch_depth": 0.04, "notch_width": 0.02})
 
