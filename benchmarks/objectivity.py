@@ -73,7 +73,7 @@ def crack(radius, maxhs):
                          "n_fragments": s["n_fragments"],
                          "length_over_notch_to_notch": s["crack_length"] / NOTCH_TO_NOTCH,
                          "seconds": time.perf_counter() - t0})
-        finest = part[-1]["crack_length"]
+        finest = part[-1]["crack_length"] if part else None
         for row in part:
             row["error_vs_finest"] = abs(row["crack_length"] - finest) / finest if finest else None
         rows += part
