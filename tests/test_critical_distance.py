@@ -179,3 +179,17 @@ def test_mode_one_grows_straight(crack_r40):
     mat = LinearElastic(E, NU, plane="stress")
     angle = _right_tip_direction(mesh, _tension(mesh, mat), mat, a, r)
     assert abs(angle) <= 5.0, angle
+
+
+def test_scene_radius_is_checked_before_any_work():
+    """A bad critical distance is named by Scene.validate (Simulation's first call)."""
+    from ngfracture import scenes
+    scene = scenes.plate(maxh=0.1)
+    scene.radius = -0.01
+    with pytest.raises(ValueError, match="critical distance"):
+        scene.validate()
+    scene.radius = {"plate": float("nan")}
+    with pytest.raises(ValueError, match="region 'plate'"):
+        scene.validate()
+    with pytest.raises(ValueError, match="radius"):
+        scenes.plate(maxh=0.1, radius=0.0)
