@@ -61,6 +61,10 @@ setup(
         "pyvista",
         "matplotlib",
         "threadpoolctl",   # one BLAS thread for the small dense solves (see README)
+        # ensembles of runs (ngfracture.ensemble): a maintained distributed engine with a
+        # LocalCluster, rescheduling of the tasks of a dead worker, and cluster deployments
+        # (dask-jobqueue, SSH, Kubernetes) instead of a home-made one
+        "dask[distributed]",
     ],
     # nbclient + nbformat + ipykernel: the smallest set that executes the tutorial
     # notebooks headless (tests/test_tutorials.py); no Jupyter server or UI

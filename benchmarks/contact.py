@@ -21,7 +21,8 @@ Measured per case (seconds, wall clock, best of `repeat`):
 no_crack_overhead_s: contact_constraints on the uncut 100k mesh with no crack edges
 (no candidates): input validation only, no collision work.
 
-Run:  PYTHONPATH=. python benchmarks/contact.py [--quick]   (prints JSON on stdout)
+Run:  PYTHONPATH=. python benchmarks/contact.py [--quick] [--json FILE [--force]]
+(JSON on stdout, or in FILE)
 """
 import argparse
 import json
@@ -32,6 +33,7 @@ import numpy as np
 import ngsolve
 from netgen.occ import Glue, MoveTo, OCCGeometry
 
+import benchmark_json
 from ngfracture import collision, contact
 
 
@@ -147,7 +149,9 @@ def main(argv=None):
     parser.add_argument("--quick", action="store_true", help="only the 10k case")
     parser.add_argument("--pieces", type=int, default=4, help="k: k x k pieces")
     parser.add_argument("--repeat", type=int, default=3)
+    benchmark_json.add_options(parser)
     args = parser.parse_args(argv)
+    benchmark_json.refuse_existing(parser, args)
     sizes = [10_000] if args.quick else [10_000, 30_000, 100_000]
     cases, last = [], None
     for n in sizes:
@@ -159,8 +163,8 @@ def main(argv=None):
     t_none, cs = best_of(lambda: contact.contact_constraints(X0, None, T0, no_edges),
                          args.repeat)
     assert len(cs) == 0
-    print(json.dumps({"cases": cases, "no_crack_overhead_s": t_none,
-                      "no_crack_ntri": int(len(T0))}, indent=1))
+    benchmark_json.write(args, {"cases": cases, "no_crack_overhead_s": t_none,
+                                "no_crack_ntri": int(len(T0))})
 
 
 if __name__ == "__main__":

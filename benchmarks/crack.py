@@ -10,12 +10,13 @@ solve, assembled in a TaskManager); then one crack pass is timed phase by phase:
   t_transfer  new VectorH1 space + GridFunction + exact copy through the vertex map
 
 The critical strain is the 99% quantile of the principal strain, so about 1% of the
-vertices split. Crack phases are the best of `--repeat` runs. Prints JSON:
+vertices split. Crack phases are the best of `--repeat` runs. Writes JSON (stdout, or
+the file of `--json FILE`):
 {"cases": [{"ntri", "t_strain", "t_select", "t_rebuild", "t_transfer", "t_solve", "ratio"}],
  "exponent": e}  with ratio = crack work / t_solve and e the fitted slope of
 log(crack work) over log(ntri).
 
-Usage: python benchmarks/crack.py [--sizes 10000 50000 ...] [--repeat 3] [--threads 2]
+Usage: python benchmarks/crack.py [--sizes 10000 50000 ...] [--repeat 3] [--threads 2] [--json FILE [--force]]
 """
 import argparse
 import json
@@ -26,6 +27,7 @@ import numpy as np
 import ngsolve
 from netgen.geom2d import unit_square
 
+import benchmark_json
 from ngfracture import crack
 
 
@@ -80,7 +82,9 @@ def main(argv=None):
     ap.add_argument("--sizes", type=int, nargs="+", default=[10000, 50000, 100000, 200000, 500000])
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--threads", type=int, default=2)
+    benchmark_json.add_options(ap)
     args = ap.parse_args(argv)
+    benchmark_json.refuse_existing(ap, args)
     ngsolve.SetNumThreads(args.threads)
     cases = []
     for n in args.sizes:
@@ -100,7 +104,7 @@ def main(argv=None):
     nt = np.array([c["ntri"] for c in cases], dtype=float)
     work = np.array([c["t_strain"] + c["t_select"] + c["t_rebuild"] + c["t_transfer"] for c in cases])
     exponent = float(np.polyfit(np.log(nt), np.log(work), 1)[0]) if len(cases) > 1 else None
-    print(json.dumps({"cases": cases, "exponent": exponent}, indent=1))
+    benchmark_json.write(args, {"cases": cases, "exponent": exponent})
 
 
 if __name__ == "__main__":

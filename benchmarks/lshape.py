@@ -35,15 +35,15 @@ paper (relative L2 error against number of vertices, log-log).
 """
 import argparse
 import gc
-import json
 import os
 import sys
 import time
 
 import numpy as np
 
+import benchmark_json
 from ngfracture import lshape, verify
-from ngfracture.cli import _int_at_least, write_json_atomic
+from ngfracture.cli import _int_at_least
 
 TARGETS = (1e-2, 1e-3, 1e-4)
 RATIO_FLOOR = 1.15
@@ -189,10 +189,8 @@ def main(argv=None):
     parser = argparse.ArgumentParser(
         description="L-shape benchmark: ngfracture vs plain NGSolve per level, time to reach "
                     "relative L2 errors 1e-2, 1e-3, 1e-4; uniform and graded meshes, order 1 and 2.")
-    parser.add_argument("--json", metavar="FILE", help="write the JSON here (atomically) "
-                        "instead of stdout; refused if FILE exists, unless --force")
+    benchmark_json.add_options(parser, force_help="overwrite existing output files (--json, --plot)")
     parser.add_argument("--plot", metavar="FILE", help="write Fig. 6b (error vs vertices) as PNG")
-    parser.add_argument("--force", action="store_true", help="overwrite existing output files")
     parser.add_argument("--max-level-p1", type=_int_at_least(1), default=7,
                         help="finest level for order 1 (default 7: 362k dofs)")
     parser.add_argument("--max-level-p2", type=_int_at_least(1), default=6,
@@ -202,20 +200,14 @@ def main(argv=None):
     parser.add_argument("--variant", choices=verify.VARIANTS, default="dirichlet",
                         help="boundary conditions (default dirichlet: exact data everywhere)")
     args = parser.parse_args(argv)
-    for path in (args.json, args.plot):
-        if path is not None and os.path.exists(path) and not args.force:
-            parser.error(f"{path} exists; pass --force to overwrite it")
+    benchmark_json.refuse_existing(parser, args, args.plot)
 
     cases = run_cases({1: args.max_level_p1, 2: args.max_level_p2}, args.repeat, args.variant)
     tte = time_to_error_table(cases)
     checks = floors(cases, tte)
     result = {"problem": "lshape", "variant": args.variant, "model": "linear",
               "cases": cases, "time_to_error": tte, "floors": checks}
-    if args.json:
-        write_json_atomic(args.json, result, force=args.force)
-    else:
-        json.dump(result, sys.stdout, indent=2)
-        print()
+    benchmark_json.write(args, result)
     if args.plot:
         plot_fig6b(cases, args.plot)
     for c in checks:

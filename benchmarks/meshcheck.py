@@ -6,17 +6,17 @@ factorisation + solve of linear elasticity (as in benchmarks/crack.py, assembly 
 so the ratio is pessimistic); t_check is validate_mesh on the mesh, t_check_cracked on the
 same mesh after one crack pass that splits about 1% of the vertices (crack lips coincide:
 the coincident-vertex check has work to do). Checks are the best of `--repeat` runs.
-Prints JSON {"cases": [{"ntri", "t_check", "t_check_cracked", "t_solve", "ratio"}]} with
+Writes JSON (stdout, or the file of `--json FILE`) {"cases": [{"ntri", "t_check", "t_check_cracked", "t_solve", "ratio"}]} with
 ratio = t_check / t_solve.
 
-Usage: python benchmarks/meshcheck.py [--sizes 10000 100000 ...] [--repeat 5] [--threads 2]
+Usage: python benchmarks/meshcheck.py [--sizes 10000 100000 ...] [--repeat 5] [--threads 2] [--json FILE [--force]]
 """
 import argparse
-import json
 import time
 
 import ngsolve
 
+import benchmark_json
 from ngfracture.meshcheck import validate_mesh
 from crack import crack_pass, plate, solve_stretch     # the sibling benchmark's mesh and solve
 
@@ -35,7 +35,9 @@ def main(argv=None):
     ap.add_argument("--sizes", type=int, nargs="+", default=[10000, 100000])
     ap.add_argument("--repeat", type=int, default=5)
     ap.add_argument("--threads", type=int, default=2)
+    benchmark_json.add_options(ap)
     args = ap.parse_args(argv)
+    benchmark_json.refuse_existing(ap, args)
     ngsolve.SetNumThreads(args.threads)
     cases = []
     for n in args.sizes:
@@ -46,7 +48,7 @@ def main(argv=None):
         t_cracked = best_time(lambda: validate_mesh(cracked), args.repeat)
         cases.append({"ntri": mesh.ne, "t_check": round(t_check, 6), "t_check_cracked": round(t_cracked, 6),
                       "t_solve": round(t_solve, 6), "ratio": round(t_check / t_solve, 5)})
-    print(json.dumps({"cases": cases}, indent=1))
+    benchmark_json.write(args, {"cases": cases})
 
 
 if __name__ == "__main__":

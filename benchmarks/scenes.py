@@ -1,68 +1,91 @@
-"""Benchmark of whole fracture simulations: wall time per phase, at three resolutions.
+"""Benchmark of whole fracture simulations: wall time per phase, in solve-equivalents.
 
-For each scene (plate, disk) and each refinement factor f (default 1, 4, 16: the paper's
-resolution and f times more triangles, maxh / sqrt(f)) one simulation runs to its end,
-writing its outputs into a temporary folder (no pictures). Reported per case:
+For each scene and each refinement factor f (default 1, 4, 16: the scene's default mesh
+and f times more triangles, maxh / sqrt(f)) one simulation runs to its end (a plate ends
+once it is broken through), writing its outputs into a temporary folder (no pictures).
+Reported per case:
 
-  ntri, nsteps, n_split_vertices, n_fragments
-  phases       seconds per phase of Simulation (solve, strain, split, rebuild, collision,
-               contact, output) and wall
-  linear       seconds in factorisations and triangular solves (part of "solve")
-  assembly     seconds in NGSolve's residual and tangent assembly (part of "solve")
-  outside_solve_share    1 - solve / wall: everything outside the Newton solves (assembly,
-               factorisation, triangular solves, residuals): crack criterion, splitting,
-               rebuilding, collision, contact rows, output. The floor's reading.
+  ntri, nsteps, reason, n_split_vertices, n_fragments
+  phases       seconds per phase of Simulation (solve, linear, assembly, strain, split,
+               rebuild, collision, contact, output) and wall
+  t_unit       one factorisation plus one solve of the uncracked configuration's tangent
+               (the scene's mesh and constraints at the first increment, NGSolve's sparse
+               Cholesky, one thread; the best of three), measured in the same process
+  solve_equivalents      wall / t_unit: the run in units of one linear solve of its own
+               size, a figure that does not depend on the machine's speed
+  seconds_per_step, solve_equivalents_per_step
+  outside_solve_share    1 - solve / wall: everything outside the Newton solves (crack
+               criterion, splitting, rebuilding, collision, contact rows, output)
   outside_fe_share       1 - (linear + assembly) / wall: everything but NGSolve's finite
-               element work (counts the Python of the Newton and KKT loops as overhead)
+               element work and the linear algebra
   outside_linear_share   1 - linear / wall: everything but factorisations and triangular
-               solves (strictest: it counts the residual assembly as overhead)
-  t_plain      one linear-elastic factorise + solve of plain NGSolve on the initial mesh,
-               measured in the same run (the baseline)
-  wall_over_plain        wall / t_plain
+               solves (it counts the residual assembly as overhead)
 
-Prints JSON {"cases": [...]}. Floors (issue 5): the plate at f = 1 under 60 s, and
-outside_solve_share under 0.3 (see the README for the measured figures and why this share
-is the one the floor is read as). The modules the run loads on first use (pyvista,
-matplotlib) are imported before the first case, as NGSolve itself is: a once-per-process
-cost that would otherwise land in the first case's "output" phase only.
+and per scene run at two or more factors:
+
+  growth       the exponent p of the least-squares fit seconds_per_step ~ ntri^p over
+               the factors (and of wall ~ ntri^p), with the cases it was fitted to
+
+Writes JSON {"cases": [...], "growth": {...}} (stdout, or the file of --json FILE). Floors (issue 15): cost per step grows at
+most like N^1.2 between the 1x, 4x and 16x plate; the 16x plate (about 31k triangles)
+runs until broken in at most 150 solve-equivalents. The modules the run loads on first
+use (pyvista, matplotlib) are imported before the first case, as NGSolve itself is: a
+once-per-process cost that would otherwise land in the first case's "output" phase only.
 
 Usage: python benchmarks/scenes.py [--scenes plate disk] [--factors 1 4 16] [--steps N] [--json FILE [--force]]
 """
 import argparse
 import json
 import math
-import os
 import sys
 import tempfile
 import time
 
+import numpy as np
 import ngsolve
 
+import benchmark_json
 from ngfracture import scenes
+from ngfracture.problem import ElasticProblem
 from ngfracture.simulation import Simulation, StepControl
 
 
-def plain_solve(mesh, E=5e9, nu=0.18):
-    """One plain-NGSolve linear-elastic solve with the whole boundary clamped: the baseline."""
-    lam, mu = E * nu / ((1 + nu) * (1 - 2 * nu)), E / (2 * (1 + nu))
-    fes = ngsolve.VectorH1(mesh, order=1, dirichlet=".*")
-    u, v = fes.TnT()
-    eps = lambda w: ngsolve.Sym(ngsolve.Grad(w))
-    a = ngsolve.BilinearForm(fes, symmetric=True)
-    a += (2 * mu * ngsolve.InnerProduct(eps(u), eps(v)) + lam * ngsolve.div(u) * ngsolve.div(v)) * ngsolve.dx
-    f = ngsolve.LinearForm(ngsolve.CF((1.0, 0.0)) * v * ngsolve.dx)
-    gfu = ngsolve.GridFunction(fes)
-    t0 = time.perf_counter()
-    a.Assemble()
-    f.Assemble()
-    gfu.vec.data = a.mat.Inverse(fes.FreeDofs(), inverse="sparsecholesky") * f.vec
-    return time.perf_counter() - t0
+def unit_solve(scene):
+    """Seconds of one factorisation and one solve of the scene's uncracked tangent (best of 3).
+
+    The tangent at u = 0 with the constraints of the first increment; the dofs they fix
+    and one pin per rigid mode they leave free are left out, as the simulation does.
+    """
+    prob = ElasticProblem(scene.mesh, scene.material, order=1)
+    scene.apply_load(prob, scene.dx)
+    rows = prob.assemble_constraints()
+    support = prob.support(rows)
+    K = prob.tangent()
+    free = ngsolve.BitArray(prob.fes.ndof)
+    free.Set()
+    for d in np.concatenate([rows.fixed_dofs, support.pins]).tolist():
+        free.Clear(int(d))
+    rhs = K.CreateColVector()
+    rhs.FV().NumPy()[:] = 1.0
+    x = K.CreateColVector()
+    best = math.inf
+    before = ngsolve.GetNumThreads()
+    ngsolve.SetNumThreads(1)          # as the simulation factorises (kkt.reproducible_threads)
+    try:
+        for _ in range(3):
+            t0 = time.perf_counter()
+            inverse = K.Inverse(free, inverse="sparsecholesky")
+            x.data = inverse * rhs
+            best = min(best, time.perf_counter() - t0)
+    finally:
+        ngsolve.SetNumThreads(before)
+    return best
 
 
 def run_case(name, factor, steps=None):
     base = scenes.SCENES[name]()
     scene = scenes.SCENES[name](maxh=base.parameters["maxh"] / math.sqrt(factor))
-    t_plain = min(plain_solve(scene.mesh) for _ in range(2))
+    t_unit = unit_solve(scene)
     control = StepControl(**{**scene.control, "max_steps": steps}) if steps else None
     with tempfile.TemporaryDirectory() as out:
         result = Simulation(scene, control, out=out, pictures="none").run()
@@ -70,13 +93,31 @@ def run_case(name, factor, steps=None):
     wall = s["timings"]["wall"]
     linear = s["timings"].get("linear", float("nan"))
     assembly = s["timings"].get("assembly", float("nan"))
+    nsteps = max(s["n_steps"], 1)
     return {"scene": name, "factor": factor, "ntri": scene.mesh.ne, "reason": result.reason, "max_steps": steps,
             "nsteps": s["n_steps"], "n_split_vertices": s["n_split_vertices"],
             "n_fragments": s["n_fragments"], "phases": s["timings"], "linear": linear,
-            "assembly": assembly, "outside_solve_share": 1.0 - s["timings"]["solve"] / wall,
+            "assembly": assembly, "t_unit": t_unit, "solve_equivalents": wall / t_unit,
+            "seconds_per_step": wall / nsteps, "solve_equivalents_per_step": wall / t_unit / nsteps,
+            "outside_solve_share": 1.0 - s["timings"]["solve"] / wall,
             "outside_fe_share": 1.0 - (linear + assembly) / wall,
-            "outside_linear_share": 1.0 - linear / wall, "t_plain": t_plain,
-            "wall_over_plain": wall / t_plain}
+            "outside_linear_share": 1.0 - linear / wall}
+
+
+def growth(cases):
+    """Per scene with two or more factors: fitted exponents of cost per step and of wall against ntri."""
+    fits = {}
+    for name in dict.fromkeys(c["scene"] for c in cases):
+        mine = [c for c in cases if c["scene"] == name]
+        if len({c["ntri"] for c in mine}) < 2:
+            continue
+        logn = np.log([c["ntri"] for c in mine])
+        exponent = lambda values: float(np.polyfit(logn, np.log(values), 1)[0])
+        fits[name] = {"factors": [c["factor"] for c in mine], "ntri": [c["ntri"] for c in mine],
+                      "seconds_per_step_exponent": exponent([c["seconds_per_step"] for c in mine]),
+                      "wall_exponent": exponent([c["phases"]["wall"] for c in mine]),
+                      "t_unit_exponent": exponent([c["t_unit"] for c in mine])}
+    return fits
 
 
 def main(argv=None):
@@ -86,23 +127,16 @@ def main(argv=None):
     p.add_argument("--steps", type=int, default=None,
                    help="stop every run after this many steps (for the finest meshes; the "
                         "shares are then those of the first steps)")
-    p.add_argument("--json", default=None, help="also write the JSON to this file; refused if it exists, "
-                                                "unless --force")
-    p.add_argument("--force", action="store_true", help="overwrite the --json file")
+    benchmark_json.add_options(p)
     args = p.parse_args(argv)
-    if args.json and os.path.exists(args.json) and not args.force:
-        p.error(f"{args.json} exists; pass --force to overwrite it")   # before hours of runs
+    benchmark_json.refuse_existing(p, args)   # before hours of runs
     import pyvista, matplotlib.figure  # noqa: F401  (see the module docstring)
     cases = []
     for name in args.scenes:
         for f in args.factors:
             cases.append(run_case(name, f, args.steps))
             print(json.dumps(cases[-1]), file=sys.stderr)
-    text = json.dumps({"cases": cases}, indent=2)
-    print(text)
-    if args.json:
-        with open(args.json, "w") as fh:
-            fh.write(text + "\n")
+    benchmark_json.write(args, {"cases": cases, "growth": growth(cases)})
     return 0
 
 

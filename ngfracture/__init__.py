@@ -23,10 +23,23 @@ meshcheck    is a mesh fit for use: bad meshes are a MeshError naming the culpri
 contact_solver  equilibrium with unilateral contact: active set around the Newton solver
 output       VTK time series, crack edges, headless PNG, fragment-size plot, summary JSON
 fragments    fragment statistics (count, areas, centroids)
+strength     random strength: a Weibull critical strain per vertex, weakest-link size effect
+ensemble     many seeds of a scene on dask.distributed, resumable, ensemble.json
+statistics   pooled fragment sizes with bootstrap intervals, distribution fits, ensemble plots
 """
 import ngsolve  # load NGSolve's shared libraries before the compiled add-on
 
-from ._ngfracture import ElementAreas, VertexAverage
+try:
+    from ._ngfracture import ElementAreas, VertexAverage
+except ImportError as _exc:
+    import os as _os
+    import sys as _sys
+    _message = (f"ngfracture: the compiled extension is missing in {_os.path.dirname(__file__)}: this is "
+                f"the uncompiled source tree (e.g. run from the repository root, where it shadows the "
+                f"installed package); run from another folder, or build in place with tools/dev_build.sh")
+    if _sys.argv[:1] == ["-m"]:      # python -m ngfracture: one line, not a traceback
+        raise SystemExit(_message) from None
+    raise ImportError(_message) from _exc
 from .meshcheck import MeshError, MeshQualityWarning, validate_mesh
 from .materials import LinearElastic, NeoHookean, StVenantKirchhoff, lame_parameters, make_material
 from .problem import ElasticProblem

@@ -2,8 +2,12 @@
 
 Commands
 --------
-run      a fracture simulation of one of the paper's scenes (``run plate ...``)
+run      a fracture simulation of a built-in scene, a scene file or a scene function
+         (``run plate ...``, ``run path/to/scene.py --set E=7e10``)
+scenes   the built-in scenes with their parameters and defaults
+render   redraw the pictures of a finished or interrupted run
 verify   convergence studies against exact solutions (``verify lshape ...``)
+ensemble many seeds of a scene with random strength on dask (``ensemble disk --samples 16``)
 
 Each command is one ``_add_<command>(subparsers)`` function that registers its
 parser and sets ``func``.
@@ -15,6 +19,10 @@ import os
 import re
 import sys
 import tempfile
+
+import numpy as np
+
+from . import __version__
 
 
 def write_json_atomic(path, data, force=False):
@@ -75,30 +83,74 @@ def _positive_float(text):
     return value
 
 
-def _add_run(subparsers):
-    from . import scenes
+#: StepControl options of ``run``: (field, type, help); --steps is max_steps
+CONTROL_OPTIONS = [
+    ("max_new_cracks", "int0", "split vertices allowed in the first crack pass after an increment "
+                               "before dx is cut (the scene's default, else 2)"),
+    ("method", ("modified", "full"), "Newton variant: modified (tangent once per load step, the paper's) "
+                                     "or full"),
+    ("tol", "float", "Newton tolerance (relative increment, paper eq. 7; default 1e-10)"),
+    ("maxit", "int1", "Newton iterations per solve (default 60)"),
+    ("cut", "float", "dx is multiplied by this after too many cracks or a failure (default 0.5)"),
+    ("grow", "float", "dx is multiplied by this after --grow-after quiet steps (default 1.5)"),
+    ("grow_after", "int1", "crack-free steps in a row before dx grows (default 2)"),
+    ("dx_min", "float", "smallest increment (default: the scene's dx / 64)"),
+    ("dx_max", "float", "largest increment (default: 8 times the scene's dx)"),
+    ("max_retries", "int0", "failed attempts in a row before the run stops (default 6)"),
+    ("split", ("spread", "all"), "which overstrained vertices a crack pass splits (default spread)"),
+]
 
+
+def _scene_help():
+    from . import scenes
+    from .scene_source import format_parameters
+    lines = [f"{name}: {_plain(func.__doc__.splitlines()[0].rstrip('.'))} (load: "
+             f"{scenes.LOAD_DESCRIPTIONS[name]}; parameters {format_parameters(func)})"
+             for name, func in sorted(scenes.SCENES.items())]
+    return ("a built-in scene, a file path/to/scene.py that defines scene(**params) returning a "
+            "Scene, or package.module:function. " + "; ".join(lines))
+
+
+def _add_run(subparsers):
     p = subparsers.add_parser(
-        "run", help="a fracture simulation of one of the paper's scenes",
+        "run", help="a fracture simulation of a built-in scene or your own",
         description="Run a quasi-static fracture simulation under load control (paper section "
                     "4.2): increase the prescribed deformation step by step, split overstrained "
                     "vertices, relax at fixed load until no new crack appears. Writes a VTK time "
                     "series (results.pvd, cracks.pvd), checkpoints, summary.json, final.png and "
-                    "fragment_sizes.png into the output folder. Exit status 0 when the run ends "
-                    "normally, 1 when a step fails after all retries (the last good state is "
-                    "written), 2 on bad input.")
-    p.add_argument("scene", choices=sorted(scenes.SCENES),
-                   help="; ".join(f"{k}: {_plain(v.__doc__.splitlines()[0].rstrip('.'))}"
-                                  for k, v in sorted(scenes.SCENES.items())))
+                    "fragment_sizes.png into the output folder. The scene, its parameters and "
+                    "the options are checked before the output folder is touched. Exit status 0 "
+                    "when the run ends normally, 1 when a step fails after all retries (the last "
+                    "good state is written), 2 on bad input.")
+    p.add_argument("scene", metavar="SCENE", help=_scene_help())
+    p.add_argument("--set", dest="assignments", metavar="NAME=VALUE", action="append", default=[],
+                   help="a parameter of the scene function, e.g. --set E=7e10 --set critical=2e-4 "
+                        "(repeatable; VALUE is converted by the type of the default; "
+                        "'ngfracture scenes' lists the built-in scenes' parameters)")
     p.add_argument("--maxh", type=_positive_float, default=None,
-                   help="mesh size (default: the scene's, about the paper's resolution)")
+                   help="mesh size, short for --set maxh=H (default: the scene's)")
     p.add_argument("--steps", type=_int_at_least(1), default=200,
                    help="at most this many accepted load steps (default 200)")
     p.add_argument("--load-max", type=_positive_float, default=None,
-                   help="final value of the load parameter (default: the scene's)")
+                   help="final value of the load parameter x (default: the scene's). plate: "
+                        "x is the total extension of the unit plate (length; the mean strain); "
+                        "disk, disintegration: x is the radial displacement of the core's inner "
+                        "boundary (length; disk radius 1); your own scene: its load_description")
+    for name, kind, text in CONTROL_OPTIONS:
+        flag = "--" + name.replace("_", "-")
+        if isinstance(kind, tuple):
+            p.add_argument(flag, dest=name, choices=kind, default=None, help=text)
+        else:
+            parse = {"int0": _int_at_least(0), "int1": _int_at_least(1), "float": _positive_float}[kind]
+            p.add_argument(flag, dest=name, type=parse, default=None, help=text)
+    p.add_argument("--checkpoint-every", type=_int_at_least(1), default=1,
+                   help="write a checkpoint after every N accepted steps (and at the end; default 1)")
+    p.add_argument("--threads", type=_int_at_least(1), default=None,
+                   help="threads of NGSolve's task manager, for this process (assembly of problems from 20000 dofs "
+                        "on; factorisations run on one thread for bitwise repeatable results)")
     p.add_argument("--out", metavar="DIR", default=None,
-                   help="output folder (default out/SCENE); refused if it holds results, "
-                        "unless --force or --resume")
+                   help="output folder (default out/NAME, NAME the scene's name or the file's "
+                        "stem); refused if it holds results, unless --force or --resume")
     p.add_argument("--force", action="store_true",
                    help="replace the results in DIR (only files ngfracture writes are removed)")
     p.add_argument("--resume", action="store_true",
@@ -110,7 +162,11 @@ def _add_run(subparsers):
     p.add_argument("--contact", choices=["auto", "never"], default="auto",
                    help="auto: contact from the first crack on (from the start for separate "
                         "bodies); never: no contact rows (overlap is still measured)")
-    p.add_argument("--quiet", action="store_true", help="no progress line")
+    p.add_argument("--progress", choices=["auto", "bar", "json", "none"], default="auto",
+                   help="bar: a progress line on stderr (auto: when stderr is a terminal); json: one "
+                        "JSON object per accepted step on stdout (step, load, splits, fragments, "
+                        "seconds; the closing lines then go to stderr); none")
+    p.add_argument("--quiet", action="store_true", help="no progress (same as --progress none)")
     p.set_defaults(func=_run_run)
 
 
@@ -147,35 +203,148 @@ def _progress_line(info):
     sys.stderr.flush()
 
 
+def progress_json(info):
+    """The JSON line of ``--progress json`` for one accepted step.
+
+    Parameters
+    ----------
+    info : dict
+        As passed to ``Simulation(progress=...)``.
+
+    Returns
+    -------
+    str
+        One JSON object: step, load (x), load_max, splits (split vertices so far),
+        fragments, seconds (wall time of the run so far).
+    """
+    return json.dumps({"step": info["step"], "load": info["x"], "load_max": info["load_max"],
+                       "splits": info["split_vertices"], "fragments": info["fragments"],
+                       "seconds": round(info["seconds"], 3)})
+
+
+def _print_json_progress(info):
+    print(progress_json(info), flush=True)
+
+
+def _default_out(spec):
+    from .scene_source import builtin_scenes
+    if spec in builtin_scenes():
+        return os.path.join("out", spec)
+    if spec.endswith(".py"):
+        return os.path.join("out", os.path.splitext(os.path.basename(spec))[0])
+    return os.path.join("out", spec.rpartition(":")[2] or "scene")
+
+
 def _run_run(args):
-    from . import scenes
+    from .scene_source import load_scene_function, parse_assignments
     from .simulation import Simulation, StepControl
 
     if args.force and args.resume:
         raise ValueError("--force and --resume exclude each other")
-    out = args.out if args.out is not None else os.path.join("out", args.scene)
+    # bad input before any work and before the output folder is looked at twice
+    make_scene = load_scene_function(args.scene)
+    assignments = list(args.assignments) + ([f"maxh={args.maxh!r}"] if args.maxh is not None else [])
+    params = parse_assignments(assignments, make_scene)
+    settings = {name: getattr(args, name) for name, _, _ in CONTROL_OPTIONS if getattr(args, name) is not None}
+    control = StepControl(max_steps=args.steps, **settings)
+    out = args.out if args.out is not None else _default_out(args.scene)
     Simulation.check_output(out, force=args.force, resume=args.resume,     # before meshing
                             option_names=("--force", "--resume"))
-    options = {} if args.maxh is None else {"maxh": args.maxh}
-    scene = scenes.SCENES[args.scene](**options)
+    try:
+        scene = make_scene(**params)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"scene {args.scene!r} with {params}: {exc}") from exc
     if args.load_max is not None:
         scene.load_max = args.load_max
         scene.parameters["load_max"] = args.load_max
-    sim = Simulation(scene, StepControl(**{**scene.control, "max_steps": args.steps}), out=out, force=args.force,
-                     resume=args.resume, pictures=args.pictures, contact=args.contact,
-                     progress=None if args.quiet else _progress_line)
+    mode = "none" if args.quiet else args.progress
+    if mode == "auto":
+        mode = "bar" if sys.stderr.isatty() else "none"
+    report = {"bar": _progress_line, "json": _print_json_progress, "none": None}[mode]
+    if args.threads is not None:
+        import ngsolve
+        ngsolve.SetNumThreads(args.threads)      # for every TaskManager of this process
+    sim = Simulation(scene, control, out=out, force=args.force, resume=args.resume,
+                     pictures=args.pictures, contact=args.contact, progress=report,
+                     checkpoint_every=args.checkpoint_every)
     result = sim.run()
-    if not args.quiet:
+    if mode == "bar":
         sys.stderr.write("\n")
+    closing = sys.stderr if mode == "json" else sys.stdout    # stdout stays JSON lines only
     s = result.summary
     print(f"{scene.name}: {s['n_steps']} steps, {s['n_split_vertices']} split vertices, crack length "
           f"{s['crack_length']:.4g}, {s['n_fragments']} fragments, {s['timings']['wall']:.1f} s; "
-          f"{result.reason}: {result.message}")
+          f"{result.reason}: {result.message}", file=closing)
+    if s.get("pictures", {}).get("final_error"):
+        print(f"final.png was not drawn: {s['pictures']['final_error']}", file=sys.stderr)
     files = ["results.pvd", "cracks.pvd", "summary.json"] + sorted(
         v for k, v in s.get("pictures", {}).items() if k in ("final", "fragment_sizes"))
-    print(f"results in {out}/ ({', '.join(files)})")
+    print(f"results in {out}/ ({', '.join(files)})", file=closing)
     if not result.ok:
         raise RuntimeError(result.message)
+    return 0
+
+
+def _add_scenes(subparsers):
+    p = subparsers.add_parser(
+        "scenes", help="list the built-in scenes with their parameters and defaults",
+        description="List the built-in scenes: what each is, its load parameter, and every "
+                    "parameter that 'run SCENE --set NAME=VALUE' accepts, with its default.")
+    p.set_defaults(func=_run_scenes)
+
+
+def _run_scenes(args):
+    import inspect
+
+    from . import scenes
+    from .scene_source import scene_parameters
+    for name, func in sorted(scenes.SCENES.items()):
+        print(f"{name}: {_plain(func.__doc__.splitlines()[0].rstrip('.'))}")
+        print(f"  load x: {scenes.LOAD_DESCRIPTIONS[name]}")
+        for pname, default in scene_parameters(func).items():
+            shown = "(required)" if default is inspect.Parameter.empty else \
+                ("(the scene's)" if default is None else repr(default))
+            print(f"  --set {pname}={shown}")
+    return 0
+
+
+def _add_render(subparsers):
+    p = subparsers.add_parser(
+        "render", help="redraw the pictures of a finished or interrupted run",
+        description="Redraw final.png and fragment_sizes.png of the run in DIR from its newest "
+                    "checkpoint (the end of a finished run, the last saved step of an "
+                    "interrupted one). Only these two files are replaced.")
+    p.add_argument("dir", metavar="DIR", help="the output folder of a run")
+    p.set_defaults(func=_run_render)
+
+
+def _run_render(args):
+    from . import checkpoint
+    from .output import RenderError, plot_fragment_sizes, render_png
+    from .fragments import FragmentStatistics
+    from .meshio import MeshArrays, mesh_from_arrays
+
+    folder = args.dir
+    if not os.path.isdir(folder):
+        raise ValueError(f"{folder} is not a folder")
+    arrays, header = checkpoint.latest(folder)
+    meta = header.get("meta", header)
+    mesh = mesh_from_arrays(MeshArrays.from_dict(arrays))
+    # the checkpoint's vector is in VectorH1 layout: components blocked, vertex dofs first
+    u = np.asarray(arrays["u"]).reshape(2, -1)[:, :mesh.nv].T
+    stats = FragmentStatistics(mesh)
+    points = np.asarray(MeshArrays.from_dict(arrays).points)
+    size = float(np.ptp(points, axis=0).max())
+    umax = float(np.abs(u).max(initial=0.0))
+    scale = 0.02 * size / umax if umax > 0 else 1.0      # as the run draws it (Simulation)
+    plot_fragment_sizes(stats.areas, os.path.join(folder, "fragment_sizes.png"), force=True)
+    try:
+        render_png(mesh, u, stats.fragment, os.path.join(folder, "final.png"), scale=scale, force=True)
+    except RenderError as err:
+        print(f"final.png was not drawn: {err}", file=sys.stderr)
+        return 1
+    print(f"{folder}/: final.png and fragment_sizes.png of step {meta['step']} (load {meta['x']:.6g}, "
+          f"{stats.count} fragments)")
     return 0
 
 
@@ -245,6 +414,82 @@ def _run_verify(args):
     return 0
 
 
+def _add_ensemble(subparsers):
+    from . import scenes
+
+    p = subparsers.add_parser(
+        "ensemble", help="many seeds of a scene with random strength, and their statistics",
+        description="Run N samples of a scene, seeds S, S+1, ..., S+N-1, each an ordinary run in "
+                    "DIR/sample_NNNN/, on dask.distributed: a local cluster of K single-threaded "
+                    "worker processes, or the scheduler at ADDRESS (any dask cluster). Writes "
+                    "DIR/ensemble.json (per-sample results, fragment-size statistics with bootstrap "
+                    "intervals, a fit of the fragment-size distribution) and three PNGs. A rerun "
+                    "skips finished samples and resumes interrupted ones. The scene needs a random "
+                    "strength: --set weibull_m=M. Exit status 0 when every sample ends normally, "
+                    "1 when one fails, 2 on bad input.")
+    p.add_argument("scene", metavar="SCENE",
+                   help=f"a built-in scene ({', '.join(sorted(scenes.SCENES))}), a file path/to/scene.py "
+                        f"defining scene(**params), or package.module:function; it needs a seed parameter")
+    p.add_argument("--samples", type=_int_at_least(1), required=True, help="number of samples N (>= 1)")
+    p.add_argument("--seed", type=_int_at_least(0), default=0, help="seed of the first sample (default 0)")
+    p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
+                   help="a scene parameter, e.g. --set weibull_m=8 --set maxh=0.12 (repeatable)")
+    p.add_argument("--out", metavar="DIR", default=None, help="output folder (default out/SCENE_ensemble)")
+    where = p.add_mutually_exclusive_group()
+    where.add_argument("--scheduler", metavar="ADDRESS", default=None,
+                       help="address of a running dask scheduler, e.g. tcp://host:8786")
+    where.add_argument("--workers", type=_int_at_least(1), default=2,
+                       help="worker processes of the local cluster (default 2)")
+    p.add_argument("--steps", type=_int_at_least(1), default=200, help="at most this many steps per sample")
+    p.add_argument("--contact", choices=["auto", "never"], default="auto", help="as for run")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(func=_run_ensemble)
+
+
+def _run_ensemble(args):
+    from .ensemble import Ensemble, SceneFactory
+    from .scene_source import load_scene_function, parse_assignments, scene_parameters
+
+    function = load_scene_function(args.scene)
+    accepted = scene_parameters(function)
+    overrides = parse_assignments(args.set, function)
+    if "seed" not in accepted:
+        raise ValueError(f"scene {args.scene} takes no seed parameter: its samples would not differ")
+    if "seed" in overrides:
+        raise ValueError("give the first seed with --seed S, not --set seed=...")
+    if "weibull_m" in accepted and overrides.get("weibull_m", accepted["weibull_m"]) is None:
+        raise ValueError(f"the samples of scene {args.scene} differ only by a random strength: "
+                         f"set its Weibull modulus, e.g. --set weibull_m=8")
+    name = os.path.splitext(os.path.basename(args.scene.replace(":", "_")))[0]
+    out = args.out if args.out is not None else os.path.join("out", f"{name}_ensemble")
+    ensemble = Ensemble(SceneFactory(args.scene, overrides),           # checks the scene, writes nothing
+                        list(range(args.seed, args.seed + args.samples)), out=out,
+                        control={"max_steps": args.steps}, contact=args.contact, workers=args.workers,
+                        progress=not args.quiet)
+    client = None
+    if args.scheduler is not None:
+        from distributed import Client
+        try:
+            client = Client(args.scheduler, timeout="5s")
+        except (OSError, ValueError) as err:
+            raise ValueError(f"cannot reach the dask scheduler at {args.scheduler}: {err}") from None
+    try:
+        report = ensemble.run(client)
+    finally:
+        if client is not None:
+            client.close()
+    counts, peaks, fit = report["fragment_counts"], report["peak_load"], report["fit"]
+    print(f"{report['scene']}: {report['finished']} of {len(report['samples'])} samples finished")
+    if counts.get("n"):
+        print(f"fragments per sample {counts['mean']:.3g} (95% interval {counts['mean_interval'][0]:.3g} to "
+              f"{counts['mean_interval'][1]:.3g}); peak load {peaks['mean']:.4g} +- {peaks['std']:.2g}; "
+              f"fragment sizes: {fit.get('family') or fit.get('reason')}")
+    print(f"results in {out}/ (ensemble.json, {', '.join(sorted(report['pictures'].values()))})")
+    if report["not_finished"]:
+        raise RuntimeError(f"samples {report['not_finished']} did not finish (see their summary.json)")
+    return 0
+
+
 def build_parser():
     """The argument parser of ``python -m ngfracture``.
 
@@ -255,9 +500,13 @@ def build_parser():
     parser = argparse.ArgumentParser(
         prog="ngfracture",
         description="ngfracture: brittle fracture by node splitting, an NGSolve plugin.")
+    parser.add_argument("--version", action="version", version=f"ngfracture {__version__}")
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     _add_run(subparsers)
+    _add_scenes(subparsers)
+    _add_render(subparsers)
     _add_verify(subparsers)
+    _add_ensemble(subparsers)
     return parser
 
 

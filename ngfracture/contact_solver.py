@@ -47,6 +47,8 @@ second order in the displacement (the normals are frozen at the prediction): mea
 plate with a zigzag crack, overlap area 8.6e-9, 8.5e-11, 8.5e-13 for boundary displacements
 1e-3, 1e-4, 1e-5.
 """
+import math
+import numbers
 import time
 from dataclasses import dataclass, field
 
@@ -60,7 +62,7 @@ from .meshio import boundary_only, mesh_to_arrays
 from .seams import KINK_ANGLE, find_seams, seam_constraints
 from .kkt import SingularSystem, single_threaded_blas
 from .qp import QPError
-from .solver import NewtonSolver, SavedTangent, SolveStatus
+from .solver import NewtonSolver, SavedTangent, SolveStatus, check_solve_options
 
 LABEL = "contact"
 
@@ -78,8 +80,9 @@ class ContactResult:
         every Newton solve in turn.
     converged, reason, rounds, constraints, multipliers, released, max_penetration
         Initial values of the attributes of the same names (below).
-    timings, history, updates, lcp
-        Likewise; by default zero timings for the four phases, an empty history, 0, 0.
+    timings, history, updates, lcp, notes
+        Likewise; by default zero timings for the four phases, an empty history, 0, 0, no
+        notes.
 
     Attributes
     ----------
@@ -114,6 +117,10 @@ class ContactResult:
         Re-linearisations of the rows at a settled solution (see ContactSolver).
     lcp : int
         Rounds whose set was chosen by the complementarity problem (after a cycle).
+    notes : list of str
+        Every departure from the plain path, one sentence each: a complementarity
+        problem that could not be solved (the primal-dual update went on instead), or
+        ``fix_free_modes=False`` that contact turned into True.
     """
     status: SolveStatus
     converged: bool = False
@@ -127,6 +134,7 @@ class ContactResult:
     history: list = field(default_factory=list)
     updates: int = 0
     lcp: int = 0
+    notes: list = field(default_factory=list)
 
     def __bool__(self):
         return self.converged
@@ -186,18 +194,39 @@ class ContactSolver:
         Passed to ``problem.solve`` (method, tol, maxit, ...); ``fix_free_modes`` is True
         (free pieces are held on the rigid modes contact leaves free) unless given as "all"
         (held on all their rigid modes: contact rows dependent on those holds are dropped
-        too), and ``tangent`` is chosen by :meth:`solve`.
+        too; False is turned into True and recorded in ``ContactResult.notes``: a piece
+        that only contact holds has free modes whenever it loses contact), and ``tangent``
+        is chosen by :meth:`solve`.
 
     Raises
     ------
     ValueError
-        If ``tol`` is NaN, infinite or negative. The other arguments are not checked here.
+        Naming the first bad argument: ``tol`` NaN, infinite or negative; ``max_rounds``,
+        ``max_updates`` or ``pdas_rounds`` not an integer (>= 1, >= 0, >= 0);
+        ``rank_tol`` not in (0, 1); ``kink_angle`` not in [0, pi]; ``fix_free_modes`` not
+        False, True or "all"; an unknown ``method``, ``linear_solver`` or ``inverse``.
     """
 
     def __init__(self, problem, tol, penetration_tol=None, max_rounds=20, rank_tol=1e-5, max_updates=10,
                  kink_angle=KINK_ANGLE, pdas_rounds=6, **solve_options):
         if not np.isfinite(tol) or tol < 0:
             raise ValueError(f"contact detection tol must be finite and >= 0, got {tol!r}")
+        for name, value, low in (("max_rounds", max_rounds, 1), ("max_updates", max_updates, 0),
+                                 ("pdas_rounds", pdas_rounds, 0)):
+            if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < low:
+                raise ValueError(f"ContactSolver {name} must be an integer >= {low}, got {value!r}")
+        if isinstance(rank_tol, bool) or not isinstance(rank_tol, numbers.Real) or not 0 < rank_tol < 1:
+            raise ValueError(f"ContactSolver rank_tol must be a number in (0, 1), got {rank_tol!r}")
+        if isinstance(kink_angle, bool) or not isinstance(kink_angle, numbers.Real) \
+                or not 0 <= kink_angle <= math.pi:
+            raise ValueError(f"ContactSolver kink_angle must be an angle in [0, pi] (radians), got {kink_angle!r}")
+        fix = solve_options.get("fix_free_modes", True)
+        if fix not in (False, True, "all"):
+            raise ValueError(f"fix_free_modes must be False, True or 'all', got {fix!r}")
+        check_solve_options(solve_options)
+        #: departures from the plain path known at construction, copied into every result
+        self._notes = (["fix_free_modes=False was turned into True: with contact, free pieces are "
+                        "held on the rigid modes contact leaves free"] if fix is False else [])
         self.problem = problem
         self.tol = float(tol)
         self.penetration_tol = 1e-10 * max(self.tol, 1e-300) if penetration_tol is None else penetration_tol
@@ -302,7 +331,10 @@ class ContactSolver:
         try:
             _, closed = NewtonSolver(prob, tangent=tangent, **options).unilateral_multipliers(
                 np.arange(offset, offset + len(candidates)))
-        except (SingularSystem, QPError, np.linalg.LinAlgError):
+        except (SingularSystem, QPError, np.linalg.LinAlgError, ValueError) as exc:
+            # recorded: the set then comes from the primal-dual update, not the exact solution
+            result.notes.append(f"complementarity problem of {len(candidates)} candidate rows not solved "
+                                f"({type(exc).__name__}: {exc}); the primal-dual update chose the set")
             return None
         finally:
             prob.constraints.clear_rows(LABEL)
@@ -344,7 +376,7 @@ class ContactSolver:
         prob.constraints.clear_rows(LABEL)
         # the rounds are at the load of the prediction: they reuse its factorised tangent
         tangent = SavedTangent()
-        result = ContactResult(None)
+        result = ContactResult(None, notes=list(self._notes))
         status = self._newton(result, tangent)
         if not status.converged:
             result.reason = status.reason
@@ -407,7 +439,7 @@ class ContactSolver:
                 # the exact solution of the complementarity problem of the linearisation.
                 exact = True
                 # candidates: the rows the update wants and every row imposed before
-                candidates = np.union1d(want, [i for i, k in enumerate(keys) if k in tried])
+                candidates = np.union1d(want, np.array([i for i, k in enumerate(keys) if k in tried], dtype=np.int64))
                 choice = self._complementarity(pool, candidates, fixed, nv, n, tangent, result)
                 if choice is not None and set(keys[i] for i in choice) != set(lam):
                     kept = choice

@@ -3,7 +3,7 @@
     [ K  C^T ] [du ]   [r]
     [ C  0   ] [lam] = [h]      plus fixed dofs du_c given (single-dof rows).
 
-How it is solved (chosen by measurement, see README): the single-dof rows are
+How it is solved (chosen by measurement, see docs/design.md): the single-dof rows are
 eliminated exactly, the symmetric positive definite block K_ff is factorised once
 (NGSolve's sparse Cholesky by default), and the general rows go through the Schur
 complement S = C_f K_ff^-1 C_f^T, a small dense matrix.  The factorisation is kept

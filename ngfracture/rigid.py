@@ -17,6 +17,38 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
+#: singular values up to this times max(largest, 1) count as zero (see numerical_rank)
+RANK_RTOL = 1e-10
+
+
+def numerical_rank(s, rtol=RANK_RTOL):
+    """How many rigid modes a set of rows holds, from the singular values of rows x modes.
+
+    One threshold for every "is this mode held" test (:func:`analyse_support`,
+    :func:`unheld_mode_rows`, ``ElasticProblem.floating_bodies``), so that the solver
+    never adds a hold that the floating-body check then calls missing, or the reverse.
+    It is relative to the largest singular value, with a floor of 1 under it: the modes
+    have entries of order 1 (coordinates relative to the piece's size, see
+    :func:`piece_modes`) and the rows unit coefficients (single dofs, unit normals,
+    interpolation weights), so a held mode has a singular value of order 1. Rows whose
+    largest singular value is itself tiny (a contact row nearly orthogonal to the only
+    mode it touches, 1e-12) hold nothing that a solve can use, and a purely relative test
+    would count them.
+
+    Parameters
+    ----------
+    s : array_like
+        Singular values (any order; empty: rank 0).
+    rtol : float
+        The threshold.
+
+    Returns
+    -------
+    int
+    """
+    s = np.asarray(s, dtype=float)
+    return int(np.sum(s > rtol * max(s.max(initial=0.0), 1.0)))
+
 
 def pieces(elements, nv):
     """Connected components of a triangle mesh (through shared vertices).
@@ -127,7 +159,7 @@ def analyse_support(x, elements, n, ndof, fixed_dofs):
         if held.shape[0]:
             # reduce to at most 3x3 first: the full V of the SVD is then cheap
             _, s, vt = np.linalg.svd(np.linalg.qr(held, mode="r"), full_matrices=True)
-            rank = int(np.sum(s > 1e-10 * max(s.max(), 1.0)))
+            rank = numerical_rank(s)
             free_modes = vt[rank:].T
         else:
             free_modes = np.eye(3)
@@ -145,7 +177,7 @@ def analyse_support(x, elements, n, ndof, fixed_dofs):
     return Support(modes, np.array(pins, dtype=np.int64), unheld)
 
 
-def unheld_mode_rows(C, modes, rtol=1e-10):
+def unheld_mode_rows(C, modes, rtol=RANK_RTOL):
     """Rows that fix exactly the rigid modes that neither single-dof nor general rows hold.
 
     Parameters
@@ -155,7 +187,7 @@ def unheld_mode_rows(C, modes, rtol=1e-10):
     modes : scipy.sparse matrix (ndof, k)
         Rigid modes left free by the single-dof rows (Support.modes).
     rtol : float
-        Relative singular-value threshold for "held".
+        Singular-value threshold for "held" (:func:`numerical_rank`).
 
     Returns
     -------
@@ -180,7 +212,7 @@ def unheld_mode_rows(C, modes, rtol=1e-10):
             dense = sub.tocsr()[touched].toarray()
             _, s, vt = np.linalg.svd(np.linalg.qr(dense, mode="r") if dense.shape[0] > cols.size else dense,
                                      full_matrices=True)
-            rank = int(np.sum(s > rtol * max(s.max(initial=0.0), 1e-300)))
+            rank = numerical_rank(s, rtol)
             null = vt[rank:].T
         else:
             null = np.eye(cols.size)

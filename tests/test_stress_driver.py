@@ -7,10 +7,12 @@ Measured (netgen/NGSolve of this checkout):
   "never": the first step (dx cut to dx_min = dx/64 = 2.16e-7) shatters the plate into
   45 fragments in one crack pass and one relaxation pass, 237 split vertices, 471
   vertices (ratio 1.195 to the triangles); later steps split nothing. With contact
-  "auto" the same step is refused instead (open): the contact rows hold a mechanism of
-  the 45 fragments only at sigma 9.2e-10 (of 4.4), rigid.unheld_mode_rows counts it as
-  held and the floating check does not; the run stops at step 0 with reason "failed"
-  (singular), the initial state written.
+  "auto" it runs too (3 steps, 223 split vertices, 38 fragments, overlap 4e-18, 18 s):
+  the contact rows hold a mechanism of the fragments only at sigma 9.2e-10 (of 4.4);
+  the solver's holds and the floating-body check use one test
+  (rigid.unheld_mode_rows, rigid.numerical_rank) and count it as held, and a
+  complementarity problem that the dual active-set method cannot solve on these nearly
+  dependent rows is recorded as a note while the primal-dual update chooses the set.
 * threads 1 and 2 (assembly in the TaskManager, PARALLEL_MIN_DOFS = 0), plate maxh
   0.06: 21 steps, 46 split vertices, 3 fragments either way; triangles and points
   bitwise equal, displacement equal to 2.4e-20 (2.6e-16 of its maximum).
@@ -37,6 +39,10 @@ def test_critical_strain_1e_12_shatters_once_and_stops():
     scene.critical = 1e-12          # 1e8 times below the strain of the first increment
     nv0, ne = scene.mesh.nv, scene.mesh.ne
     control = StepControl(max_steps=3, max_relax_passes=20)
+    # the shattered plate is broken through: the run ends after the step that shattered it
+    broken = Simulation(scene, control, contact="never").run()
+    assert broken.reason == "broken" and broken.summary["n_steps"] == 1, broken.message
+    scene.stop_when_unloaded = False     # go on: the steps after shattering stay quiet
     result = Simulation(scene, control, contact="never").run()
     s, hist = result.summary, result.summary["history"]
     assert result.ok and result.reason == "max_steps" and s["n_steps"] == 3
@@ -56,6 +62,20 @@ def test_critical_strain_1e_12_shatters_once_and_stops():
     assert stats.count == s["n_fragments"] and np.all(stats.areas > 0)
     assert s["area_final"] == s["area_initial"]          # splitting keeps every triangle
     assert np.all(np.isfinite(result.state.u))
+
+
+def test_critical_strain_1e_12_with_contact_runs():
+    scene = scenes.plate(maxh=0.1)
+    scene.critical = 1e-12
+    result = Simulation(scene, StepControl(max_steps=3, max_relax_passes=20), contact="auto").run()
+    s = result.summary
+    assert result.ok and result.reason == "max_steps" and s["n_steps"] == 3, result.message
+    assert s["n_fragments"] > 10 and s["area_final"] == s["area_initial"]
+    assert s["n_vertices"] == scene.mesh.nv + s["n_split_vertices"]
+    # contact holds the lips to its penetration tolerance (1e-10 contact_tol) along both
+    # faces of every crack: the overlap area is at most that depth times their length
+    assert s["max_overlap_area"] <= 1e-10 * scene.contact_tol * 2 * s["crack_length"]
+    assert all(n["note"].startswith("complementarity problem of ") for n in s["notes"])
 
 
 # -- thread count 1 and 2 ----------------------------------------------------------------------

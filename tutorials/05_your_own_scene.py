@@ -142,3 +142,16 @@ plt.show()
 stats = FragmentStatistics(run.problem.mesh)
 print(stats.summary())
 assert abs(stats.total_area - summary["area_initial"]) <= 1e-14 * summary["area_initial"]
+
+# %% [markdown]
+# ## The same scene from the command line
+#
+# `examples/beam_scene.py` holds this scene as a function `scene(**params)` whose
+# parameters all have defaults. The command line runs it and sets any parameter:
+#
+# ```
+# ngfracture run examples/beam_scene.py --set E_glass=60e9 --set critical=1.5e-4 --max-new-cracks 4
+# ```
+#
+# `--progress json` prints one JSON object per accepted step (step, load, splits,
+# fragments, seconds), and `ngfracture render out/beam_scene` redraws the pictures.

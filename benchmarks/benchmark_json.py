@@ -1,0 +1,35 @@
+"""The benchmarks' common output options: ``--json FILE`` and ``--force``.
+
+Every benchmark writes its result as JSON, to stdout or, with ``--json FILE``, atomically
+to FILE (``ngfracture.cli.write_json_atomic``). An existing FILE is refused before any
+measurement unless ``--force``: a benchmark can run for hours, and a finished result is
+not overwritten by mistake.
+"""
+import json
+import os
+import sys
+
+from ngfracture.cli import write_json_atomic
+
+
+def add_options(parser, force_help="overwrite an existing --json file"):
+    """Add ``--json FILE`` and ``--force`` to an argparse parser."""
+    parser.add_argument("--json", metavar="FILE", help="write the JSON here (atomically) instead of "
+                        "stdout; refused if FILE exists, unless --force")
+    parser.add_argument("--force", action="store_true", help=force_help)
+
+
+def refuse_existing(parser, args, *more_paths):
+    """Exit with a usage error (status 2) if an output file exists and ``--force`` is not given."""
+    for path in (args.json, *more_paths):
+        if path is not None and os.path.exists(path) and not args.force:
+            parser.error(f"{path} exists; pass --force to overwrite it")
+
+
+def write(args, result):
+    """Write ``result`` to ``args.json`` (atomically) or to stdout."""
+    if args.json:
+        write_json_atomic(args.json, result, force=args.force)
+    else:
+        json.dump(result, sys.stdout, indent=1)
+        print()
