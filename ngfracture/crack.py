@@ -275,7 +275,7 @@ def equivalent_strain(mesh, strain, material):
     missing = [n for n in names if n not in mats]
     if missing:
         raise ValueError(f"ngfracture.crack: no material for regions {missing}")
-    region = np.array([el.index for el in mesh.Elements(ngsolve.VOL)], dtype=int)
+    region = mesh.ngmesh.Elements2D().NumPy()["index"].astype(int) - 1   # netgen counts regions from 1
     lam = np.array([mats[n].lam / mats[n].E for n in names])[region]
     two_mu = np.array([2 * mats[n].mu / mats[n].E for n in names])[region]
     trace = e[:, 0] + e[:, 1]
