@@ -5,6 +5,7 @@
 #include "crack_strain.hpp"
 #include "crack_split.hpp"
 #include "crack_rebuild.hpp"
+#include "nonlocal_strain.hpp"
 
 namespace py = pybind11;
 using namespace ngfracture;
@@ -105,6 +106,46 @@ Returns
 -------
 numpy.ndarray
     Shape (nv, 3): (xx, yy, xy) per vertex.
+)doc");
+
+  m.def("CrackNonlocalOpening",
+        [] (shared_ptr<ngcomp::MeshAccess> mesh, darray tensors, darray radius, int ndir)
+        {
+          size_t nv = mesh->GetNV();
+          if (tensors.ndim() != 2 || size_t(tensors.shape(0)) != nv || tensors.shape(1) != 3)
+            throw Exception("ngfracture.CrackNonlocalOpening: tensors must have shape (nv, 3) = (" +
+                            ToString(nv) + ", 3)");
+          if (radius.ndim() != 1 || size_t(radius.shape(0)) != nv)
+            throw Exception("ngfracture.CrackNonlocalOpening: radius must have shape (nv,) = (" +
+                            ToString(nv) + ",)");
+          py::array_t<double> out({ nv, size_t(3) });
+          FlatMatrix<double> T(nv, 3, const_cast<double*>(tensors.data()));
+          FlatVector<double> R(nv, const_cast<double*>(radius.data()));
+          FlatMatrix<double> res(nv, 3, out.mutable_data());
+          NonlocalOpening(*mesh, T, R, ndir, res);
+          return out;
+        },
+        py::arg("mesh"), py::arg("tensors"), py::arg("radius"), py::arg("ndir") = 72,
+        R"doc(Critical-distance opening measure of every vertex (docs/criterion.md).
+
+Low-level: use ngfracture.crack.StrainCriterion(critical, radius=r).
+
+Parameters
+----------
+mesh : ngsolve.Mesh
+    2D triangle mesh, reference configuration.
+tensors : numpy.ndarray
+    Shape (nv, 3), nodal tensor field (xx, yy, xy), interpolated linearly on triangles.
+radius : numpy.ndarray
+    Shape (nv,), critical distance of every vertex (<= 0: not evaluated).
+ndir : int
+    Number of ray directions (>= 8).
+
+Returns
+-------
+numpy.ndarray
+    Shape (nv, 3): value * n n^T, value the largest over the rays of the smallest opening
+    component along the ray (length radius), n the opening direction of the best ray.
 )doc");
 
   m.def("CrackPrincipal",

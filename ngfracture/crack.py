@@ -64,7 +64,8 @@ from .meshcheck import validate_mesh
 
 __all__ = [
     "RULE_1", "RULE_1A", "RULE_1B", "RULE_2", "RULE_2A", "RULE_2B", "RULE_TIP", "RULE_NONE",
-    "StrainCriterion", "SplitResult", "vertex_displacement", "vertex_strain", "principal",
+    "StrainCriterion", "SplitResult", "vertex_displacement", "element_strain", "vertex_strain",
+    "equivalent_strain", "nonlocal_opening", "toughness", "critical_distance", "principal",
     "select", "split_vertices", "transfer", "transfer_vertex_field", "split_by_tensor",
     "crack_step", "rule_names",
 ]
@@ -154,8 +155,8 @@ def vertex_displacement(u):
     return a
 
 
-def vertex_strain(mesh, u, measure="green"):
-    """Nodal strain tensor: area-weighted average of the element strains around each vertex.
+def element_strain(mesh, u, measure="green"):
+    """Strain of every triangle (the P1 gradient, or the element mean for order >= 2).
 
     Parameters
     ----------
@@ -171,7 +172,7 @@ def vertex_strain(mesh, u, measure="green"):
     Returns
     -------
     numpy.ndarray
-        Shape (nv, 3), rows (xx, yy, xy).
+        Shape (ne, 3), rows (xx, yy, xy).
 
     Raises
     ------
@@ -190,9 +191,44 @@ def vertex_strain(mesh, u, measure="green"):
             E = E + 0.5 * H.trans * H
         area = ngsolve.Integrate(ngsolve.CF(1), mesh, element_wise=True).NumPy()
         comps = [E[0, 0], E[1, 1], E[0, 1]]
-        em = np.column_stack([ngsolve.Integrate(c, mesh, element_wise=True).NumPy() / area
-                              for c in comps])
-        return _C.VertexAverage(mesh, em)
+        return np.column_stack([ngsolve.Integrate(c, mesh, element_wise=True).NumPy() / area
+                                for c in comps])
+    U = vertex_displacement(u)
+    if U.shape[0] != mesh.nv:
+        raise ValueError(f"ngfracture.crack: displacement has {U.shape[0]} vertex values, "
+                         f"the mesh has {mesh.nv} vertices")
+    if not np.all(np.isfinite(U)):
+        raise ValueError("ngfracture.crack: displacement has NaN or inf values")
+    return _C.CrackElementStrain(mesh, U, measure)
+
+
+def vertex_strain(mesh, u, measure="green"):
+    """Nodal strain tensor: area-weighted average of the element strains around each vertex.
+
+    Parameters
+    ----------
+    mesh : ngsolve.Mesh
+        2D triangle mesh (reference configuration).
+    u : ngsolve.GridFunction or numpy.ndarray
+        Displacement, see :func:`element_strain`.
+    measure : {'green', 'linear'}
+        Green-Lagrange (H + H^T + H^T H)/2 or small strain (H + H^T)/2, H = grad u.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (nv, 3), rows (xx, yy, xy).
+
+    Raises
+    ------
+    ValueError
+        Non-2D mesh, unknown measure or a field that does not fit the mesh.
+    """
+    _check_mesh(mesh)
+    if isinstance(u, ngsolve.GridFunction) and _field_order(u) > 1:
+        return _C.VertexAverage(mesh, element_strain(mesh, u, measure))
+    if measure not in ("green", "linear"):
+        raise ValueError(f"ngfracture.crack: measure must be 'green' or 'linear', got {measure!r}")
     U = vertex_displacement(u)
     if U.shape[0] != mesh.nv:
         raise ValueError(f"ngfracture.crack: displacement has {U.shape[0]} vertex values, "
@@ -200,6 +236,151 @@ def vertex_strain(mesh, u, measure="green"):
     if not np.all(np.isfinite(U)):
         raise ValueError("ngfracture.crack: displacement has NaN or inf values")
     return _C.CrackVertexStrain(mesh, U, measure)
+
+
+def equivalent_strain(mesh, strain, material):
+    """Stress divided by Young's modulus, per triangle: the strain a uniaxial test would show.
+
+    For a 2D material with Lame parameters (lambda, mu) of its plane reduction,
+    ``(lambda tr(E) I + 2 mu E) / E_young``. Under uniaxial stress it equals the principal
+    strain along the load, so a critical strain keeps its meaning; its opening component
+    is the hoop stress of the maximum-hoop-stress rule (docs/criterion.md). For
+    St Venant-Kirchhoff and linear materials this is the (second Piola-Kirchhoff) stress
+    over E exactly.
+
+    Parameters
+    ----------
+    mesh : ngsolve.Mesh
+        2D triangle mesh.
+    strain : numpy.ndarray
+        Shape (ne, 3), element strains (xx, yy, xy).
+    material : Material or dict of str -> Material
+        One material, or one per region of the mesh.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (ne, 3).
+
+    Raises
+    ------
+    ValueError
+        If a region of the mesh has no material or the shape is wrong.
+    """
+    e = np.asarray(strain, dtype=float)
+    if e.shape != (mesh.ne, 3):
+        raise ValueError(f"ngfracture.crack: element strains must have shape ({mesh.ne}, 3), got {e.shape}")
+    names = list(mesh.GetMaterials())
+    mats = material if isinstance(material, dict) else {n: material for n in names}
+    missing = [n for n in names if n not in mats]
+    if missing:
+        raise ValueError(f"ngfracture.crack: no material for regions {missing}")
+    region = mesh.ngmesh.Elements2D().NumPy()["index"].astype(int) - 1   # netgen counts regions from 1
+    lam = np.array([mats[n].lam / mats[n].E for n in names])[region]
+    two_mu = np.array([2 * mats[n].mu / mats[n].E for n in names])[region]
+    trace = e[:, 0] + e[:, 1]
+    out = two_mu[:, None] * e
+    out[:, :2] += (lam * trace)[:, None]
+    return out
+
+
+def nonlocal_opening(mesh, element_tensors, radius, ndir=72):
+    """Critical-distance measure of every vertex from element tensors (docs/criterion.md).
+
+    The element tensors are averaged at the vertices (area weights) and interpolated
+    linearly; from every vertex, rays of length ``radius`` in ``ndir`` directions are walked
+    through the mesh (a ray that meets the boundary or a crack face before its end does not
+    count); a ray's value is the smallest opening component n.T.n (n perpendicular to the
+    ray) along it, the vertex's value the largest over the rays (refined by a parabola).
+
+    Parameters
+    ----------
+    mesh : ngsolve.Mesh
+        2D triangle mesh, reference configuration.
+    element_tensors : numpy.ndarray
+        Shape (ne, 3), rows (xx, yy, xy).
+    radius : float or numpy.ndarray
+        Critical distance (> 0), or one per vertex (<= 0: the vertex gets 0).
+    ndir : int
+        Number of ray directions (>= 8).
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (nv, 3): ``value * n n^T`` per vertex, so :func:`principal` returns the value
+        and the opening direction n (the crack runs perpendicular to n).
+
+    Raises
+    ------
+    ValueError
+        Bad shapes, a non-finite radius or field, too few directions.
+    """
+    _check_mesh(mesh)
+    t = np.asarray(element_tensors, dtype=float)
+    if t.shape != (mesh.ne, 3):
+        raise ValueError(f"ngfracture.crack: element tensors must have shape ({mesh.ne}, 3), got {t.shape}")
+    if not np.all(np.isfinite(t)):
+        raise ValueError("ngfracture.crack: element tensors have NaN or inf values")
+    if np.ndim(radius) == 0:
+        r = np.full(mesh.nv, _check_critical(radius, "critical distance"))
+    else:
+        r = np.asarray(radius, dtype=float)
+        if r.shape != (mesh.nv,) or not np.all(np.isfinite(r)):
+            raise ValueError(f"ngfracture.crack: radius must be a number or {mesh.nv} finite values")
+    if isinstance(ndir, bool) or not isinstance(ndir, (int, np.integer)) or ndir < 8:
+        raise ValueError(f"ngfracture.crack: ndir must be an integer >= 8, got {ndir!r}")
+    nodal = _C.VertexAverage(mesh, t)
+    return _C.CrackNonlocalOpening(mesh, nodal, r, int(ndir))
+
+
+def toughness(critical, radius, E):
+    """Fracture toughness K_c of the critical-distance criterion: ``E critical sqrt(2 pi radius)``.
+
+    A straight crack under mode I starts to grow when the stress at distance r ahead of its
+    tip, ``K_I / sqrt(2 pi r)`` (the singular field), reaches ``E * critical``
+    (docs/criterion.md).
+
+    Parameters
+    ----------
+    critical : float
+        Critical strain (> 0).
+    radius : float
+        Critical distance r (> 0).
+    E : float
+        Young's modulus (> 0).
+
+    Returns
+    -------
+    float
+        K_c (stress times square root of length).
+    """
+    c = _check_critical(critical)
+    r = _check_critical(radius, "critical distance")
+    return _check_critical(E, "Young's modulus") * c * math.sqrt(2 * math.pi * r)
+
+
+def critical_distance(critical, toughness, E):
+    """Critical distance r for a given fracture toughness: ``(K_c / (E critical))^2 / (2 pi)``.
+
+    The inverse of :func:`toughness`.
+
+    Parameters
+    ----------
+    critical : float
+        Critical strain (> 0).
+    toughness : float
+        K_c (> 0).
+    E : float
+        Young's modulus (> 0).
+
+    Returns
+    -------
+    float
+        r.
+    """
+    c = _check_critical(critical)
+    k = _check_critical(toughness, "toughness")
+    return (k / (_check_critical(E, "Young's modulus") * c)) ** 2 / (2 * math.pi)
 
 
 def principal(tensors):
@@ -255,11 +436,19 @@ def select(values, critical):
 
 
 class StrainCriterion:
-    """Principal nodal strain above a critical strain (the paper's criterion).
+    """Principal strain above a critical strain: one-ring (the paper's) or critical distance.
 
     A criterion is any object with ``critical`` and ``vertex_tensor(mesh, u)`` returning a
     symmetric tensor per vertex (rows xx, yy, xy); a stress criterion fits the same slot by
     returning the nodal stress and a critical stress.
+
+    With ``radius=None`` the tensor is the nodal strain (:func:`vertex_strain`), averaged
+    over the triangles around the vertex: mesh dependent at notches and crack tips, where
+    the strain is singular. With a critical distance ``radius`` it is the nonlocal measure of
+    :func:`nonlocal_opening` (docs/criterion.md): the opening strain (or, given a material,
+    the opening stress over E) judged along rays of length ``radius``, which gives a
+    mesh-independent initiation load and the maximum-hoop-stress crack direction; its
+    fracture toughness is :func:`toughness`.
 
     Parameters
     ----------
@@ -267,21 +456,31 @@ class StrainCriterion:
         Critical principal strain, finite and > 0.
     measure : {'green', 'linear'}
         Green-Lagrange for the nonlinear models, small strain for the linear one.
+    radius : float, optional
+        Critical distance r (> 0); None: the one-ring average.
+    material : Material or dict of str -> Material, optional
+        With a radius: judge the stress over E (:func:`equivalent_strain`) instead of the
+        strain, as the maximum hoop stress rule does.
+    ndir : int
+        Ray directions of the nonlocal measure.
 
     Raises
     ------
     ValueError
-        If critical is not a finite number > 0 or the measure is unknown.
+        If critical or radius is not a number > 0 or the measure is unknown.
     """
 
-    def __init__(self, critical, measure="green"):
+    def __init__(self, critical, measure="green", radius=None, material=None, ndir=72):
         self.critical = _check_critical(critical)
         if measure not in ("green", "linear"):
             raise ValueError(f"ngfracture.crack: measure must be 'green' or 'linear', got {measure!r}")
         self.measure = measure
+        self.radius = None if radius is None else _check_critical(radius, "critical distance")
+        self.material = material
+        self.ndir = ndir
 
     def vertex_tensor(self, mesh, u):
-        """Nodal strain of displacement u on mesh, see :func:`vertex_strain`.
+        """Tensor per vertex whose largest principal value is compared with ``critical``.
 
         Parameters
         ----------
@@ -293,12 +492,19 @@ class StrainCriterion:
         Returns
         -------
         numpy.ndarray
-            Shape (nv, 3), rows (xx, yy, xy), in this criterion's measure.
+            Shape (nv, 3), rows (xx, yy, xy): the nodal strain (radius None) or the
+            rank-one nonlocal tensor of :func:`nonlocal_opening`.
         """
-        return vertex_strain(mesh, u, self.measure)
+        if self.radius is None:
+            return vertex_strain(mesh, u, self.measure)
+        strain = element_strain(mesh, u, self.measure)
+        if self.material is not None:
+            strain = equivalent_strain(mesh, strain, self.material)
+        return nonlocal_opening(mesh, strain, self.radius, self.ndir)
 
     def __repr__(self):
-        return f"StrainCriterion(critical={self.critical!r}, measure={self.measure!r})"
+        return (f"StrainCriterion(critical={self.critical!r}, measure={self.measure!r}, "
+                f"radius={self.radius!r})")
 
 
 @dataclass

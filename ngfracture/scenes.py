@@ -14,6 +14,7 @@ import math
 
 import ngsolve as ng
 from netgen.geom2d import SplineGeometry
+from netgen.meshing import MeshingParameters, Pnt
 
 from .materials import StVenantKirchhoff
 from .simulation import Scene
@@ -41,12 +42,13 @@ def _positive(name, value):
 
 
 def notched_plate_mesh(maxh=0.034, width=1.0, height=1.0, notch_depth=0.04, notch_width=0.02,
-                       notch_maxh=None):
+                       notch_maxh=None, notch_zone=0.0, path_maxh=None):
     """A rectangle with a V-notch in the middle of the top and of the bottom edge.
 
     Boundaries: ``left``, ``right``, ``top``, ``bottom`` (the notches belong to top and
     bottom); region ``plate``. Near the notch tips the mesh size is ``notch_maxh``
-    (default: a quarter of the notch depth, at most maxh).
+    (default: a quarter of the notch depth, at most maxh), within ``notch_zone`` of each
+    tip; along the line from tip to tip (where the crack runs) it is at most ``path_maxh``.
 
     Parameters
     ----------
@@ -58,6 +60,11 @@ def notched_plate_mesh(maxh=0.034, width=1.0, height=1.0, notch_depth=0.04, notc
         Depth and opening of each V-notch.
     notch_maxh : float, optional
         Mesh size at the notch tips.
+    notch_zone : float
+        Radius of the disks around the tips meshed with ``notch_maxh`` (0: only the tips
+        and the notch flanks; a critical-distance criterion needs about twice its radius).
+    path_maxh : float, optional
+        Mesh size along the segment between the tips.
 
     Returns
     -------
@@ -88,11 +95,24 @@ def notched_plate_mesh(maxh=0.034, width=1.0, height=1.0, notch_depth=0.04, notc
         geo.Append(["line", pts[i], pts[(i + 1) % len(pts)]], bc=bc, leftdomain=1, rightdomain=0,
                    **({"maxh": hn} if near_tip else {}))
     geo.SetMaterial(1, "plate")
-    return ng.Mesh(geo.GenerateMesh(maxh=maxh))
+    mp = MeshingParameters(maxh=maxh)
+    if notch_zone < 0 or not math.isfinite(notch_zone):
+        raise ValueError(f"notch_zone must be a finite number >= 0, got {notch_zone!r}")
+    n = int(math.ceil(notch_zone / hn))
+    for tip_y in (notch_depth, height - notch_depth):
+        for i in range(-n, n + 1):         # a grid of size restrictions fills the disk
+            for j in range(-n, n + 1):
+                if (i * i + j * j) * hn * hn <= notch_zone ** 2:
+                    mp.RestrictH(x=c + i * hn, y=tip_y + j * hn, z=0, h=hn)
+    if path_maxh is not None:
+        mp.RestrictHLine(p1=Pnt(c, notch_depth, 0), p2=Pnt(c, height - notch_depth, 0),
+                         maxh=_positive("path_maxh", path_maxh))
+    return ng.Mesh(geo.GenerateMesh(mp=mp))
 
 
 def plate(maxh=0.034, strain_max=1e-3, dx=None, material=None, critical=GLASS["critical"],
-          E=GLASS["E"], nu=GLASS["nu"], weibull_m=None, weibull_scale=None, weibull_area=None, seed=None):
+          E=GLASS["E"], nu=GLASS["nu"], notch_maxh=None, radius=None,
+          weibull_m=None, weibull_scale=None, weibull_area=None, seed=None):
     """The plate under tension of paper section 4.2 (Fig. 8).
 
     A 1 x 1 plate of glass (E = 5 GPa, nu = 0.18, plane stress, St Venant-Kirchhoff)
@@ -115,6 +135,13 @@ def plate(maxh=0.034, strain_max=1e-3, dx=None, material=None, critical=GLASS["c
         Critical principal strain (the mean strength of a random one).
     E, nu : float
         Young's modulus (Pa) and Poisson's ratio of the plate (plane stress).
+    notch_maxh : float, optional
+        Mesh size at the notch tips; default a quarter of the notch depth (one-ring
+        criterion) or radius / 2 (critical distance), at most maxh.
+    radius : float, optional
+        Critical distance of the crack criterion (docs/criterion.md); the mesh is then
+        at most radius / 2 within 2 radius of the tips and along the line between them,
+        where the crack runs. None: the paper's one-ring nodal strain.
     weibull_m, weibull_scale, weibull_area, seed
         Random strength, see :func:`ngfracture.strength.scene_strength`: a Weibull
         modulus (None: uniform strength), the scale (default: mean = ``critical``), the
@@ -125,7 +152,13 @@ def plate(maxh=0.034, strain_max=1e-3, dx=None, material=None, critical=GLASS["c
     Scene
     """
     maxh, strain_max = _positive("maxh", maxh), _positive("strain_max", strain_max)
-    mesh = notched_plate_mesh(maxh)
+    if radius is None:
+        mesh = notched_plate_mesh(maxh, notch_maxh=notch_maxh)
+    else:
+        radius = _positive("radius", radius)
+        fine = min(maxh, radius / 2)
+        notch_maxh = fine if notch_maxh is None else _positive("notch_maxh", notch_maxh)
+        mesh = notched_plate_mesh(maxh, notch_maxh=notch_maxh, notch_zone=2 * radius, path_maxh=fine)
     material = material if material is not None else StVenantKirchhoff(E, nu, plane="stress")
     dx = _positive("dx", dx) if dx is not None else critical / 10
     strength, strength_parameters = scene_strength(mesh, ["plate"], critical, weibull_m, weibull_scale,
@@ -137,8 +170,9 @@ def plate(maxh=0.034, strain_max=1e-3, dx=None, material=None, critical=GLASS["c
 
     return Scene(name="plate", mesh=mesh, material=material, critical=critical, apply_load=apply_load,
                  load_max=strain_max, dx=dx, contact_tol=1e-3 * maxh, stop_when_unloaded=True,
-                 load_description=PLATE_LOAD,
+                 radius=radius, load_description=PLATE_LOAD,
                  parameters={"maxh": maxh, "strain_max": strain_max, "dx": dx, "critical": critical,
+                             "notch_maxh": notch_maxh, "radius": radius,
                              "E": material.E, "nu": material.nu, "model": type(material).__name__,
                              "notch_depth": 0.04, "notch_width": 0.02, **strength_parameters},
                  strength=strength)

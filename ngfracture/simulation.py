@@ -32,7 +32,8 @@ Where the paper is vague, we chose:
   first pass after the increment; cracks that run at fixed load during relaxation
   are the physical answer to that load and are not limited.
 * The criterion is the paper's nodal principal strain (Green-Lagrange, averaged from
-  the elements around a vertex) against a critical strain per material region;
+  the elements around a vertex) or, for a scene with a critical distance, the
+  nonlocal opening stress over E of docs/criterion.md, against a critical strain per material region;
   regions without a critical strain never crack.  Vertices are compared by their
   strain divided by their critical strain, so one pass serves several materials.
 * Every accepted state goes through the checkpoint's mesh representation (arrays and
@@ -55,7 +56,8 @@ import ngsolve as ng
 
 from . import checkpoint
 from .contact_solver import ContactSolver, fragment_overlap_area
-from .crack import StrainCriterion, split_by_tensor, transfer, transfer_vertex_field
+from .crack import (StrainCriterion, element_strain, equivalent_strain, nonlocal_opening,
+                    split_by_tensor, transfer, transfer_vertex_field)
 from .fragments import FragmentStatistics
 from .kkt import single_threaded_blas
 from .loadpath import load_path_cut, prescribed_increment
@@ -110,6 +112,9 @@ class Scene:
         How pieces without Dirichlet support are held (``NewtonSolver``): True, on the
         rigid modes that contact leaves free; "all", on all their rigid modes (the paper's
         pinned fragments), for scenes where contact pushes pieces that nothing else holds.
+    radius : float or dict of str -> float, optional
+        Critical distance of the crack criterion (docs/criterion.md), or one per region;
+        None: the paper's one-ring nodal strain.
     strength : numpy.ndarray, optional
         Critical strain per vertex of ``mesh`` (a random field, :mod:`ngfracture.strength`);
         it replaces the region's critical strain at the vertices of regions that can
@@ -131,6 +136,7 @@ class Scene:
     parameters: dict = field(default_factory=dict)
     control: dict = field(default_factory=dict)
     fix_free_modes: object = True
+    radius: object = None
     strength: object = None
     load_description: str = ""
 
@@ -175,6 +181,12 @@ class Scene:
             raise ValueError(f"Scene {self.name!r}: fix_free_modes must be True or 'all', got {self.fix_free_modes!r}")
         if not isinstance(self.material, (Material, dict)):
             raise ValueError(f"Scene {self.name!r}: material must be a Material or a dict of them")
+        radii = self.radius.items() if isinstance(self.radius, dict) else [("all", self.radius)]
+        for region, r in radii:
+            if r is not None and (isinstance(r, bool) or not isinstance(r, (int, float))
+                                  or not math.isfinite(r) or r <= 0):
+                raise ValueError(f"Scene {self.name!r}: critical distance (radius) of region {region!r} "
+                                 f"must be a finite number > 0 or None, got {r!r}")
         if self.strength is not None:
             s = np.asarray(self.strength)
             if s.shape != (self.mesh.nv,) or not np.issubdtype(s.dtype, np.floating) \
@@ -621,7 +633,6 @@ class Simulation:
         """
         t0 = time.perf_counter()
         mesh = prob.mesh
-        tensors = StrainCriterion(1.0).vertex_tensor(mesh, prob.u)
         arrays = mesh_to_arrays(mesh)
         names = arrays.region_names
         inv = np.array([0.0] + [1.0 / self.critical[n] if self.critical.get(n) is not None else 0.0
@@ -629,10 +640,23 @@ class Simulation:
         # a vertex takes the smallest critical strain of its triangles (the weakest material)
         scale = np.zeros(mesh.nv)
         np.maximum.at(scale, arrays.triangles.ravel(), np.repeat(inv[arrays.regions], 3))
-        if strength is not None:
-            scale = np.where(scale > 0, 1.0 / strength, 0.0)
+        if self.scene.radius is None:
+            if strength is not None:
+                scale = np.where(scale > 0, 1.0 / strength, 0.0)
+            tensors = StrainCriterion(1.0).vertex_tensor(mesh, prob.u) * scale[:, None]
+        else:
+            # stress / (E critical) per triangle, judged at the critical distance
+            strain = equivalent_strain(mesh, element_strain(mesh, prob.u), self.scene.material)
+            radii = self.scene.radius if isinstance(self.scene.radius, dict) else dict.fromkeys(names, self.scene.radius)
+            r_region = np.array([0.0] + [radii.get(n) or 0.0 for n in names])
+            radius = np.zeros(mesh.nv)
+            np.maximum.at(radius, arrays.triangles.ravel(), np.repeat(r_region[arrays.regions], 3))
+            tensors = nonlocal_opening(mesh, strain * inv[arrays.regions][:, None], radius * (scale > 0))
+            if strength is not None:
+                # the vertex's random strength replaces its region's critical strain
+                tensors *= np.where(scale > 0, 1.0 / (strength * np.where(scale > 0, scale, 1.0)), 0.0)[:, None]
         self.timings["strain"] += time.perf_counter() - t0
-        return tensors * scale[:, None]
+        return tensors
 
     def _crack_pass(self, prob, strength=None):
         """One splitting pass; returns (new problem or None, number of split vertices, strength)."""

@@ -1,0 +1,33 @@
+#ifndef NGFRACTURE_NONLOCAL_STRAIN_HPP
+#define NGFRACTURE_NONLOCAL_STRAIN_HPP
+
+// Critical-distance crack measure (docs/criterion.md): for every vertex and every one of
+// ndir directions d, walk straight from the vertex through the triangles to the distance
+// r, and take the smallest opening component n.T.n (n perpendicular to d) of the nodal
+// tensor field T (interpolated linearly) at every edge crossing and at the end point:
+// the whole segment of length r must be overstressed for a crack to run along it. The
+// vertex keeps the largest value over the directions and its opening direction n.
+//
+// Only hot spots are judged: a vertex whose local (nodal) principal value is the largest
+// among the vertices within distance r connected to it (ties: smaller number). The critical
+// distance is measured from the stress concentration, as in the theory of critical
+// distances; the other vertices of its zone get 0 (they are judged once they lead).
+//
+// The walk goes through shared edges only: a ray that meets the boundary (an outer edge,
+// a notch flank, a crack face) before r ends there (a crack along it would run through to
+// that surface), so a vertex never sees the material across a crack; a direction that
+// points out of the body at the vertex does not count. Cost: ndir * (r/h + 1) triangle steps per vertex.
+
+#include <comp.hpp>
+
+namespace ngfracture
+{
+  // tensors: nv x 3 nodal field (xx, yy, xy); radius: nv (<= 0: vertex not evaluated);
+  // result: nv x 3, the rank-one tensor value * n n^T of each vertex (0 if it is no hot spot
+  // or no direction reaches r inside the body).
+  void NonlocalOpening (const ngcomp::MeshAccess & ma, ngbla::FlatMatrix<double> tensors,
+                        ngbla::FlatVector<double> radius, int ndir,
+                        ngbla::FlatMatrix<double> result);
+}
+
+#endif
