@@ -3,11 +3,27 @@
     [ K  C^T ] [du ]   [r]
     [ C  0   ] [lam] = [h]      plus fixed dofs du_c given (single-dof rows).
 
-How it is solved (chosen by measurement, see README): the single-dof rows are
-eliminated exactly, the symmetric positive definite block K_ff is factorised once
-(NGSolve's sparse Cholesky by default), and the general rows go through the Schur
-complement S = C_f K_ff^-1 C_f^T, a small dense matrix.  The factorisation is kept
-and reused by every solve until the tangent changes (modified Newton).
+How it is solved (chosen by measurement, see docs/solvers.md): the single-dof rows are
+eliminated exactly. Without general rows the symmetric positive definite block K_ff is
+factorised (SuperLU up to ``SUPERLU_MAX_DOFS`` dofs, NGSolve's sparse Cholesky above) and
+kept for every solve until the tangent changes (modified Newton). With general rows
+(contact, holds of free modes) on a SuperLU-sized K_ff the augmented matrix
+
+    [ K_ff   C_f^T D ]
+    [ D C_f  0       ]      D: every row scaled to the mean diagonal of K_ff
+
+is LU-factorised once per tangent and row set (SuperLU, symmetric ordering, threshold
+pivoting): one sparse factorisation instead of one triangular solve per row for the
+Schur complement, and no pins, since the rows hold the free rigid modes (measured on the
+disk scene's steps 64 to 68: 118 s against 184 s, the same cracks). The first solve of
+each augmented factorisation must solve its own system (backward error below 1e-6); a
+nearly singular matrix is reported, not solved. Above ``SUPERLU_MAX_DOFS`` SuperLU's
+fill makes the augmented matrix dearer than NGSolve's Cholesky of K_ff plus the Schur
+columns (which contact rounds reuse), so the Schur path below is taken there.
+
+The Schur-complement path below is kept for the contact complementarity problem
+(:meth:`ConstrainedSolver.solve_unilateral`), which needs S = C K^+ C^T itself, and can
+be asked for with ``path="schur"``.
 
 Pieces held only by general rows (a fragment in contact, a free fragment whose
 rigid modes are fixed by multiplier rows) leave K_ff singular.  Their free rigid
@@ -139,10 +155,12 @@ SUPERLU_MAX_DOFS = 5000
 class EliminatedFactor:
     """K^+: the stiffness without fixed dofs and pins, factorised once, for many solves.
 
-    Kept between the constrained solves of one load (contact rounds, modified Newton):
-    building a ConstrainedSolver on it costs only the solves for the Schur complement of
-    the new general rows. It also remembers K^+ c for the rows c of the last Schur
-    complement, so rows kept from one round to the next cost no solve.
+    Kept between the constrained solves of one load (contact rounds, modified Newton).
+    The direct factorisation of K_ff is made at first need (:meth:`factorise`): a solver on
+    the augmented path factorises K with its rows instead (:meth:`augmented`, which keeps
+    the factorisation of the last rows). For the Schur path it remembers K^+ c for the
+    rows c of the last Schur complement, so rows kept from one round to the next cost no
+    solve.
 
     Parameters
     ----------
@@ -502,6 +520,17 @@ class ConstrainedSolver:
     dependent_rows : bool
         Allow linearly dependent general rows; then only :meth:`solve_unilateral` works
         (inequalities that are dependent as vectors are still distinct constraints).
+    path : {"auto", "augmented", "schur"}
+        How the general rows are solved (see the module docstring): "augmented" one LU of
+        the augmented matrix (:meth:`EliminatedFactor.augmented`), "schur" the Schur
+        complement with pins and corrected modes. "auto" (default): "augmented" where K_ff
+        is factorised by SuperLU (up to ``SUPERLU_MAX_DOFS``) with general rows and
+        without ``dependent_rows``, else "schur".
+
+    Attributes
+    ----------
+    path : str
+        The path chosen ("augmented" or "schur").
 
     Raises
     ------
@@ -511,7 +540,8 @@ class ConstrainedSolver:
         <= 1e-12), or a failed factorisation or solve of K_ff (see EliminatedFactor).
     ValueError
         If ``factor`` was made for other fixed dofs or pins, or (without ``factor``) if
-        ``linear_solver`` is unknown.
+        ``linear_solver`` is unknown, or if ``path`` is unknown, or "augmented" without
+        general rows, with ``dependent_rows`` or with "gmres".
     """
 
     def __init__(self, K, fixed_dofs, C, linear_solver="direct", inverse="auto", gmres_tol=1e-12,
@@ -535,7 +565,11 @@ class ConstrainedSolver:
         if path not in ("auto", "augmented", "schur"):
             raise ValueError(f"path must be 'auto', 'augmented' or 'schur', got {path!r}")
         if path == "auto":
-            path = "augmented" if self.m and factor.linear_solver == "direct" and not dependent_rows else "schur"
+            # by measurement: SuperLU's fill of the augmented matrix grows fast with size
+            # (plate at 8210 dofs, 100 rows: 1.9 s against 0.25 s for NGSolve's Cholesky of
+            # K_ff plus 1.8 s for 100 Schur columns, which later rounds reuse)
+            small = factor.inverse == "superlu"
+            path = "augmented" if self.m and factor.linear_solver == "direct" and small and not dependent_rows else "schur"
         if path == "augmented" and (dependent_rows or not self.m or factor.linear_solver != "direct"):
             raise ValueError("the augmented path needs independent general rows and a direct solver")
         self.path = path
@@ -591,8 +625,9 @@ class ConstrainedSolver:
         Raises
         ------
         SingularSystem
-            If made with ``dependent_rows=True`` (no coarse factorisation), or if the
-            factorised stiffness fails (see :meth:`EliminatedFactor.solve`).
+            If made with ``dependent_rows=True`` (no coarse factorisation), if the
+            factorised stiffness fails (see :meth:`EliminatedFactor.solve`), or on the
+            augmented path if the first solve leaves a backward error of 1e-6 or more.
         """
         if self.m and self.path == "schur" and self._coarse is None:
             raise SingularSystem("made with dependent_rows=True: only solve_unilateral is available")
@@ -719,6 +754,11 @@ class ConstrainedSolver:
             The rows that hold with equality, C_i du = h_i: the equalities and the unilateral
             rows that are not released. A closed row may carry no force (lam_i = 0): it
             touches, and still fixes the position of a piece that no force holds.
+
+        Raises
+        ------
+        ValueError
+            If the solver was built on the augmented path (no Schur complement).
         """
         from .qp import convex_qp    # only needed here
 

@@ -69,8 +69,9 @@ def whole_kkt_solution(K, rows, r, du_fixed, h):
     return x[:ndof], x[ndof + nfix:]
 
 
-@pytest.mark.parametrize("path", ["augmented", "schur"])
-def test_constrained_solve_equals_whole_kkt_solve(contact_state, path):
+@pytest.mark.parametrize("path, inverse", [("augmented", "superlu"), ("schur", "superlu"),
+                                           ("schur", "sparsecholesky")])
+def test_constrained_solve_equals_whole_kkt_solve(contact_state, path, inverse):
     prob, rows, support, result = contact_state
     n_contact = len(result.multipliers)
     assert n_contact > 0 and np.any(result.multipliers < 0)     # pieces pressed together
@@ -84,7 +85,8 @@ def test_constrained_solve_equals_whole_kkt_solve(contact_state, path):
     du_fixed = np.zeros(ndof)
     du_fixed[rows.fixed_dofs] = 1e-3 * rng.standard_normal(rows.fixed_dofs.size)
     h = 1e-3 * rng.standard_normal(rows.C.shape[0])
-    kkt = ConstrainedSolver(K, rows.fixed_dofs, rows.C, modes=support.modes, pins=support.pins, path=path)
+    kkt = ConstrainedSolver(K, rows.fixed_dofs, rows.C, inverse=inverse, modes=support.modes, pins=support.pins,
+                            path=path)
     assert kkt.path == path
     du, lam = kkt.solve(r, du_fixed, h)
     du_ref, lam_ref = whole_kkt_solution(Ks, rows, r, du_fixed, h)
@@ -104,10 +106,12 @@ def test_the_configurations_exercise_the_rigid_modes(contact_state):
         assert rows.C.shape[0] > len(contact_state[3].multipliers)
 
 
-def test_default_path_is_augmented_and_the_complementarity_path_is_schur(contact_state):
+def test_default_path_by_size_and_the_complementarity_path_is_schur(contact_state):
     prob, rows, support, _ = contact_state
     K = prob.tangent()
     assert ConstrainedSolver(K, rows.fixed_dofs, rows.C, modes=support.modes, pins=support.pins).path == "augmented"
+    assert ConstrainedSolver(K, rows.fixed_dofs, rows.C, inverse="sparsecholesky", modes=support.modes,
+                             pins=support.pins).path == "schur"
     unilateral = ConstrainedSolver(K, rows.fixed_dofs, rows.C, modes=support.modes, pins=support.pins,
                                    dependent_rows=True)
     assert unilateral.path == "schur"
