@@ -3,11 +3,27 @@
     [ K  C^T ] [du ]   [r]
     [ C  0   ] [lam] = [h]      plus fixed dofs du_c given (single-dof rows).
 
-How it is solved (chosen by measurement, see docs/design.md): the single-dof rows are
-eliminated exactly, the symmetric positive definite block K_ff is factorised once
-(NGSolve's sparse Cholesky by default), and the general rows go through the Schur
-complement S = C_f K_ff^-1 C_f^T, a small dense matrix.  The factorisation is kept
-and reused by every solve until the tangent changes (modified Newton).
+How it is solved (chosen by measurement, see docs/solvers.md): the single-dof rows are
+eliminated exactly. Without general rows the symmetric positive definite block K_ff is
+factorised (SuperLU up to ``SUPERLU_MAX_DOFS`` dofs, NGSolve's sparse Cholesky above) and
+kept for every solve until the tangent changes (modified Newton). With general rows
+(contact, holds of free modes) on a SuperLU-sized K_ff the augmented matrix
+
+    [ K_ff   C_f^T D ]
+    [ D C_f  0       ]      D: every row scaled to the mean diagonal of K_ff
+
+is LU-factorised once per tangent and row set (SuperLU, symmetric ordering, threshold
+pivoting): one sparse factorisation instead of one triangular solve per row for the
+Schur complement, and no pins, since the rows hold the free rigid modes (measured on the
+disk scene's steps 64 to 68: 118 s against 184 s, the same cracks). The first solve of
+each augmented factorisation must solve its own system (backward error below 1e-6); a
+nearly singular matrix is reported, not solved. Above ``SUPERLU_MAX_DOFS`` SuperLU's
+fill makes the augmented matrix dearer than NGSolve's Cholesky of K_ff plus the Schur
+columns (which contact rounds reuse), so the Schur path below is taken there.
+
+The Schur-complement path below is kept for the contact complementarity problem
+(:meth:`ConstrainedSolver.solve_unilateral`), which needs S = C K^+ C^T itself, and can
+be asked for with ``path="schur"``.
 
 Pieces held only by general rows (a fragment in contact, a free fragment whose
 rigid modes are fixed by multiplier rows) leave K_ff singular.  Their free rigid
@@ -139,10 +155,12 @@ SUPERLU_MAX_DOFS = 5000
 class EliminatedFactor:
     """K^+: the stiffness without fixed dofs and pins, factorised once, for many solves.
 
-    Kept between the constrained solves of one load (contact rounds, modified Newton):
-    building a ConstrainedSolver on it costs only the solves for the Schur complement of
-    the new general rows. It also remembers K^+ c for the rows c of the last Schur
-    complement, so rows kept from one round to the next cost no solve.
+    Kept between the constrained solves of one load (contact rounds, modified Newton).
+    The direct factorisation of K_ff is made at first need (:meth:`factorise`): a solver on
+    the augmented path factorises K with its rows instead (:meth:`augmented`, which keeps
+    the factorisation of the last rows). For the Schur path it remembers K^+ c for the
+    rows c of the last Schur complement, so rows kept from one round to the next cost no
+    solve.
 
     Parameters
     ----------
@@ -187,26 +205,14 @@ class EliminatedFactor:
         self._tmp = K.CreateColVector()
         self._columns = {}        # row key -> K^+ row^T, for the rows of the last Schur complement
         self._lu = None
+        self._free_block = None   # K on all free dofs (pins included), scipy CSC, made at first need
         self._checked = False     # direct solvers: the first solve checks its residual
         if inverse == "auto":
             inverse = "superlu" if np.count_nonzero(self.factor_free) <= SUPERLU_MAX_DOFS else "sparsecholesky"
         self.inverse = inverse
-        if linear_solver == "direct" and inverse == "superlu":
-            Kff = self._factorised_block()
-            try:
-                # symmetric ordering, diagonal pivots unless one is 100 times below its column
-                self._lu = spla.splu(Kff, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.01,
-                                     options={"SymmetricMode": True})
-            except RuntimeError as err:
-                raise SingularSystem(f"the sparse LU factorisation failed: {err}") from None
-        elif linear_solver == "direct":
-            factor_dofs = ng.BitArray(self.ndof)
-            factor_dofs.Set()
-            for d in np.flatnonzero(~self.factor_free).tolist():
-                factor_dofs.Clear(d)
-            with reproducible_threads():
-                self._inv = K.Inverse(factor_dofs, inverse=inverse)
-        else:
+        self._inv = None
+        self._augmented = None    # (row key, factorised augmented matrix) of the last rows
+        if linear_solver == "gmres":
             Kff = self._factorised_block()
             self._Kff = Kff
             try:
@@ -216,9 +222,105 @@ class EliminatedFactor:
             self._precond = spla.LinearOperator(Kff.shape, ilu.solve)
         self.seconds = time.perf_counter() - t0
 
+    @property
+    def factorised(self):
+        """True once K_ff is factorised (the direct solvers factorise at first need)."""
+        return self.linear_solver == "gmres" or self._lu is not None or self._inv is not None
+
+    def factorise(self):
+        """Factorise K_ff now, if not yet done (a no-op for "gmres" and when done).
+
+        The direct factorisation is made at first need: a ConstrainedSolver that solves
+        through the augmented matrix (:meth:`augmented`) never needs it. Call this outside
+        an NGSolve TaskManager (the factorisation runs on one thread, see
+        :func:`reproducible_threads`); ConstrainedSolver does so when it builds.
+
+        Raises
+        ------
+        SingularSystem
+            If SuperLU finds K_ff exactly singular.
+        """
+        if self.factorised:
+            return
+        t0 = time.perf_counter()
+        if self.inverse == "superlu":
+            Kff = self._factorised_block()
+            try:
+                # symmetric ordering, diagonal pivots unless one is 100 times below its column
+                self._lu = spla.splu(Kff, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.01,
+                                     options={"SymmetricMode": True})
+            except RuntimeError as err:
+                raise SingularSystem(f"the sparse LU factorisation failed: {err}") from None
+        else:
+            factor_dofs = ng.BitArray(self.ndof)
+            factor_dofs.Set()
+            for d in np.flatnonzero(~self.factor_free).tolist():
+                factor_dofs.Clear(d)
+            with reproducible_threads():
+                self._inv = self.K.Inverse(factor_dofs, inverse=self.inverse)
+        self.seconds += time.perf_counter() - t0
+
     def _factorised_block(self):
         """K on the factorised dofs (without fixed dofs and pins), scipy CSC."""
         return to_scipy(self.K)[self.factor_free][:, self.factor_free].tocsc()
+
+    def augmented(self, C):
+        """The augmented matrix [[K_ff, C_f^T D], [D C_f, 0]] of rows C, LU-factorised.
+
+        K_ff is K on all free dofs (pins included: the rows hold the free modes, so the
+        augmented matrix is regular without pins and corrected modes). D scales every row
+        to the mean diagonal of K_ff, so that the pivots of the multiplier block are of the
+        size of those of K (multiplier = D times the unknown). SuperLU with a symmetric
+        ordering and threshold pivoting: the zero block needs off-diagonal pivots. The
+        factorisation of the last rows is kept (a solver rebuilt for the same rows reuses it).
+
+        Parameters
+        ----------
+        C : scipy.sparse matrix, shape (m, ndof)
+            General rows, m >= 1.
+
+        Returns
+        -------
+        lu : scipy.sparse.linalg.SuperLU
+            Factorisation of the augmented matrix of size n_free + m (free dofs in order,
+            then the rows).
+        row_scale : numpy.ndarray (m,)
+            D.
+
+        Raises
+        ------
+        SingularSystem
+            If the augmented matrix is singular or nearly so (pivot ratio <= 1e-13): rows
+            (nearly) linearly dependent, leaving rigid modes free, or a singular K.
+        """
+        C = sp.csr_matrix(C)
+        key = C.indptr.tobytes() + C.indices.tobytes() + C.data.tobytes()
+        if self._augmented is not None and self._augmented[0] == key:
+            return self._augmented[1]
+        t0 = time.perf_counter()
+        if self._free_block is None:
+            self._free_block = to_scipy(self.K)[self.free][:, self.free].tocsc()
+        Kff = self._free_block
+        Cf = C[:, self.free]
+        size = float(np.abs(Kff.diagonal()).mean())
+        norms = np.sqrt(np.asarray(Cf.multiply(Cf).sum(axis=1)).ravel())
+        row_scale = size / np.where(norms > 0, norms, 1.0)
+        DC = sp.diags(row_scale) @ Cf
+        A = sp.bmat([[Kff, DC.T], [DC, None]], format="csc")
+        m = C.shape[0]
+        message = (f"the {m} general constraint rows are (nearly) linearly dependent or leave rigid "
+                   f"modes free (or the stiffness is singular)")
+        try:
+            lu = spla.splu(A, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.1,
+                           options={"SymmetricMode": True})
+        except RuntimeError as err:
+            raise SingularSystem(f"{message}: {err}") from None
+        pivots = np.abs(lu.U.diagonal())
+        if not np.all(np.isfinite(pivots)) or pivots.min() <= 1e-13 * pivots.max():
+            raise SingularSystem(f"{message}: pivot ratio {pivots.min() / pivots.max():.2e}")
+        self._augmented = (key, (lu, row_scale))
+        self.seconds += time.perf_counter() - t0
+        return lu, row_scale
 
     def matches(self, fixed_dofs, pins):
         """True if this factorisation leaves out exactly these fixed dofs and pins.
@@ -275,6 +377,7 @@ class EliminatedFactor:
                     raise SingularSystem(f"GMRES did not converge (info={info})")
                 X[self.factor_free, j] = x
         else:
+            self.factorise()
             self._direct_solve(B, X)
             if not np.all(np.isfinite(X)):
                 raise SingularSystem("the factorised stiffness produced NaN/inf: singular (a floating body?)")
@@ -417,6 +520,17 @@ class ConstrainedSolver:
     dependent_rows : bool
         Allow linearly dependent general rows; then only :meth:`solve_unilateral` works
         (inequalities that are dependent as vectors are still distinct constraints).
+    path : {"auto", "augmented", "schur"}
+        How the general rows are solved (see the module docstring): "augmented" one LU of
+        the augmented matrix (:meth:`EliminatedFactor.augmented`), "schur" the Schur
+        complement with pins and corrected modes. "auto" (default): "augmented" where K_ff
+        is factorised by SuperLU (up to ``SUPERLU_MAX_DOFS``) with general rows and
+        without ``dependent_rows``, else "schur".
+
+    Attributes
+    ----------
+    path : str
+        The path chosen ("augmented" or "schur").
 
     Raises
     ------
@@ -426,11 +540,12 @@ class ConstrainedSolver:
         <= 1e-12), or a failed factorisation or solve of K_ff (see EliminatedFactor).
     ValueError
         If ``factor`` was made for other fixed dofs or pins, or (without ``factor``) if
-        ``linear_solver`` is unknown.
+        ``linear_solver`` is unknown, or if ``path`` is unknown, or "augmented" without
+        general rows, with ``dependent_rows`` or with "gmres".
     """
 
     def __init__(self, K, fixed_dofs, C, linear_solver="direct", inverse="auto", gmres_tol=1e-12,
-                 modes=None, pins=None, factor=None, dependent_rows=False):
+                 modes=None, pins=None, factor=None, dependent_rows=False, path="auto"):
         if factor is None:
             factor = EliminatedFactor(K, fixed_dofs, pins, linear_solver, inverse, gmres_tol)
         elif not factor.matches(np.asarray(fixed_dofs, dtype=np.int64),
@@ -447,6 +562,22 @@ class ConstrainedSolver:
         self.k = self._R.shape[1]
         if self.k and not self.m:
             raise SingularSystem(f"{self.k} rigid-body mode(s) are held by no constraint (floating body)")
+        if path not in ("auto", "augmented", "schur"):
+            raise ValueError(f"path must be 'auto', 'augmented' or 'schur', got {path!r}")
+        if path == "auto":
+            # by measurement: SuperLU's fill of the augmented matrix grows fast with size
+            # (plate at 8210 dofs, 100 rows: 1.9 s against 0.25 s for NGSolve's Cholesky of
+            # K_ff plus 1.8 s for 100 Schur columns, which later rounds reuse)
+            small = factor.inverse == "superlu"
+            path = "augmented" if self.m and factor.linear_solver == "direct" and small and not dependent_rows else "schur"
+        if path == "augmented" and (dependent_rows or not self.m or factor.linear_solver != "direct"):
+            raise ValueError("the augmented path needs independent general rows and a direct solver")
+        self.path = path
+        self._checked = False     # the augmented path checks the residual of its first solve
+        if path == "augmented":
+            self._augmented = factor.augmented(self.C)
+            return
+        factor.factorise()        # here, outside a TaskManager (see EliminatedFactor.factorise)
         if self.m:
             self._R, A = factor.corrected_modes(self._R)
             self._Z = factor.columns(self.C)
@@ -494,10 +625,11 @@ class ConstrainedSolver:
         Raises
         ------
         SingularSystem
-            If made with ``dependent_rows=True`` (no coarse factorisation), or if the
-            factorised stiffness fails (see :meth:`EliminatedFactor.solve`).
+            If made with ``dependent_rows=True`` (no coarse factorisation), if the
+            factorised stiffness fails (see :meth:`EliminatedFactor.solve`), or on the
+            augmented path if the first solve leaves a backward error of 1e-6 or more.
         """
-        if self.m and self._coarse is None:
+        if self.m and self.path == "schur" and self._coarse is None:
             raise SingularSystem("made with dependent_rows=True: only solve_unilateral is available")
         du, lam, q = self._solve_once(r, du_fixed, h)
         self.last_load_norm = float(np.linalg.norm(q[self.free]))
@@ -508,12 +640,28 @@ class ConstrainedSolver:
             # Newton's residual stalled at 1.5e-6 with increments of 1e-7 to 1e-6 in 60
             # iterations, full Newton and 32 substeps alike; with one refinement step it
             # converges in a few iterations. A K product per solve decides whether it is needed.
-            for _ in range(self.REFINEMENTS):
+            for refinement in range(self.REFINEMENTS + 1):
                 res, res_rows, force_scale, row_scale = self._residual(r, h, du, lam)
-                if np.linalg.norm(res) <= 1e-11 * force_scale and np.linalg.norm(res_rows) <= 1e-11 * row_scale:
+                error = max(np.linalg.norm(res) / force_scale, np.linalg.norm(res_rows) / row_scale)
+                if error <= 1e-11 or refinement == self.REFINEMENTS:
                     break
                 ddu, dlam, _ = self._solve_once(res, np.zeros_like(du), res_rows)
                 du, lam = du + ddu, lam + dlam
+            if self.path == "augmented" and not self._checked:
+                # a nearly singular augmented matrix can pass the pivot test and return
+                # finite garbage: its first solve must solve its own system, up to a
+                # backward error (residuals against |K| |du|, |C^T| |lam|, |C| |du|: the
+                # rounding of the products; measured 2e-5 of |K du| late in Newton)
+                free = self.free
+                Kabs = abs(self.factor._free_block) @ np.abs(du[free])
+                force_size = (np.linalg.norm(Kabs) + np.linalg.norm((abs(self.C.T) @ np.abs(lam))[free])
+                              + np.linalg.norm(r[free]) + np.linalg.norm(q[free]))
+                rows_size = np.linalg.norm(h) + np.linalg.norm(abs(self.C) @ np.abs(du))
+                error = max(np.linalg.norm(res) / max(force_size, 1e-300), np.linalg.norm(res_rows) / max(rows_size, 1e-300))
+                if not error < 1e-6:
+                    raise SingularSystem(f"the constrained system is singular or too badly conditioned "
+                                         f"(relative residual {error:.1e})")
+                self._checked = True
         return du, lam
 
     #: refinement steps at most per solve (each: one K product and one solve with K^+)
@@ -521,6 +669,8 @@ class ConstrainedSolver:
 
     def _solve_once(self, r, du_fixed, h):
         """One pass of the eliminated solve: (du, lam, the load q of :meth:`_unconstrained`)."""
+        if self.path == "augmented":
+            return self._solve_augmented(r, du_fixed, h)
         q, du = self._unconstrained(r, du_fixed)
         lam = np.zeros(self.m)
         if self.m:
@@ -530,6 +680,24 @@ class ConstrainedSolver:
             du -= self._Z @ lam
             du += self._R @ alpha
         return du, lam, q
+
+    def _solve_augmented(self, r, du_fixed, h):
+        """One solve with the factorised augmented matrix (see EliminatedFactor.augmented)."""
+        t0 = time.perf_counter()
+        q = r
+        if np.any(du_fixed):
+            self._tmp.FV().NumPy()[:] = du_fixed
+            q = r - (self.K * self._tmp).Evaluate().FV().NumPy()
+        lu, row_scale = self._augmented
+        rhs = np.concatenate([q[self.free], row_scale * (h - self.C @ du_fixed)])
+        x = lu.solve(rhs)
+        if not np.all(np.isfinite(x)):
+            raise SingularSystem("the factorised augmented matrix produced NaN/inf")
+        du = du_fixed.copy()
+        nfree = rhs.size - self.m
+        du[self.free] = x[:nfree]
+        self.factor.seconds += time.perf_counter() - t0
+        return du, row_scale * x[nfree:], q
 
     def _residual(self, r, h, du, lam):
         """Residuals of the free rows and of the general rows, each with its size scale."""
@@ -586,8 +754,16 @@ class ConstrainedSolver:
             The rows that hold with equality, C_i du = h_i: the equalities and the unilateral
             rows that are not released. A closed row may carry no force (lam_i = 0): it
             touches, and still fixes the position of a piece that no force holds.
+
+        Raises
+        ------
+        ValueError
+            If the solver was built on the augmented path (no Schur complement).
         """
         from .qp import convex_qp    # only needed here
+
+        if self.path != "schur":
+            raise ValueError("solve_unilateral needs the Schur complement: build with path='schur' or dependent_rows=True")
 
         q, du = self._unconstrained(r, du_fixed)
         if not self.m:

@@ -170,10 +170,16 @@ def analyse_support(x, elements, n, ndof, fixed_dofs):
         # pin the dofs that best resolve these modes (column-pivoted QR)
         _, _, piv = sla.qr(N.T, pivoting=True, mode="economic")
         pins.extend(dofs[piv[:N.shape[1]]].tolist())
+        # one triplet block per mode: a sparse matrix per column cost 50 ms per call
+        # with 20 pieces (scipy's construction overhead)
         for j in range(N.shape[1]):
-            cols.append(sp.csc_matrix((N[:, j], (dofs, np.zeros(dofs.size, dtype=int))), shape=(ndof, 1)))
+            cols.append((dofs, np.full(dofs.size, len(cols), dtype=np.int64), N[:, j]))
         unheld.append((p, N.shape[1]))
-    modes = sp.hstack(cols).tocsc() if cols else sp.csc_matrix((ndof, 0))
+    if cols:
+        row, col, data = (np.concatenate(part) for part in zip(*cols))
+        modes = sp.csc_matrix((data, (row, col)), shape=(ndof, len(cols)))
+    else:
+        modes = sp.csc_matrix((ndof, 0))
     return Support(modes, np.array(pins, dtype=np.int64), unheld)
 
 
@@ -199,17 +205,19 @@ def unheld_mode_rows(C, modes, rtol=RANK_RTOL):
     ndof = modes.shape[0]
     if k == 0:
         return sp.csr_matrix((0, ndof))
-    G = (sp.csr_matrix(C) @ modes).tocsc() if C.shape[0] else sp.csc_matrix((0, k))
+    # dense: m x k is small (rows times three modes per free piece), and slicing it per
+    # group is much cheaper than slicing a sparse matrix
+    G = (sp.csr_matrix(C) @ modes).toarray() if C.shape[0] else np.zeros((0, k))
     # modes coupled through rows form groups; each group is a small dense problem
-    link = (abs(G).T @ abs(G)) if G.shape[0] else sp.csr_matrix((k, k))
+    link = sp.csr_matrix(np.abs(G).T @ np.abs(G))
     ngroups, group = connected_components(link + sp.identity(k), directed=False)
     rows = []
     for gidx in range(ngroups):
         cols = np.flatnonzero(group == gidx)
         sub = G[:, cols]
-        touched = np.flatnonzero(np.diff(sub.tocsr().indptr))
+        touched = np.flatnonzero(np.any(sub != 0.0, axis=1))
         if touched.size:
-            dense = sub.tocsr()[touched].toarray()
+            dense = sub[touched]
             _, s, vt = np.linalg.svd(np.linalg.qr(dense, mode="r") if dense.shape[0] > cols.size else dense,
                                      full_matrices=True)
             rank = numerical_rank(s, rtol)

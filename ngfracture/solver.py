@@ -416,9 +416,13 @@ class NewtonSolver:
                         with _Timer(timings, "factorize"):
                             factor = EliminatedFactor(K, rows.fixed_dofs, support.pins, self.linear_solver,
                                                       self.inverse)
+                    # a tangent factorised for one solve (full Newton) takes its rows into one
+                    # factorisation of the augmented matrix; one kept over iterations and
+                    # contact rounds builds Schur columns once and reuses them (docs/solvers.md)
+                    path = "auto" if self.method == "full" and given is None else "schur"
                     with _Timer(timings, "factorize"):
                         kkt = ConstrainedSolver(None, rows.fixed_dofs, rows.C, modes=support.modes,
-                                                pins=support.pins, factor=factor)
+                                                pins=support.pins, factor=factor, path=path)
                 except SingularSystem as err:
                     status.fail("singular", str(err))
                     return None

@@ -1,0 +1,119 @@
+"""The constrained solve (kkt.ConstrainedSolver) against a direct solve of the whole KKT system.
+
+The solver eliminates the fixed dofs and solves the general rows either through the
+factorised augmented matrix (the default for the direct solvers) or through the Schur
+complement with pins and corrected rigid modes (kept for the contact complementarity
+problem). Both must give the solution of
+
+    [ K  B^T ] [du ]   [r]
+    [ B  0   ] [lam] = [b]      B = [unit rows of the fixed dofs; C],
+
+assembled whole and handed to a sparse LU, to 1e-10 relative, on cracked plates in
+contact: four fragments pressed against each other across the seams, and the small
+fragments at the crack junction held by contact alone (free rigid modes: pins, and a
+tangent that does not vanish on their rotation under finite strain), or by contact and
+rows holding their modes.
+"""
+import numpy as np
+import pytest
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+import ngfracture as nf
+from ngfracture.contact_solver import ContactSolver
+from ngfracture.kkt import ConstrainedSolver, to_scipy
+from ngfracture.solver import NewtonSolver
+
+from test_contact_fractured import crack_bands, plate_mesh
+
+H = 0.1
+
+
+def cross_cracked_pressed():
+    """Two crossing cracks, four fragments pressed together from all sides (finite strain)."""
+    res = crack_bands(plate_mesh(H), [(0, 1.0), (1, 0.5)], 0.6 * H)
+    prob = nf.ElasticProblem(res.mesh, nf.StVenantKirchhoff(1.0, 0.3, plane="stress"))
+    prob.add_dirichlet("left", 0.0, component="x")
+    prob.add_dirichlet("right", -1e-3, component="x")
+    prob.add_dirichlet("bottom", 0.0, component="y")
+    prob.add_dirichlet("top", -1e-3, component="y")
+    return prob, dict(fix_free_modes=False)
+
+
+def cross_cracked_held():
+    """The same, with every free rigid mode of the small fragments at the junction held by a row."""
+    prob, _ = cross_cracked_pressed()
+    return prob, dict(fix_free_modes="all")
+
+
+@pytest.fixture(scope="module", params=[cross_cracked_pressed, cross_cracked_held], ids=["cross", "cross_held"])
+def contact_state(request):
+    """A converged contact solve: the problem, its assembled rows (holds included) and support."""
+    prob, options = request.param()
+    result = ContactSolver(prob, tol=0.1 * H, **options).solve()
+    assert result.converged, result.reason
+    rows = prob.assemble_constraints()
+    support = prob.support(rows)
+    if options["fix_free_modes"]:
+        rows = NewtonSolver(prob, fix_free_modes=options["fix_free_modes"])._hold_free_modes(rows, support)
+    return prob, rows, support, result
+
+
+def whole_kkt_solution(K, rows, r, du_fixed, h):
+    """du and the multipliers of the general rows from one sparse LU of the whole system."""
+    ndof, nfix = K.shape[0], rows.fixed_dofs.size
+    E = sp.csr_matrix((np.ones(nfix), (np.arange(nfix), rows.fixed_dofs)), shape=(nfix, ndof))
+    B = sp.vstack([E, rows.C])
+    kkt = sp.bmat([[K, B.T], [B, None]]).tocsc()
+    x = spla.spsolve(kkt, np.concatenate([r, du_fixed[rows.fixed_dofs], h]))
+    return x[:ndof], x[ndof + nfix:]
+
+
+@pytest.mark.parametrize("path, inverse", [("augmented", "superlu"), ("schur", "superlu"),
+                                           ("schur", "sparsecholesky")])
+def test_constrained_solve_equals_whole_kkt_solve(contact_state, path, inverse):
+    prob, rows, support, result = contact_state
+    n_contact = len(result.multipliers)
+    assert n_contact > 0 and np.any(result.multipliers < 0)     # pieces pressed together
+    K = prob.tangent()
+    Ks = to_scipy(K)
+    ndof = prob.fes.ndof
+    free = np.ones(ndof, dtype=bool)
+    free[rows.fixed_dofs] = False
+    rng = np.random.default_rng(11)
+    r = np.where(free, rng.standard_normal(ndof), 0.0)
+    du_fixed = np.zeros(ndof)
+    du_fixed[rows.fixed_dofs] = 1e-3 * rng.standard_normal(rows.fixed_dofs.size)
+    h = 1e-3 * rng.standard_normal(rows.C.shape[0])
+    kkt = ConstrainedSolver(K, rows.fixed_dofs, rows.C, inverse=inverse, modes=support.modes, pins=support.pins,
+                            path=path)
+    assert kkt.path == path
+    du, lam = kkt.solve(r, du_fixed, h)
+    du_ref, lam_ref = whole_kkt_solution(Ks, rows, r, du_fixed, h)
+    assert np.linalg.norm(du - du_ref) <= 1e-10 * np.linalg.norm(du_ref)
+    assert np.linalg.norm(lam - lam_ref) <= 1e-10 * np.linalg.norm(lam_ref)
+
+
+def test_the_configurations_exercise_the_rigid_modes(contact_state):
+    """Free modes held through general rows, with K R != 0 (not a vacuous case)."""
+    prob, rows, support, _ = contact_state
+    assert support.pins.size > 0 and support.modes.shape[1] == support.pins.size
+    free = np.ones(prob.fes.ndof, dtype=bool)
+    free[rows.fixed_dofs] = False
+    KR = to_scipy(prob.tangent()) @ support.modes
+    assert np.abs(KR[free]).max() > 1e-6 * np.abs(to_scipy(prob.tangent()).diagonal()).max()
+    if rows.labels[-1] == "free modes":
+        assert rows.C.shape[0] > len(contact_state[3].multipliers)
+
+
+def test_default_path_by_size_and_the_complementarity_path_is_schur(contact_state):
+    prob, rows, support, _ = contact_state
+    K = prob.tangent()
+    assert ConstrainedSolver(K, rows.fixed_dofs, rows.C, modes=support.modes, pins=support.pins).path == "augmented"
+    assert ConstrainedSolver(K, rows.fixed_dofs, rows.C, inverse="sparsecholesky", modes=support.modes,
+                             pins=support.pins).path == "schur"
+    unilateral = ConstrainedSolver(K, rows.fixed_dofs, rows.C, modes=support.modes, pins=support.pins,
+                                   dependent_rows=True)
+    assert unilateral.path == "schur"
+    with pytest.raises(ValueError, match="path"):
+        ConstrainedSolver(K, rows.fixed_dofs, rows.C, modes=support.modes, pins=support.pins, path="qr")
