@@ -157,7 +157,8 @@ class SavedTangent:
     empty SavedTangent leaves its last factorisation here (modified Newton, or any method
     on a linear model, whose tangent is constant); a solve given a filled one for the same
     fixed dofs uses it instead of assembling and factorising, and rebuilds only the Schur
-    complement of its general rows. Its rigid modes and pins stay those of the
+    complement of its general rows (the augmented factorisation of kkt.py is for fresh
+    tangents, which are solved once). Its rigid modes and pins stay those of the
     configuration the tangent was assembled at (kkt.py corrects them for K R != 0).
 
     Attributes
