@@ -29,6 +29,7 @@
 import functools
 import json
 import math
+import shutil
 from pathlib import Path
 
 import matplotlib.pyplot as plt  # inline in Jupyter; Agg (no window) in a headless script
@@ -95,6 +96,7 @@ for k in (1, 4, 16):
 
 # %%
 out = Path("out") / "plate_ensemble"
+shutil.rmtree(out, ignore_errors=True)   # a fresh ensemble each time the notebook runs
 factory = functools.partial(scenes.plate, maxh=0.15, weibull_m=8)
 report = Ensemble(factory, seeds=range(6), out=out, workers=2, contact="never", progress=False).run()
 print(f"{report['finished']} of {len(report['samples'])} samples finished")
