@@ -1,4 +1,6 @@
-"""Shared fixtures: small meshes that build in milliseconds."""
+"""Shared fixtures: small meshes that build in milliseconds; the environment of child processes."""
+import os
+
 import ngsolve as ng
 import numpy as np
 import pytest
@@ -55,3 +57,18 @@ def two_region_bar_mesh(maxh=0.25):
     geo.SetMaterial(1, "soft")
     geo.SetMaterial(2, "stiff")
     return ng.Mesh(geo.GenerateMesh(maxh=maxh))
+
+
+def child_env(**extra):
+    """The environment for a child Python process: this one's, with a relative PYTHONPATH
+    made absolute (the child may run in another folder), plus ``extra``.
+
+    Nothing is added to the path: an installed ngfracture must be found as installed (the
+    repository root on the path would import the uncompiled source tree instead), and an
+    in-place build is found through the caller's own PYTHONPATH.
+    """
+    env = dict(os.environ, **extra)
+    paths = [os.path.abspath(p) for p in env.get("PYTHONPATH", "").split(os.pathsep) if p]
+    if paths:
+        env["PYTHONPATH"] = os.pathsep.join(paths)
+    return env

@@ -1,20 +1,19 @@
 """Every benchmark takes ``--json FILE``, refuses an existing FILE before any work, and writes JSON."""
 import json
-import os
 import subprocess
 import sys
 from pathlib import Path
 
 import pytest
+from conftest import child_env
 
 ROOT = Path(__file__).resolve().parent.parent
 BENCHMARKS = ["contact", "crack", "ensemble", "lshape", "meshcheck", "scenes"]
 
 
 def run_benchmark(name, *args):
-    env = {**os.environ, "PYTHONPATH": str(ROOT), "OMP_NUM_THREADS": "1"}
     return subprocess.run([sys.executable, str(ROOT / "benchmarks" / f"{name}.py"), *args],
-                          capture_output=True, text=True, env=env, timeout=600)
+                          capture_output=True, text=True, env=child_env(OMP_NUM_THREADS="1"), timeout=600)
 
 
 @pytest.mark.parametrize("name", BENCHMARKS)

@@ -6,11 +6,11 @@ through ``main`` (a traceback would be an exception other than SystemExit); one 
 real process as well.
 """
 import json
-import os
 import subprocess
 import sys
 
 import pytest
+from conftest import child_env
 
 from ngfracture import cli, scenes
 from ngfracture.cli import main
@@ -26,19 +26,6 @@ SUMMARY_KEYS = ["scene", "parameters", "n_steps", "n_split_vertices", "crack_len
                 "fragment_areas", "area_initial", "area_final", "max_overlap_area", "energy",
                 "newton_iterations", "timings"]
 PHASES = ["solve", "strain", "split", "rebuild", "collision", "contact", "output"]
-
-
-def _env():
-    """The environment with a relative PYTHONPATH made absolute (the child runs elsewhere).
-
-    Nothing is added: an installed ngfracture must be found as installed; the repository
-    root on the path would import the uncompiled source tree instead.
-    """
-    env = dict(os.environ)
-    paths = [os.path.abspath(p) for p in env.get("PYTHONPATH", "").split(os.pathsep) if p]
-    if paths:
-        env["PYTHONPATH"] = os.pathsep.join(paths)
-    return env
 
 
 def snapshot(root):
@@ -94,7 +81,7 @@ def test_bad_option_is_refused_before_any_file(args, message, tmp_path, capsys, 
 
 def test_unknown_scene_in_a_real_process(tmp_path):
     proc = subprocess.run([sys.executable, "-m", "ngfracture", "run", "plat", "--out", "o"],
-                          capture_output=True, text=True, cwd=tmp_path, env=_env())
+                          capture_output=True, text=True, cwd=tmp_path, env=child_env())
     assert proc.returncode == 2
     assert "unknown scene 'plat'" in proc.stderr and "Traceback" not in proc.stderr
     assert list(tmp_path.iterdir()) == []
@@ -166,7 +153,7 @@ def test_success_writes_results_and_summary(tmp_path):
     # the command of the README with --steps 12 (the full run, 49 steps, takes 19 s here)
     proc = subprocess.run([sys.executable, "-m", "ngfracture", "run", "plate", "--maxh", "0.1", "--out", "res",
                            "--quiet", "--pictures", "none", "--steps", "12"],
-                          capture_output=True, text=True, cwd=tmp_path, env=_env())
+                          capture_output=True, text=True, cwd=tmp_path, env=child_env())
     assert proc.returncode == 0, proc.stderr
     out = tmp_path / "res"
     for name in ("results.pvd", "cracks.pvd", "summary.json"):

@@ -10,6 +10,7 @@ from pathlib import Path
 
 import ngsolve as ng
 import pytest
+from conftest import child_env
 
 import ngfracture
 from ngfracture import output, scenes, simulation
@@ -32,17 +33,10 @@ def beam_run(tmp_path_factory):
     proc = subprocess.run([sys.executable, "-m", "ngfracture", "run", BEAM, "--set", "maxh=0.1",
                            "--set", "E_glass=6e10", "--steps", "6", "--progress", "json", "--pictures", "none",
                            "--max-new-cracks", "4", "--out", str(out)],
-                          capture_output=True, text=True, cwd=out.parent, env=_env())
+                          capture_output=True, text=True, cwd=out.parent, env=child_env())
     assert proc.returncode == 0, proc.stderr
     assert "Traceback" not in proc.stderr
     return out, proc.stdout.splitlines(), proc.stderr
-
-
-def _env():
-    env = dict(os.environ)
-    paths = [os.path.abspath(p) for p in env.get("PYTHONPATH", "").split(os.pathsep) if p]
-    env["PYTHONPATH"] = os.pathsep.join(paths or [str(ROOT)])
-    return env
 
 
 def test_scene_file_runs_with_its_parameters(beam_run):

@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import child_env
 
 from ngfracture import scenes
 from ngfracture.ensemble import KILL_HOOK, Ensemble
@@ -85,8 +86,9 @@ def test_a_killed_command_reruns_without_rerunning_finished_samples(reference, t
     resumes or runs the others, and gives the reference ensemble."""
     from ngfracture.cli import main
     out = tmp_path / "ens"
+    # in tmp_path: "python -c" puts its working folder first on the path
     child = subprocess.Popen([sys.executable, "-c", CHILD, *CLI_ARGS, "--out", str(out)], start_new_session=True,
-                             env={**os.environ, "OMP_NUM_THREADS": "1"})
+                             cwd=tmp_path, env=child_env(OMP_NUM_THREADS="1"))
     first = out / "sample_0000" / "summary.json"
     deadline = time.monotonic() + 240
     while not first.exists() and child.poll() is None and time.monotonic() < deadline:
