@@ -320,7 +320,7 @@ def _add_render(subparsers):
 
 def _run_render(args):
     from . import checkpoint
-    from .output import RenderError, plot_fragment_sizes, render_png
+    from .output import RenderError, picture_scale, plot_fragment_sizes, render_png
     from .fragments import FragmentStatistics
     from .meshio import MeshArrays, mesh_from_arrays
 
@@ -333,10 +333,7 @@ def _run_render(args):
     # the checkpoint's vector is in VectorH1 layout: components blocked, vertex dofs first
     u = np.asarray(arrays["u"]).reshape(2, -1)[:, :mesh.nv].T
     stats = FragmentStatistics(mesh)
-    points = np.asarray(MeshArrays.from_dict(arrays).points)
-    size = float(np.ptp(points, axis=0).max())
-    umax = float(np.abs(u).max(initial=0.0))
-    scale = 0.02 * size / umax if umax > 0 else 1.0      # as the run draws it (Simulation)
+    scale = picture_scale(MeshArrays.from_dict(arrays).points, u)      # as the run draws it
     plot_fragment_sizes(stats.areas, os.path.join(folder, "fragment_sizes.png"), force=True)
     try:
         render_png(mesh, u, stats.fragment, os.path.join(folder, "final.png"), scale=scale, force=True)

@@ -524,6 +524,26 @@ _FRAGMENT_COLOURS = ["#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c
                      "#c5b0d5", "#c49c94", "#f7b6d2", "#c7c7c7", "#dbdb8d", "#9edae5"]
 
 
+def picture_scale(points, u):
+    """Magnification that shows the largest displacement as 2% of the body's size.
+
+    Parameters
+    ----------
+    points : numpy.ndarray, shape (nv, 2)
+        Reference coordinates.
+    u : numpy.ndarray
+        Displacement values (any shape).
+
+    Returns
+    -------
+    float
+        1 when nothing moves.
+    """
+    size = float(np.ptp(np.asarray(points), axis=0).max())
+    umax = float(np.abs(u).max(initial=0.0))
+    return 0.02 * size / umax if umax > 0 else 1.0
+
+
 def render_png(mesh, u, fragment, path, window_size=(1200, 900), scale=1.0, crack_boundary="crack",
                line_width=2.0, force=False):
     """A PNG of the deformed configuration coloured by fragment, crack faces drawn in black.

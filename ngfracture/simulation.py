@@ -906,9 +906,9 @@ class Simulation:
         t0 = time.perf_counter()
         self.writer.write(state.step, state.x, prob.mesh, prob.u, stats.fragment)
         if self.pictures == "every":
-            from .output import render_png
+            from .output import picture_scale, render_png
             render_png(prob.mesh, prob.u, stats.fragment, self.out / f"step_{state.step:06d}.png",
-                       scale=self._picture_scale(state))
+                       scale=picture_scale(state.arrays.points, state.u))
         self.timings["output"] += time.perf_counter() - t0
 
     def _checkpoint(self, state, wall):
@@ -955,19 +955,13 @@ class Simulation:
         """
         return {**{k: v for k, v in asdict(self.control).items() if k != "max_steps"}, "contact": self.contact}
 
-    def _picture_scale(self, state):
-        """Magnification that shows the largest displacement as 2% of the body's size."""
-        size = float(np.ptp(state.arrays.points, axis=0).max())
-        umax = float(np.abs(state.u).max(initial=0.0))
-        return 0.02 * size / umax if umax > 0 else 1.0
-
     def _final_outputs(self, state, prob, stats, summary):
-        from .output import RenderError, plot_fragment_sizes, render_png, write_summary
+        from .output import RenderError, picture_scale, plot_fragment_sizes, render_png, write_summary
         t0 = time.perf_counter()
         pictures = {}
         if self.pictures != "none":
             try:
-                scale = self._picture_scale(state)
+                scale = picture_scale(state.arrays.points, state.u)
                 render_png(prob.mesh, prob.u, stats.fragment, self.out / "final.png", scale=scale,
                            force=True)   # ours: a resumed run redraws it
                 pictures["final"] = "final.png"
