@@ -155,6 +155,17 @@ def vertex_displacement(u):
     return a
 
 
+def _vertex_values(mesh, u):
+    """The displacement's vertex values (nv, 2), checked to fit the mesh and to be finite."""
+    U = vertex_displacement(u)
+    if U.shape[0] != mesh.nv:
+        raise ValueError(f"ngfracture.crack: displacement has {U.shape[0]} vertex values, "
+                         f"the mesh has {mesh.nv} vertices")
+    if not np.all(np.isfinite(U)):
+        raise ValueError("ngfracture.crack: displacement has NaN or inf values")
+    return U
+
+
 def element_strain(mesh, u, measure="green"):
     """Strain of every triangle (the P1 gradient, or the element mean for order >= 2).
 
@@ -193,13 +204,7 @@ def element_strain(mesh, u, measure="green"):
         comps = [E[0, 0], E[1, 1], E[0, 1]]
         return np.column_stack([ngsolve.Integrate(c, mesh, element_wise=True).NumPy() / area
                                 for c in comps])
-    U = vertex_displacement(u)
-    if U.shape[0] != mesh.nv:
-        raise ValueError(f"ngfracture.crack: displacement has {U.shape[0]} vertex values, "
-                         f"the mesh has {mesh.nv} vertices")
-    if not np.all(np.isfinite(U)):
-        raise ValueError("ngfracture.crack: displacement has NaN or inf values")
-    return _C.CrackElementStrain(mesh, U, measure)
+    return _C.CrackElementStrain(mesh, _vertex_values(mesh, u), measure)
 
 
 def vertex_strain(mesh, u, measure="green"):
@@ -229,13 +234,7 @@ def vertex_strain(mesh, u, measure="green"):
         return _C.VertexAverage(mesh, element_strain(mesh, u, measure))
     if measure not in ("green", "linear"):
         raise ValueError(f"ngfracture.crack: measure must be 'green' or 'linear', got {measure!r}")
-    U = vertex_displacement(u)
-    if U.shape[0] != mesh.nv:
-        raise ValueError(f"ngfracture.crack: displacement has {U.shape[0]} vertex values, "
-                         f"the mesh has {mesh.nv} vertices")
-    if not np.all(np.isfinite(U)):
-        raise ValueError("ngfracture.crack: displacement has NaN or inf values")
-    return _C.CrackVertexStrain(mesh, U, measure)
+    return _C.CrackVertexStrain(mesh, _vertex_values(mesh, u), measure)
 
 
 def equivalent_strain(mesh, strain, material):
