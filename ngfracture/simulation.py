@@ -302,13 +302,15 @@ class StepControl:
             Naming the first field out of range.
         """
         settings = asdict(self)
-        if settings["dx_min"] is None:
-            settings["dx_min"] = dx / 64
-        if settings["dx_max"] is None:
-            settings["dx_max"] = 8 * dx
+        settings["dx_min"], settings["dx_max"] = self._dx_bounds(dx)
         control = StepControl(**settings)
         control.validate(dx)
         return control
+
+    def _dx_bounds(self, dx):
+        """(dx_min, dx_max): the set bounds, or the defaults dx / 64 and 8 dx."""
+        return (self.dx_min if self.dx_min is not None else dx / 64,
+                self.dx_max if self.dx_max is not None else 8 * dx)
 
     def validate(self, dx):
         """Check every field (the bounds of dx, if None, as :meth:`resolved` fills them in).
@@ -323,8 +325,7 @@ class StepControl:
         ValueError
             Naming the first field out of range.
         """
-        dx_min = self.dx_min if self.dx_min is not None else dx / 64
-        dx_max = self.dx_max if self.dx_max is not None else 8 * dx
+        dx_min, dx_max = self._dx_bounds(dx)
 
         def number(v):
             return not isinstance(v, bool) and isinstance(v, numbers.Real) and math.isfinite(v)
