@@ -4,33 +4,49 @@ A primal-dual active set around the Newton solver, in the paper's predict-and-co
 manner:
 
     1. solve without contact rows (free pieces held on their rigid modes): the prediction;
-    2. candidate rows, linearised where they are first found (eq. 13, 14) and then frozen:
+       a solve given the active rows of the solve before (``warm``: the previous crack pass
+       or load step) imposes those instead and skips the prediction;
+    2. candidate rows (eq. 13, 14), each identified by a key (its nodes and facet):
        - across seams, where two lips coincide in the reference configuration (crack
          faces from node splitting, interfaces from ``meshio.separate_region``),
-         node-to-node rows between twins, built once at the prediction
+         node-to-node rows between twins, chosen once at the prediction
          (:mod:`ngfracture.seams`: one row per straight node, one per facet at a kink);
        - elsewhere, node-to-segment rows of the paper's rules 1-4 (:mod:`ngfracture.contact`)
-         at the current configuration; a row keeps its first linearisation while it is
-         active or found again, rows of a twin against its own seam are left out;
+         found at the current configuration; a row stays a candidate while it is active
+         or found again, rows of a twin against its own seam are left out;
+       every candidate is re-linearised at the configuration of the last solve, so the
+       set update judges the gaps of that configuration;
     3. active set update, for every candidate row (semismooth Newton for the
        complementarity function min(-lambda, g) of eq. 8, Hintermueller-Ito-Kunisch):
        an active row stays while its multiplier compresses (lambda <= 0 up to rounding,
        compression is lambda <= 0 as the paper's p_N <= 0); an inactive row enters when
        its linearised gap is below -``penetration_tol``. Rows that depend on others are
        dropped by the pivoted QR (``contact.independent_rows``);
-    4. if the set equals the one of the last solve, stop; if the update of 3 revisits a
-       set imposed before, or has not settled after ``pdas_rounds`` rounds, replace it by
-       the exact solution of the linear complementarity problem of the linearisation
-       (:meth:`ContactSolver._complementarity`); impose the set as equalities
-       C u + g = 0 (eq. 12), solve, and go to 2.
+    4. if the set equals the one of the last solve and no row penetrates by more than
+       ``penetration_tol``, stop; a settled set that still penetrates is solved again with
+       its rows linearised here (an update; at most ``max_updates``); if the update of 3
+       revisits a set imposed before, or has not settled after ``pdas_rounds`` rounds,
+       replace it by the exact solution of the linear complementarity problem of the
+       linearisation (:meth:`ContactSolver._complementarity`); impose the set as
+       equalities C u + g = 0 (eq. 12), solve, and go to 2.
 
-Why: the active set used to be re-selected from scratch at every linearisation. On coincident
-lips every node is at once a slave of the other lip and an end of its master segments, both
-lips offer masters with different normals, and rounding decides; the choice flipped between
-rounds and the set cycled (measured: 20 rounds, 27 to 31 rows in a cycle of 4, on a plate
-cracked across). With rows identified by their nodes (and facet) and frozen linearisations
-the candidate set is fixed for a seam, and the primal-dual update settles in a few rounds
-(measured: 2 to 7).
+Why keys: the active set used to be re-selected from scratch at every linearisation. On
+coincident lips every node is at once a slave of the other lip and an end of its master
+segments, both lips offer masters with different normals, and rounding decides; the choice
+flipped between rounds and the set cycled (measured: 20 rounds, 27 to 31 rows in a cycle of
+4, on a plate cracked across). With rows identified by their nodes (and facet) the candidate
+set is fixed for a seam, and the primal-dual update settles in a few rounds (measured: 2 to 7).
+
+Why re-linearise every round: with each row frozen where it was found until the set settled,
+a settled set was only the start of a fixed point of updates (re-linearise, solve, look
+again), each of which could change the set again; on pieces that move by a good part of the
+detection threshold in a step this took 12 to 14 solves per contact solve (the
+disintegrating disk) and gave up on a pinwheel of four quarters sliding by a tenth of the
+mesh size. Re-linearised every round, set and geometry settle together: 5 to 7 solves on the
+disk, and the pinwheel converges up to a third of the mesh size (tests/test_contact_fractured.py).
+Where re-linearising stops reducing the penetration at a settled set (rows sliding over a
+kink), the rows are frozen from then on and the plain fixed point of updates decides, and
+fails with reason "penetration" when it does not contract.
 
 Why the complementarity problem: the primal-dual update converges when the response of
 the gaps to the contact forces, S = C K^-1 C^T, is an M-matrix; nearly parallel rows at a
@@ -40,12 +56,10 @@ rows of one node pair). The complementarity problem with S positive definite has
 solution, found in finitely many steps (:mod:`ngfracture.qp`); it costs a dense QP on the
 candidate rows, so it is used only where the cheap update fails.
 
-At the end the Kuhn-Tucker conditions of eq. 8 hold for the linearised gaps to the solver
-tolerance: g_N >= -``penetration_tol``, lambda <= 0, lambda g_N = 0 (active rows have
-g_N = 0, inactive ones carry no force). The true overlap of the solved configuration is
-second order in the displacement (the normals are frozen at the prediction): measured on a
-plate with a zigzag crack, overlap area 8.6e-9, 8.5e-11, 8.5e-13 for boundary displacements
-1e-3, 1e-4, 1e-5.
+At the end the Kuhn-Tucker conditions of eq. 8 hold to the solver tolerance for the rows
+linearised at the solution: g_N >= -``penetration_tol``, lambda <= 0, lambda g_N = 0 (active
+rows have g_N = 0, inactive ones carry no force). What overlap remains is that of the
+polygonal lips between the rows' nodes, of second order in the last update.
 """
 import math
 import numbers
@@ -80,9 +94,9 @@ class ContactResult:
         every Newton solve in turn.
     converged, reason, rounds, constraints, multipliers, released, max_penetration
         Initial values of the attributes of the same names (below).
-    timings, history, updates, lcp, notes
+    timings, history, updates, lcp, notes, active_keys
         Likewise; by default zero timings for the four phases, an empty history, 0, 0, no
-        notes.
+        notes, no keys.
 
     Attributes
     ----------
@@ -121,6 +135,10 @@ class ContactResult:
         Every departure from the plain path, one sentence each: a complementarity
         problem that could not be solved (the primal-dual update went on instead), or
         ``fix_free_modes=False`` that contact turned into True.
+    active_keys : list of tuple
+        Sorted keys of the active rows of a converged solve: ("s", lower twin, higher
+        twin, kind) for seam rows, ("n", slave, a, c) for node-to-segment rows. The next
+        solve can start from them (``ContactSolver.solve(warm=...)``).
     """
     status: SolveStatus
     converged: bool = False
@@ -135,6 +153,7 @@ class ContactResult:
     updates: int = 0
     lcp: int = 0
     notes: list = field(default_factory=list)
+    active_keys: list = field(default_factory=list)
 
     def __bool__(self):
         return self.converged
@@ -166,17 +185,16 @@ class ContactSolver:
         redundant. Measured on cracked plates: near-duplicate lip rows at 1e-6 made the
         Schur complement so ill-conditioned (1e12) that Newton stalled at 5e-10.
     max_updates : int
-        Re-linearisations at a settled active set at most. Rows are linearised where
-        they are found (eq. 13/14), so a settled solution still overlaps to second order
-        in the displacement (measured 1.6e-9 of the area on the plate scene, from a free
-        one-triangle fragment sliding along its seams). When the true gaps at the
-        solution penetrate by more than penetration_tol, the rows are linearised again
-        there (same rows, current normals and projections) and the solve repeated. This
-        fixed point contracts fast where the step is small enough (measured: a factor 20
-        to 500 per update on the disintegration disk, 1e-5 to 8e-15 in five updates; less
-        where the active set changes between updates). When one update does not reduce the
-        penetration, or after ``max_updates`` of them, the solve fails with reason
-        "penetration".
+        Solves of a settled active set again at most. A row linearised at the last solve
+        (eq. 13/14) still lets the next solution overlap to second order in that solve's
+        motion (measured 1.6e-9 of the area on the plate scene, from a free one-triangle
+        fragment sliding along its seams). When the gaps at the solution penetrate by more
+        than penetration_tol, the set is solved again with its rows linearised there (same
+        rows, current normals and projections). This fixed point contracts fast where the
+        step is small enough (measured: a factor 20 to 500 per update on the
+        disintegration disk). Once the rows are frozen (see the module docstring), an
+        update that does not reduce the penetration, or ``max_updates`` of them, end the
+        solve with reason "penetration".
     kink_angle : float
         Seam facets meeting at a larger angle (radians, in the reference configuration)
         get a row each at their common node (see :mod:`ngfracture.seams`). The default
@@ -347,9 +365,11 @@ class ContactSolver:
         return choice[contact.independent_rows(pool.C[choice], fixed_dofs=fixed, G=self._holds,
                                                rtol=self.rank_tol)] if len(choice) else choice
 
-    def _newton(self, result, tangent):
+    def _newton(self, result, tangent, increment_scale=None):
+        """One Newton solve with the current rows; later rounds pass the first solve's first
+        increment (they correct that solve: eq. 7 is judged against the step, not the correction)."""
         t0 = time.perf_counter()
-        status = self.problem.solve(tangent=tangent, **self.options)
+        status = self.problem.solve(tangent=tangent, increment_scale=increment_scale, **self.options)
         result.status = status
         result.timings["solve"] += time.perf_counter() - t0
         for part, seconds in status.phase_seconds().items():
@@ -357,12 +377,23 @@ class ContactSolver:
         return status
 
     @single_threaded_blas()
-    def solve(self):
+    def solve(self, warm=()):
         """Solve for equilibrium with contact.
 
         The problem's rows labelled "contact" are replaced by the active set of each round
         and are those of the last solve at the end; the displacement is the solution of
         the last converged Newton solve.
+
+        Parameters
+        ----------
+        warm : iterable of tuple, optional
+            Keys of rows to start from (``ContactResult.active_keys`` of the solve before,
+            on this mesh or on the mesh a crack pass split from it: old vertices keep their
+            numbers). They enter the first round as active rows, linearised at the current
+            state, and the prediction without contact rows is skipped. Only the path
+            changes: the set still has to settle and pass the same tests. A warm start that
+            fails is followed by the plain path from the same start (recorded in
+            ``notes``). Empty: the plain predict-and-correct path.
 
         Returns
         -------
@@ -373,18 +404,43 @@ class ContactSolver:
             are not raised.
         """
         prob = self.problem
+        uncracked = prob.fragments()[0] == 1 and "crack" not in prob.mesh.GetBoundaries()
+        warm = set() if uncracked else set(warm)
+        if not warm:
+            return self._solve(warm, uncracked)
+        u, load = prob.u.vec.FV().NumPy().copy(), prob.load_factor.Get()
+        result = self._solve(warm, uncracked)
+        if result.converged:
+            return result
+        # rows of the pass before can hold a shattered piece in a nearly singular way
+        # (measured: a plate at critical strain 1e-12); the plain path decides then
+        prob.u.vec.FV().NumPy()[:] = u
+        prob.load_factor.Set(load)
+        plain = self._solve(set(), uncracked)
+        plain.notes.append(f"the warm start from {len(warm)} contact rows failed ({result.reason}); "
+                           "solved from the prediction without rows")
+        for phase, seconds in result.timings.items():
+            plain.timings[phase] = plain.timings.get(phase, 0.0) + seconds
+        return plain
+
+    def _solve(self, warm, uncracked):
+        """The solve of :meth:`solve` from the given warm keys (a set, maybe empty)."""
+        prob = self.problem
         prob.constraints.clear_rows(LABEL)
         # the rounds are at the load of the prediction: they reuse its factorised tangent
         tangent = SavedTangent()
         result = ContactResult(None, notes=list(self._notes))
-        status = self._newton(result, tangent)
-        if not status.converged:
-            result.reason = status.reason
-            return result
-        if prob.fragments()[0] == 1 and "crack" not in prob.mesh.GetBoundaries():
-            # one uncracked body cannot touch itself: no collision work at all
-            result.converged, result.reason = True, "converged"
-            return result
+        scale = None        # the first increment of the first solve
+        if not warm:
+            status = self._newton(result, tangent)
+            scale = status.first_increment
+            if not status.converged:
+                result.reason = status.reason
+                return result
+            if uncracked:
+                # one uncracked body cannot touch itself: no collision work at all
+                result.converged, result.reason = True, "converged"
+                return result
         t0 = time.perf_counter()
         arrays, fragment, fixed_all, fixed = self._geometry()
         self._holds = self._held_modes()
@@ -399,6 +455,7 @@ class ContactSolver:
         exact = False                           # the complementarity problem chooses the set
         force_scale = 0.0                       # the largest force of any round so far
         last_penetration = np.inf               # at the last re-linearisation
+        moving = True        # rows re-linearised every round (until that stops contracting)
         for rnd in range(1, self.max_rounds + 1):
             result.rounds = rnd
             t0 = time.perf_counter()
@@ -409,6 +466,13 @@ class ContactSolver:
                 seam_keys = [("s",) + tuple(r) for r in k.tolist()]
                 matched = np.zeros(nv, dtype=bool)
                 matched[seam_rows.slave] = matched[seam_rows.a] = True
+            elif moving and result.status is not None:
+                # every row at the configuration just solved: the gaps the set update
+                # judges are those of this configuration, to second order in the last step
+                fresh = self._relinearised(contact.ContactConstraints.stack([seam_rows, n2s]), len(seam_keys),
+                                           seam_keys, seams, arrays.points, U)
+                seam_rows = fresh.subset(np.arange(len(seam_keys)))
+                n2s = fresh.subset(np.arange(len(seam_keys), len(fresh)))
             # node-to-segment rows: a row keeps the linearisation it was found with while
             # it is active or detected again; new ones are linearised here
             found, found_keys = self._node_to_segment(arrays, fragment, U, seams, matched, result.timings)
@@ -422,8 +486,9 @@ class ContactSolver:
             gap = pool.C @ U.T.ravel() + pool.g
             # primal-dual active set: an active row stays while it pushes (lambda <= 0),
             # an inactive one enters when its node penetrates
-            want = np.array([(lam[k] <= 0.0) if k in lam else (g < -self.penetration_tol)
+            want = np.array([(lam[k] <= 0.0) if k in lam else (g < -self.penetration_tol or k in warm)
                              for k, g in zip(keys, gap)], dtype=bool)
+            warm = set()     # a warm row that the solve releases is judged like any other
             want = np.flatnonzero(want)
             kept = want[contact.independent_rows(pool.C[want], fixed_dofs=fixed, G=self._holds, rtol=self.rank_tol)] \
                 if want.size else want
@@ -432,7 +497,10 @@ class ContactSolver:
             penetration = float(max(0.0, -gap[other].min(initial=0.0)))
             result.history.append((len(kept), penetration))
             result.timings["contact"] += time.perf_counter() - t0
-            settled = set(keys[i] for i in kept) == set(lam)
+            # settled: the set of the last solve again (none yet when started warm)
+            settled = result.status is not None and set(keys[i] for i in kept) == set(lam)
+            if moving and not settled:
+                last_penetration = np.inf     # the contraction is judged at one set only
             if not settled and (exact or rnd > self.pdas_rounds or frozenset(keys[i] for i in kept) in imposed):
                 # the update revisits a set: it cycles (rows with a response that is no
                 # M-matrix, e.g. nearly parallel rows at a kink). From here on the set is
@@ -456,8 +524,14 @@ class ContactSolver:
                 result.max_penetration = penetration
                 if penetration <= self.penetration_tol:
                     result.converged, result.reason = True, "converged"
+                    result.active_keys = sorted(lam)
                     return result
-                if result.updates == self.max_updates or penetration >= last_penetration:
+                if moving and penetration >= last_penetration and result.updates < self.max_updates:
+                    # re-linearising every round went round in circles at this set: from
+                    # here on the rows stay as linearised now, and the plain fixed point of
+                    # updates at a settled set decides (and fails when it does not contract)
+                    moving = False
+                elif result.updates == self.max_updates or penetration >= last_penetration:
                     # the linearisations do not converge to a state without overlap (large
                     # relative motion for one solve): a failure, which a caller cures with
                     # a smaller step, not an overlap passed off as a solution
@@ -476,7 +550,8 @@ class ContactSolver:
             if len(cs):
                 # active: the linearised gap closes, C u + g = 0
                 prob.constraints.add_rows(_space_columns(cs.C, nv, n), -cs.g, label=LABEL)
-            status = self._newton(result, tangent)
+            status = self._newton(result, tangent, scale)
+            scale = status.first_increment if scale is None else scale
             if not status.converged:
                 result.reason = status.reason
                 return result

@@ -27,14 +27,11 @@ Files of a :class:`TimeSeriesWriter` folder
 Strains are those of the P1 interpolant of the vertex displacements (element-wise constant,
 Green-Lagrange by default), the same quantity the crack criterion averages at the vertices.
 """
-import ctypes.util
-import glob
 import io
 import json
 import math
 import os
 import re
-import sys
 import tempfile
 import xml.etree.ElementTree as ET
 from pathlib import Path
@@ -46,7 +43,7 @@ from .meshio import mesh_to_arrays
 from .problem import check_mesh
 
 __all__ = ["vertex_arrays", "element_strain", "to_pyvista", "cracks_to_pyvista",
-           "TimeSeriesWriter", "RenderError", "check_headless", "render_png", "plot_fragment_sizes", "write_summary"]
+           "TimeSeriesWriter", "RenderError", "render_png", "plot_fragment_sizes", "write_summary"]
 
 
 # -- arrays ---------------------------------------------------------------------------------
@@ -475,50 +472,9 @@ class TimeSeriesWriter:
 # -- pictures -------------------------------------------------------------------------------
 
 class RenderError(RuntimeError):
-    """Headless rendering is impossible on this machine; the message says what is missing."""
+    """A picture could not be drawn; the message says why."""
 
 
-def _dri_drivers():
-    dirs = [d for d in os.environ.get("LIBGL_DRIVERS_PATH", "").split(":") if d]
-    dirs += glob.glob("/usr/lib/*/dri") + ["/usr/lib/dri", "/usr/lib64/dri"]
-    return [f for d in dirs for f in glob.glob(os.path.join(d, "*_dri.so"))]
-
-
-def check_headless():
-    """Make sure VTK can render without a display, or raise RenderError saying why.
-
-    With a display (``DISPLAY``/``WAYLAND_DISPLAY`` set) or off Linux nothing is checked.
-    Otherwise Mesa's EGL (``libEGL.so.1``, ``libEGL_mesa.so.0`` and a DRI driver; Debian
-    packages ``libegl1 libegl-mesa0 libgl1-mesa-dri``) or OSMesa must be present, and
-    ``VTK_DEFAULT_OPENGL_WINDOW`` is set to the matching VTK window unless already set
-    (this skips VTK's X attempt).
-
-    Raises
-    ------
-    RenderError
-        No display and neither Mesa's EGL nor OSMesa; the message lists the missing
-        libraries and the Debian packages that provide them.
-    """
-    if not sys.platform.startswith("linux") or os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"):
-        return
-    missing = []
-    if not ctypes.util.find_library("EGL"):
-        missing.append("libEGL.so.1 (Debian package libegl1)")
-    if not ctypes.util.find_library("EGL_mesa"):
-        missing.append("libEGL_mesa.so.0 (libegl-mesa0)")
-    if not _dri_drivers():
-        missing.append("a Mesa DRI driver such as swrast_dri.so (libgl1-mesa-dri)")
-    if not missing:
-        os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
-    elif ctypes.util.find_library("OSMesa"):
-        os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkOSOpenGLRenderWindow")
-    else:
-        raise RenderError("ngfracture.output: headless rendering is impossible: no display and "
-                          f"missing {', '.join(missing)} (or OSMesa). On Debian/Ubuntu: "
-                          "apt-get install -y libegl1 libegl-mesa0 libgl1-mesa-dri")
-
-
-# matplotlib's tab20, dark shades first: consecutive fragment ids get different hues
 _FRAGMENT_COLOURS = ["#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2",
                      "#7f7f7f", "#bcbd22", "#17becf", "#aec7e8", "#ffbb78", "#98df8a", "#ff9896",
                      "#c5b0d5", "#c49c94", "#f7b6d2", "#c7c7c7", "#dbdb8d", "#9edae5"]
@@ -547,6 +503,9 @@ def picture_scale(points, u):
 def render_png(mesh, u, fragment, path, window_size=(1200, 900), scale=1.0, crack_boundary="crack",
                line_width=2.0, force=False):
     """A PNG of the deformed configuration coloured by fragment, crack faces drawn in black.
+
+    Drawn with matplotlib's Agg backend: no display and no OpenGL are needed (the VTK
+    files are for ParaView and PyVista).
 
     Parameters
     ----------
@@ -577,52 +536,48 @@ def render_png(mesh, u, fragment, path, window_size=(1200, 900), scale=1.0, crac
     Raises
     ------
     RenderError
-        Rendering is impossible here (missing EGL/Mesa libraries, or VTK failed); the
-        message names what is missing.
+        matplotlib failed to draw or encode the picture (the message says how).
+    ValueError
+        ``fragment`` does not have one entry per triangle, or a bad displacement.
     FileExistsError
         ``path`` exists and not ``force``.
     """
     path = Path(path)
     if path.exists() and not force:
         raise FileExistsError(f"render_png: {path} exists; pass force=True to overwrite it")
-    check_headless()
-    import pyvista as pv
-    pv.OFF_SCREEN = True
     a = vertex_arrays(mesh)
+    fragment = np.asarray(fragment, dtype=np.int64).ravel()
+    if fragment.shape != (len(a.triangles),):
+        raise ValueError(f"render_png: {fragment.size} fragment numbers for {len(a.triangles)} triangles")
     U = np.zeros((mesh.nv, 2)) if u is None else _displacement(mesh, u)
-    grid = to_pyvista(mesh, U, fragment, strain=None, arrays=a)
-    grid.points = grid.points + scale * grid.point_data["displacement"]
-    grid.cell_data["colour"] = grid.cell_data["fragment"] % 20
-    lines = cracks_to_pyvista(mesh, U, crack_boundary, arrays=a)
-    if lines.n_points:
-        lines.points = lines.points + scale * lines.point_data["displacement"]
-    plotter = None
+    X = a.points + scale * U
+    cracks = X[a.boundary_segments(crack_boundary)]
+    width, height = (int(w) for w in window_size)
     try:
-        plotter = pv.Plotter(off_screen=True, window_size=[int(w) for w in window_size])
-        plotter.set_background("white")
-        plotter.add_mesh(grid, scalars="colour", cmap=_FRAGMENT_COLOURS, clim=[0, 19], n_colors=20,
-                         show_scalar_bar=False, preference="cell")
-        if lines.n_cells:
-            plotter.add_mesh(lines, color="black", line_width=line_width)
-        plotter.view_xy()
-        fd, tmp = tempfile.mkstemp(prefix=".tmp_ngf_", suffix=".png", dir=path.parent)
-        os.close(fd)
-        try:
-            img = plotter.screenshot(tmp, return_img=True)
-            if img is None or img.size == 0:
-                raise RenderError("ngfracture.output: VTK returned an empty image")
-            _publish(tmp, path, force)
-        finally:
-            if os.path.exists(tmp):
-                os.unlink(tmp)
-    except RenderError:
-        raise
+        from matplotlib.backends.backend_agg import FigureCanvasAgg
+        from matplotlib.collections import LineCollection, PolyCollection
+        from matplotlib.figure import Figure
+        dpi = 100
+        fig = Figure(figsize=(width / dpi, height / dpi), dpi=dpi, facecolor="white")
+        FigureCanvasAgg(fig)
+        ax = fig.add_axes([0.02, 0.02, 0.96, 0.96])
+        ax.set_axis_off()
+        colours = np.array(_FRAGMENT_COLOURS)[fragment % len(_FRAGMENT_COLOURS)]
+        # edges in the face colour: no white seams between triangles of one fragment
+        ax.add_collection(PolyCollection(X[a.triangles], facecolors=colours, edgecolors=colours,
+                                         linewidths=0.3))
+        if len(cracks):
+            ax.add_collection(LineCollection(cracks, colors="black", linewidths=line_width * 72 / dpi))
+        lo, hi = X.min(axis=0), X.max(axis=0)
+        ax.set_xlim(lo[0], hi[0])
+        ax.set_ylim(lo[1], hi[1])
+        ax.set_aspect("equal")
+        buf = io.BytesIO()
+        fig.savefig(buf, format="png", dpi=dpi, facecolor="white")
     except Exception as e:
-        raise RenderError(f"ngfracture.output: VTK could not render off-screen ({type(e).__name__}: {e}); "
-                          "headless Linux needs libegl1 libegl-mesa0 libgl1-mesa-dri") from e
-    finally:
-        if plotter is not None:
-            plotter.close()
+        raise RenderError(f"ngfracture.output: matplotlib could not draw {path.name} "
+                          f"({type(e).__name__}: {e})") from e
+    _atomic_bytes(path, buf.getvalue(), force)
     return path
 
 

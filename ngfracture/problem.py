@@ -467,7 +467,7 @@ class ElasticProblem:
         return self.mesh.MaterialCF({name: make(m) for name, m in self.materials.items()})
 
     def solve(self, method="modified", load_steps=1, tol=1e-10, maxit=50, linear_solver="direct",
-              inverse="auto", fix_free_modes=False, tangent=None):
+              inverse="auto", fix_free_modes=False, tangent=None, increment_scale=None):
         """Solve for equilibrium with the current constraints and loads.
 
         Parameters
@@ -491,6 +491,8 @@ class ElasticProblem:
         tangent : solver.SavedTangent, optional
             A factorised tangent to reuse at this load, or to leave this solve's in
             (contact rounds at a fixed load).
+        increment_scale : float, optional
+            Reference first increment of eq. 7 (see :class:`solver.NewtonSolver`).
 
         Returns
         -------
@@ -504,5 +506,6 @@ class ElasticProblem:
             On invalid options or constraints (unknown boundary, conflicting values).
         """
         solver = NewtonSolver(self, method=method, tol=tol, maxit=maxit, linear_solver=linear_solver,
-                              inverse=inverse, fix_free_modes=fix_free_modes, tangent=tangent)
+                              inverse=inverse, fix_free_modes=fix_free_modes, tangent=tangent,
+                              increment_scale=increment_scale)
         return solver.solve(load_steps)

@@ -395,6 +395,9 @@ class State:
         One record per accepted step.
     strength : numpy.ndarray or None
         Critical strain per vertex (None: the regions' uniform ones).
+    contact_keys : list of tuple
+        Keys of the active contact rows at this state: the first contact solve of the next
+        step starts from them (ContactSolver.solve, ``warm``).
     """
     arrays: MeshArrays
     u: np.ndarray            # P1 displacement vector, VectorH1 layout
@@ -409,6 +412,7 @@ class State:
     peak_energy: float
     history: list            # one dict per accepted step
     strength: np.ndarray = None
+    contact_keys: list = field(default_factory=list)
 
 
 def round_trip(mesh):
@@ -590,15 +594,19 @@ class Simulation:
             return False
         return self.scene.contact or "crack" in mesh.GetBoundaries()
 
-    def _equilibrium(self, prob, phase, substeps=1):
-        """Solve in ``substeps`` load steps; raise StepFailed(reason, phase) if it does not converge."""
+    def _equilibrium(self, prob, phase, substeps=1, warm=()):
+        """Solve in ``substeps`` load steps; returns the keys of the active contact rows.
+
+        ``warm``: the active contact keys of the solve before (ContactSolver.solve).
+        Raises StepFailed(reason, phase) if the solve does not converge.
+        """
         c = self.control
         options = dict(method=self._method, tol=c.tol, maxit=c.maxit, load_steps=substeps)
         if self._needs_contact(prob.mesh):
             solver = ContactSolver(prob, tol=self.scene.contact_tol,   # its tol: detection threshold
                                    fix_free_modes=self.scene.fix_free_modes)
             solver.options.update(options)                              # Newton's tol, method, maxit
-            result = solver.solve()
+            result = solver.solve(warm=warm)
             self.timings["solve"] += result.timings["solve"]
             self.timings["contact"] += result.timings["contact"] - result.timings.get("collision", 0.0)
             self.timings["collision"] += result.timings.get("collision", 0.0)
@@ -616,7 +624,7 @@ class Simulation:
                 else:
                     message = status.message
                 raise StepFailed(result.reason, phase, message)
-            return status
+            return result.active_keys
         t0 = time.perf_counter()
         status = prob.solve(fix_free_modes=self.scene.fix_free_modes, **options)
         self.timings["solve"] += time.perf_counter() - t0
@@ -625,7 +633,7 @@ class Simulation:
         self._iterations += status.iterations
         if not status.converged:
             raise StepFailed(status.reason, phase, status.message)
-        return status
+        return []
 
     def _normalised_strain(self, prob, strength=None):
         """Vertex strain tensors divided by the vertex's critical strain (0: cannot crack).
@@ -677,14 +685,14 @@ class Simulation:
     # -- one load step ----------------------------------------------------------------------------
     def _attempt(self, state, dx, substeps=1):
         """Try the step x + dx from an accepted state; returns (problem, first-pass cracks, total cracks,
-        vertex strength).
+        vertex strength, active contact keys).
 
         Raises StepFailed on a failed solve and returns None for too many cracks.
         """
         self._x_try = state.x + dx
         self._split_positions = []      # per pass: reference positions of the vertices split
         prob = self._problem(self._mesh, self._x_try, state.u)
-        self._equilibrium(prob, "increment", substeps)
+        keys = self._equilibrium(prob, "increment", substeps, warm=state.contact_keys)
         self._dwork = self._increment_work(state, prob)
         new_prob, first, strength = self._crack_pass(prob, state.strength)
         c = self.control
@@ -696,10 +704,10 @@ class Simulation:
             if passes > c.max_relax_passes:
                 raise StepFailed("relaxation", "relaxation", f"cracks still grow after {c.max_relax_passes} passes at fixed load")
             prob = new_prob
-            self._equilibrium(prob, "relaxation")
+            keys = self._equilibrium(prob, "relaxation", warm=keys)
             new_prob, n, strength = self._crack_pass(prob, strength)
             total += n
-        return prob, first, total, strength
+        return prob, first, total, strength, keys
 
     @staticmethod
     def _increment_work(state, prob):
@@ -716,7 +724,7 @@ class Simulation:
         dg = rows.fixed_values[pos[same]] - state.fixed_values[same]
         return float(0.5 * np.dot(state.reactions[same] + r_new, dg))
 
-    def _accept(self, state, prob, dx, first, total, strength):
+    def _accept(self, state, dx, prob, first, total, strength, contact_keys):
         arrays, mesh = round_trip(prob.mesh)
         u = prob.u.vec.FV().NumPy().copy()
         # the solve ended at u (kept by the problem, no assembly); the round trip keeps the dof numbers
@@ -746,7 +754,7 @@ class Simulation:
         new = State(arrays=arrays, u=u, x=self._x_try, dx=new_dx, step=state.step + 1, quiet=quiet,
                     work=state.work + dwork, reactions=reactions, fixed_values=rows.fixed_values.copy(),
                     fixed_dofs=rows.fixed_dofs.copy(), peak_energy=max(state.peak_energy, energy),
-                    history=state.history + [record], strength=strength)
+                    history=state.history + [record], strength=strength, contact_keys=contact_keys)
         return new, prob, mesh, stats
 
     # -- the run ----------------------------------------------------------------------------------
@@ -841,8 +849,7 @@ class Simulation:
                 message = (f"step {state.step + 1} at x = {state.x + dx:.6g} failed {self._retries} time(s); "
                            f"last reason {failure.reason}: {failure.message}")
                 break
-            prob, first, total, strength = attempt
-            state, prob, self._mesh, stats = self._accept(state, prob, dx, first, total, strength)
+            state, prob, self._mesh, stats = self._accept(state, dx, *attempt)
             if self.writer is not None:
                 self._write_step(state, prob, stats)
                 if state.step % self.checkpoint_every == 0:
@@ -921,6 +928,7 @@ class Simulation:
         meta = {"scene": self.scene.name, "parameters": self.scene.parameters,
                 "x": state.x, "dx": state.dx, "step": state.step, "quiet": state.quiet, "work": state.work,
                 "peak_energy": state.peak_energy, "history": state.history,
+                "contact_keys": [list(k) for k in state.contact_keys],
                 "area_initial": self.area_initial,
                 "control": self._path_options(),
                 "timings": {**self.timings, "wall": wall}}
@@ -946,7 +954,8 @@ class Simulation:
         return State(arrays=MeshArrays.from_dict(arrays), u=arrays["u"], x=meta["x"], dx=meta["dx"],
                      step=meta["step"], quiet=meta["quiet"], work=meta["work"], reactions=arrays["reactions"],
                      fixed_values=arrays["fixed_values"], fixed_dofs=arrays["fixed_dofs"],
-                     peak_energy=meta["peak_energy"], history=meta["history"], strength=arrays.get("strength"))
+                     peak_energy=meta["peak_energy"], history=meta["history"], strength=arrays.get("strength"),
+                     contact_keys=[tuple(k) for k in meta.get("contact_keys", [])])
 
     def _path_options(self):
         """The options that decide the load path: a resumed run must have the same ones.

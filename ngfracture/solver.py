@@ -71,8 +71,8 @@ class SolveStatus:
     ----------
     converged, reason, message, iterations, steps, increment_history, residual_history
         Initial values of the attributes of the same names (below).
-    timings, multipliers
-        Likewise; by default a dict of zeros for the five phases and an empty array.
+    timings, multipliers, first_increment
+        Likewise; by default a dict of zeros for the five phases, an empty array and 0.
 
     Attributes
     ----------
@@ -96,6 +96,8 @@ class SolveStatus:
     multipliers : numpy.ndarray
         Lagrange multipliers of the general rows at the end (the forces -C^T lam
         they exert on the dofs); empty without general rows.
+    first_increment : float
+        Euclidean norm of the first increment du^(0) (0 before any iteration).
     """
     converged: bool = False
     reason: str = "max_iterations"
@@ -107,6 +109,7 @@ class SolveStatus:
     timings: dict = field(default_factory=lambda: dict.fromkeys(
         ("assemble", "factorize", "solve", "residual", "checks"), 0.0))
     multipliers: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    first_increment: float = 0.0
 
     def __bool__(self):
         return self.converged
@@ -213,7 +216,18 @@ class NewtonSolver:
     tol : float
         Relative increment tolerance of eq. 7. An increment that has stopped falling
         (not below the smallest of the three before it) below 1e3 tol counts as
-        converged too: rounding, not the method, sets that floor.
+        converged too: rounding, not the method, sets that floor. Modified Newton, from
+        the third iteration on, also stops when the error estimate of the iterate from the
+        contraction of the last two increments, rho / (1 - rho) |du^(k)| with
+        rho = |du^(k)| / |du^(k-1)| < 1/2, is below tol |du^(0)|: the increment eq. 7 would
+        wait for is already below the tolerance (the first ratio is no estimate: it
+        compares the nonlinear correction with the linear response).
+    increment_scale : float, optional
+        A reference for |du^(0)| in eq. 7: the solve compares increments with the larger
+        of its own first increment and this. A solve that corrects another one at the same
+        load (a contact round with changed rows) is as accurate as the step it corrects
+        when its increments fall below tol times the step's first increment; measured
+        against its own tiny first increment it would solve the correction to rounding.
     maxit : int
         Maximum iterations per load step.
     linear_solver : {"direct", "gmres"}
@@ -239,7 +253,8 @@ class NewtonSolver:
     """
 
     def __init__(self, problem, method="modified", tol=1e-10, maxit=50, linear_solver="direct",
-                 inverse="auto", divergence_factor=1e4, fix_free_modes=False, tangent=None):
+                 inverse="auto", divergence_factor=1e4, fix_free_modes=False, tangent=None,
+                 increment_scale=None):
         if fix_free_modes not in (False, True, "all"):
             raise ValueError(f"fix_free_modes must be False, True or 'all', got {fix_free_modes!r}")
         check_solve_options(dict(method=method, tol=tol, maxit=maxit, linear_solver=linear_solver,
@@ -250,6 +265,9 @@ class NewtonSolver:
         self.divergence_factor = divergence_factor
         self.fix_free_modes = fix_free_modes
         self.tangent = tangent
+        if increment_scale is not None and not (np.isfinite(increment_scale) and increment_scale >= 0):
+            raise ValueError(f"increment_scale must be a finite number >= 0, got {increment_scale!r}")
+        self.increment_scale = increment_scale or 0.0
 
     @single_threaded_blas()
     def solve(self, load_steps=1):
@@ -289,9 +307,10 @@ class NewtonSolver:
             rows = prob.assemble_constraints()
             reuse = reusable and saved.holds(rows.fixed_dofs)
             support = saved.support if reuse else prob.support(rows)
+            # rows that hold the free modes leave none floating: checked only without them
+            floating = "" if self.fix_free_modes else prob.floating_bodies(rows, support)
             if self.fix_free_modes:
                 rows = self._hold_free_modes(rows, support)
-            floating = prob.floating_bodies(rows, support)
         if floating:
             return status.fail("singular", floating)
         u = prob.u.vec.FV().NumPy()
@@ -449,7 +468,8 @@ class NewtonSolver:
             status.iterations += 1
             norm = float(np.linalg.norm(du))
             if du0 is None:
-                du0 = norm
+                status.first_increment = status.first_increment or norm
+                du0 = max(norm, self.increment_scale)
             ratio = norm / du0 if du0 > 0 else 0.0
             status.increment_history.append(ratio)
             with _Timer(timings, "residual"):
@@ -472,7 +492,10 @@ class NewtonSolver:
             # stagnated at 9.8e-10 for 60 iterations and the disintegration run stopped)
             hist = status.increment_history
             stalled = ratio < 1e3 * self.tol and len(hist) >= 4 and ratio >= min(hist[-4:-1])
-            if ratio < self.tol or norm == 0.0 or exact or rounding or stalled:
+            # modified Newton contracts linearly: the last ratio estimates the next ones
+            rho = norm / prev if self.method == "modified" and k >= 2 and prev > 0 else 1.0
+            contracted = rho < 0.5 and rho / (1.0 - rho) * ratio < self.tol
+            if ratio < self.tol or norm == 0.0 or exact or rounding or stalled or contracted:
                 status.converged, status.reason = True, "converged"
                 status.message = f"stalled at relative increment {ratio:.1e}" if stalled and ratio >= self.tol else ""
                 if self.tangent is not None:

@@ -151,10 +151,12 @@ def pinwheel(h, s):
     return prob
 
 
-@pytest.mark.parametrize("s", [1e-4, 1e-3])
+@pytest.mark.parametrize("s", [1e-4, 1e-3, 1e-2, 3e-2])
 def test_pinwheel_opposite_quarters_do_not_overlap(s):
-    """Measured (h = 0.1): overlap 1.7e-16 (s = 1e-4) and 8.1e-16 (s = 1e-3) of the area
-    2.0; without the diagonal rows 3.6e-9 and 3.6e-7 (a test below)."""
+    """Measured (h = 0.1): overlap 1.7e-16 (s = 1e-4) and 5.1e-15 (s = 1e-3) of the area 2.0;
+    without the diagonal rows 3.6e-9 and 3.6e-7 (a test below). Sliding by a tenth and a
+    third of h at every kink (s = 1e-2, 3e-2): 2.5e-14 and 9.5e-15, the rows re-linearised
+    every round."""
     h = 0.1
     prob = pinwheel(h, s)
     solver = ContactSolver(prob, tol=0.1 * h)
@@ -167,13 +169,13 @@ def test_pinwheel_opposite_quarters_do_not_overlap(s):
 
 
 def test_pinwheel_too_large_for_one_solve_fails_with_a_reason():
-    """At s = 1e-2 (a tenth of h of sliding at every kink of the zigzag cracks) re-linearising
-    the rows does not contract the penetration (measured over all rows: 5.1e-2, 1.3e-3,
-    7.0e-3, 1.3e-4, 8.6e-4, ...): the solve says so after the first update that does not
-    reduce it (reason "penetration", the amount in max_penetration) instead of reporting
-    convergence with the overlap it leaves (measured 2.4e-6 of the area 2.0)."""
+    """At s = 5e-2 (half of h of sliding at every kink of the zigzag cracks) re-linearising
+    the rows does not contract the penetration: the solve says so after the first update of
+    the frozen rows that does not reduce it (reason "penetration", the amount in
+    max_penetration: measured 6.8e-8) instead of reporting convergence with the overlap it
+    leaves (measured 9.9e-4 of the area 2.0)."""
     h = 0.1
-    prob = pinwheel(h, 1e-2)
+    prob = pinwheel(h, 5e-2)
     solver = ContactSolver(prob, tol=0.1 * h)
     result = solver.solve()
     assert not result.converged and result.reason == "penetration", (result.reason, result.history)

@@ -76,7 +76,10 @@ def test_critical_strain_1e_12_with_contact_runs():
     # contact holds the lips to its penetration tolerance (1e-10 contact_tol) along both
     # faces of every crack: the overlap area is at most that depth times their length
     assert s["max_overlap_area"] <= 1e-10 * scene.contact_tol * 2 * s["crack_length"]
-    assert all(n["note"].startswith("complementarity problem of ") for n in s["notes"])
+    # the departures recorded: the set from the primal-dual update where the complementarity
+    # problem failed, the plain path where a warm start failed on the shattered plate
+    assert all(n["note"].startswith(("complementarity problem of ", "the warm start from "))
+               for n in s["notes"]), s["notes"]
 
 
 # -- thread count 1 and 2 ----------------------------------------------------------------------
