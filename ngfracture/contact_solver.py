@@ -44,6 +44,9 @@ detection threshold in a step this took 12 to 14 solves per contact solve (the
 disintegrating disk) and gave up on a pinwheel of four quarters sliding by a tenth of the
 mesh size. Re-linearised every round, set and geometry settle together: 5 to 7 solves on the
 disk, and the pinwheel converges up to a third of the mesh size (tests/test_contact_fractured.py).
+A row whose gap at the new configuration is the same to a hundredth of ``penetration_tol``
+under both linearisations keeps its old one, bit for bit, and with it its cached column of
+the Schur complement: the lips that did not move cost no solve (:func:`_refreshed`).
 Where re-linearising stops reducing the penetration at a settled set (rows sliding over a
 kink), the rows are frozen from then on and the plain fixed point of updates decides, and
 fails with reason "penetration" when it does not contract.
@@ -157,6 +160,24 @@ class ContactResult:
 
     def __bool__(self):
         return self.converged
+
+
+def _refreshed(old, fresh, U, limit):
+    """The rows of ``fresh`` (re-linearised at U), except where the gap at U of the row in
+    ``old`` (same order, same keys) differs from the fresh one by at most ``limit``: those
+    keep their old linearisation, bit for bit, and with it their cached Schur column
+    (kkt.EliminatedFactor.columns). Rows of lips that did not move are all of these; the
+    final test of a settled set judges freshly linearised rows whatever was kept."""
+    u = U.T.ravel()
+    drift = np.abs((fresh.C @ u + fresh.g) - (old.C @ u + old.g))
+    keep = drift <= limit
+    if keep.all():
+        return old
+    if not keep.any():
+        return fresh
+    kept, renewed = np.flatnonzero(keep), np.flatnonzero(~keep)
+    rows = contact.ContactConstraints.stack([old.subset(kept), fresh.subset(renewed)])
+    return rows.subset(np.argsort(np.concatenate([kept, renewed])))
 
 
 def _space_columns(C, nv, n):
@@ -469,8 +490,9 @@ class ContactSolver:
             elif moving and result.status is not None:
                 # every row at the configuration just solved: the gaps the set update
                 # judges are those of this configuration, to second order in the last step
-                fresh = self._relinearised(contact.ContactConstraints.stack([seam_rows, n2s]), len(seam_keys),
-                                           seam_keys, seams, arrays.points, U)
+                old = contact.ContactConstraints.stack([seam_rows, n2s])
+                fresh = _refreshed(old, self._relinearised(old, len(seam_keys), seam_keys, seams, arrays.points, U),
+                                   U, 0.01 * self.penetration_tol)
                 seam_rows = fresh.subset(np.arange(len(seam_keys)))
                 n2s = fresh.subset(np.arange(len(seam_keys), len(fresh)))
             # node-to-segment rows: a row keeps the linearisation it was found with while
@@ -541,7 +563,7 @@ class ContactSolver:
                 # a geometric fixed point: solve again with the rows linearised here
                 # (the overlap falls from second to fourth order in the displacement)
                 result.updates += 1
-                pool = fresh
+                pool = _refreshed(pool, fresh, U, 0.01 * self.penetration_tol)
                 seam_rows = pool.subset(np.arange(len(seam_keys)))
                 n2s = pool.subset(np.arange(len(seam_keys), len(keys)))
             cs = pool.subset(kept)

@@ -17,9 +17,9 @@ pivoting): one sparse factorisation instead of one triangular solve per row for 
 Schur complement, and no pins, since the rows hold the free rigid modes (measured on the
 disk scene's steps 64 to 68: 118 s against 184 s, the same cracks). The first solve of
 each augmented factorisation must solve its own system (backward error below 1e-6); a
-nearly singular matrix is reported, not solved. Above ``SUPERLU_MAX_DOFS`` SuperLU's
-fill makes the augmented matrix dearer than NGSolve's Cholesky of K_ff plus the Schur
-columns (which contact rounds reuse), so the Schur path below is taken there.
+nearly singular matrix is reported, not solved. Above ``AUGMENTED_MAX_DOFS`` SuperLU's
+fill makes the augmented matrix dearer than a factorisation of K_ff plus the Schur
+columns, so the Schur path below is taken there.
 
 The Schur-complement path below is kept for the contact complementarity problem
 (:meth:`ConstrainedSolver.solve_unilateral`), which needs S = C K^+ C^T itself, and can
@@ -145,11 +145,19 @@ def reproducible_threads():
 #: of a block of 50 right-hand sides, per right-hand side:
 #:   2042 dofs: NGSolve 7.6 ms / 0.33 ms, SuperLU 8.0 ms / 0.12 ms;
 #:   7870 dofs: 23 ms / 1.8 ms against 54 ms / 0.9 ms; 117208 dofs: 0.77 s / 88 ms against 2.2 s / 23 ms.
-#: Contact makes one solve per row for each factorisation (Schur columns), so at the
-#: paper's resolution SuperLU wins both ways (the disk's steps 64 to 75: 171 s against
-#: 239 s, the same cracks); above a few thousand dofs NGSolve factorises faster, which the
-#: linear and modified-Newton runs (few solves per factorisation) need.
-SUPERLU_MAX_DOFS = 5000
+#: Contact makes one solve per row for each factorisation (Schur columns, computed again
+#: in every contact round), so SuperLU wins where there are many: at the paper's resolution
+#: both ways (the disk's steps 64 to 75: 171 s against 239 s, the same cracks), and on the
+#: plate's tangent at 31478 dofs a block of 100 right-hand sides takes 0.55 s against 1.08 s
+#: (factorisation 0.30 s against 0.19 s: SuperLU pays off from about 20 solves per
+#: factorisation, and a contact round makes more). Above 40000 dofs SuperLU's fill grows
+#: faster than NGSolve's (117208 dofs: factorisation 2.2 s against 0.77 s).
+SUPERLU_MAX_DOFS = 40000
+
+#: up to this many free dofs a fresh tangent with general rows is factorised as the
+#: augmented matrix (SuperLU); above, SuperLU's fill of the augmented matrix grows fast
+#: (plate at 8210 dofs, 100 rows: 1.9 s against 0.25 s for K_ff plus 1.8 s for the columns)
+AUGMENTED_MAX_DOFS = 5000
 
 
 class EliminatedFactor:
@@ -524,7 +532,7 @@ class ConstrainedSolver:
         How the general rows are solved (see the module docstring): "augmented" one LU of
         the augmented matrix (:meth:`EliminatedFactor.augmented`), "schur" the Schur
         complement with pins and corrected modes. "auto" (default): "augmented" where K_ff
-        is factorised by SuperLU (up to ``SUPERLU_MAX_DOFS``) with general rows and
+        is factorised by SuperLU with at most ``AUGMENTED_MAX_DOFS`` free dofs, with general rows and
         without ``dependent_rows``, else "schur".
 
     Attributes
@@ -568,7 +576,7 @@ class ConstrainedSolver:
             # by measurement: SuperLU's fill of the augmented matrix grows fast with size
             # (plate at 8210 dofs, 100 rows: 1.9 s against 0.25 s for NGSolve's Cholesky of
             # K_ff plus 1.8 s for 100 Schur columns, which later rounds reuse)
-            small = factor.inverse == "superlu"
+            small = factor.inverse == "superlu" and np.count_nonzero(factor.free) <= AUGMENTED_MAX_DOFS
             path = "augmented" if self.m and factor.linear_solver == "direct" and small and not dependent_rows else "schur"
         if path == "augmented" and (dependent_rows or not self.m or factor.linear_solver != "direct"):
             raise ValueError("the augmented path needs independent general rows and a direct solver")
@@ -643,7 +651,7 @@ class ConstrainedSolver:
             for refinement in range(self.REFINEMENTS + 1):
                 res, res_rows, force_scale, row_scale = self._residual(r, h, du, lam)
                 error = max(np.linalg.norm(res) / force_scale, np.linalg.norm(res_rows) / row_scale)
-                if error <= 1e-11 or refinement == self.REFINEMENTS:
+                if error <= 1e-13 or refinement == self.REFINEMENTS:
                     break
                 ddu, dlam, _ = self._solve_once(res, np.zeros_like(du), res_rows)
                 du, lam = du + ddu, lam + dlam
@@ -700,7 +708,12 @@ class ConstrainedSolver:
         return du, row_scale * x[nfree:], q
 
     def _residual(self, r, h, du, lam):
-        """Residuals of the free rows and of the general rows, each with its size scale."""
+        """Residuals of the free rows and of the general rows, each with its size scale.
+
+        The rows' scale is that of the rounding of C du, |C| |du| (entrywise absolute
+        values), not |C du|: rows already satisfied have C du and h near zero, and measured
+        against those the rounding of the product looked like an error (measured on the
+        default plate: half of all solves refined twice for nothing)."""
         self._tmp.FV().NumPy()[:] = du
         Kdu = (self.K * self._tmp).Evaluate().FV().NumPy()
         Ct_lam = self.C.T @ lam
@@ -708,7 +721,8 @@ class ConstrainedSolver:
         res = np.where(free, r - Kdu - Ct_lam, 0.0)
         Cdu = self.C @ du
         force_scale = (np.linalg.norm(r[free]) + np.linalg.norm(Kdu[free]) + np.linalg.norm(Ct_lam[free]))
-        return res, h - Cdu, max(force_scale, 1e-300), max(np.linalg.norm(h) + np.linalg.norm(Cdu), 1e-300)
+        row_scale = np.linalg.norm(h) + np.linalg.norm(abs(self.C) @ np.abs(du))
+        return res, h - Cdu, max(force_scale, 1e-300), max(row_scale, 1e-300)
 
     def _unconstrained(self, r, du_fixed):
         """The load q with the prescribed increments moved over, and du = du_fixed + K^+ q."""

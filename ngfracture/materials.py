@@ -114,6 +114,9 @@ class Material:
     name = "material"
     #: False for the linear model: it has no notion of an inverted element
     geometrically_nonlinear = True
+    #: the law's number in the C++ internal-force kernel (``_ngfracture.InternalForces``);
+    #: None: the residual comes from NGSolve's Apply of the energy (a user's own law)
+    kernel = None
 
     def __init__(self, E, nu, plane="strain"):
         self.lam, self.mu = lame_parameters(E, nu, plane)
@@ -216,6 +219,7 @@ class LinearElastic(Material):
 
     name = "linear"
     geometrically_nonlinear = False
+    kernel = 0
 
     def strain(self, H):
         """The small strain (H + H^T)/2.
@@ -299,6 +303,7 @@ class StVenantKirchhoff(Material):
     """
 
     name = "svk"
+    kernel = 1
 
     def energy(self, H):
         """Strain-energy density mu E:E + lambda/2 (tr E)^2.
@@ -355,6 +360,7 @@ class NeoHookean(Material):
     """
 
     name = "neohooke"
+    kernel = 2
 
     def energy(self, H):
         """Strain-energy density mu/2 (tr C - 2) - mu ln J + lambda/2 (ln J)^2.

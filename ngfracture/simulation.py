@@ -523,7 +523,7 @@ class Simulation:
     # -- output folder ---------------------------------------------------------------------
     OWN_PATTERNS = ("step_*.vtu", "cracks_*.vtp", "results.pvd", "cracks.pvd", "checkpoint_*.npz",
                     "summary.json", "final.png", "step_*.png", "fragment_sizes.png",
-                    ".checkpoint_*.tmp")
+                    ".checkpoint_*.tmp", ".tmp_ngf_*")
 
     @classmethod
     def check_output(cls, out, force=False, resume=False, option_names=("force", "resume")):

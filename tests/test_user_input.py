@@ -1,5 +1,6 @@
 """Input checked before any work, nothing lost; options overridden only where set; no silent path."""
 import math
+import os
 
 import numpy as np
 import pytest
@@ -177,3 +178,17 @@ def test_timings_of_a_resumed_run_cover_the_whole_run(tmp_path, coarse_plate):
     assert t["wall"] >= math.fsum(t[k] for k in disjoint)
     assert t["wall"] > first["timings"]["wall"] - first["timings"]["output"]
     assert t["solve"] >= first["timings"]["solve"]
+
+
+def test_a_temporary_file_of_a_killed_write_is_ours(tmp_path, coarse_plate):
+    """A run killed while a VTK collection was written leaves ``.tmp_ngf_*``; with force it
+    goes like every file of ours (an ensemble reruns such a sample that way), without
+    force the run is refused, naming it, before anything is written."""
+    out = tmp_path / "run"
+    out.mkdir()
+    (out / ".tmp_ngf_abc.pvd").write_text("<partial")
+    with pytest.raises(FileExistsError, match=r"\.tmp_ngf_abc\.pvd"):
+        Simulation(coarse_plate, StepControl(max_steps=1), out=out, pictures="none")
+    assert sorted(os.listdir(out)) == [".tmp_ngf_abc.pvd"]
+    result = Simulation(coarse_plate, StepControl(max_steps=1), out=out, force=True, pictures="none").run()
+    assert result.ok and not (out / ".tmp_ngf_abc.pvd").exists()
