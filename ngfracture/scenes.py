@@ -238,7 +238,7 @@ def disk(maxh=0.06, expansion=None, dx=None, core_stiffness=0.1, name="disk", co
     ----------
     maxh : float
         Mesh size (the paper gives none for the disk; 0.06 makes about 2000 triangles and
-        a run of minutes on 2 cores).
+        a run of about a minute on one core).
     expansion : float, optional
         Final radial displacement of the core's inner boundary.
     dx : float, optional
@@ -311,9 +311,8 @@ def disintegration(maxh=0.08, expansion=None, dx=None, core_stiffness=0.1, E=GLA
     ----------
     maxh : float
         Mesh size. Coarser than :func:`disk`'s by default (0.08, about 1000 triangles), as
-        the paper ran this case "using a coarse initial mesh": measured on a busy 2-core
-        machine, 118 steps and 32 pieces in about 3 minutes; maxh 0.06 needs 155 steps and
-        about 20 minutes (docs/verification.md).
+        the paper ran this case "using a coarse initial mesh": 116 steps and 31 pieces in
+        about 40 s on one core; maxh 0.06 takes a few minutes (docs/verification.md).
     expansion, dx, core_stiffness, E, nu, critical, core_nu, weibull_m, weibull_scale, weibull_area, seed
         As for :func:`disk`.
 

@@ -128,7 +128,7 @@ plt.show()
 # ## At the default resolution
 #
 # `ngfracture run disk` (maxh 0.06, the expansion 50 times the first-crack estimate;
-# a few minutes) breaks the inner part of the disk into grains while the outer part
+# about a minute) breaks the inner part of the disk into grains while the outer part
 # stays whole, as the paper's Fig. 9. The picture below is that run's `final.png`
 # (made by `tools/readme_pictures.py`); its `fragment_sizes.png` shows the
 # distribution of the grains' areas, which `plot_fragment_sizes` draws for any run:
