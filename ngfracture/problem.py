@@ -297,7 +297,9 @@ class ElasticProblem:
     def out_of_balance(self):
         """External minus internal nodal forces at the current displacement.
 
-        The last one is kept with the displacement and load factor it belongs to: asked
+        P1 spaces with the package's laws take the internal forces from the C++ kernel
+        (the gradient of the same energy, see ``_kernel_data``); others from NGSolve's
+        Apply of the energy form. The last one is kept with the displacement and load factor it belongs to: asked
         again at the same state (the work and reactions after a solve that ended there),
         it is returned without a second assembly.
 
