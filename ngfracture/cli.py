@@ -320,7 +320,7 @@ def _add_render(subparsers):
 
 def _run_render(args):
     from . import checkpoint
-    from .output import RenderError, picture_scale, plot_fragment_sizes, render_png
+    from .output import final_pictures, picture_scale
     from .fragments import FragmentStatistics
     from .meshio import MeshArrays, mesh_from_arrays
 
@@ -334,11 +334,9 @@ def _run_render(args):
     u = np.asarray(arrays["u"]).reshape(2, -1)[:, :mesh.nv].T
     stats = FragmentStatistics(mesh)
     scale = picture_scale(MeshArrays.from_dict(arrays).points, u)      # as the run draws it
-    plot_fragment_sizes(stats.areas, os.path.join(folder, "fragment_sizes.png"), force=True)
-    try:
-        render_png(mesh, u, stats.fragment, os.path.join(folder, "final.png"), scale=scale, force=True)
-    except RenderError as err:
-        print(f"final.png was not drawn: {err}", file=sys.stderr)
+    pictures = final_pictures(folder, mesh, u, stats, scale)
+    if "final_error" in pictures:
+        print(f"final.png was not drawn: {pictures['final_error']}", file=sys.stderr)
         return 1
     print(f"{folder}/: final.png and fragment_sizes.png of step {meta['step']} (load {meta['x']:.6g}, "
           f"{stats.count} fragments)")

@@ -43,7 +43,8 @@ from .meshio import mesh_to_arrays
 from .problem import check_mesh
 
 __all__ = ["vertex_arrays", "element_strain", "to_pyvista", "cracks_to_pyvista",
-           "TimeSeriesWriter", "RenderError", "render_png", "plot_fragment_sizes", "write_summary"]
+           "TimeSeriesWriter", "RenderError", "render_png", "plot_fragment_sizes", "final_pictures",
+           "write_summary"]
 
 
 # -- arrays ---------------------------------------------------------------------------------
@@ -691,6 +692,41 @@ def _jsonable(obj, where):
     if obj is None or isinstance(obj, (str, int, float, bool)):
         return obj
     raise TypeError(f"write_summary: {where} is a {type(obj).__name__}, which JSON cannot hold")
+
+
+def final_pictures(folder, mesh, u, stats, scale):
+    """Draw a run's ``final.png`` and ``fragment_sizes.png`` into ``folder`` (both replaced).
+
+    A picture that cannot be drawn is a fact of the output, not a failed run: the
+    fragment sizes are drawn in any case, and the returned record says why final.png is
+    missing.
+
+    Parameters
+    ----------
+    folder : path
+        The run's output folder.
+    mesh, u
+        The mesh and displacement, as for :func:`render_png`.
+    stats : FragmentStatistics
+        Fragment per triangle and fragment areas.
+    scale : float
+        Displacement magnification (:func:`picture_scale`).
+
+    Returns
+    -------
+    dict
+        ``{"final": "final.png", "displacement_scale": scale}`` or ``{"final_error": reason}``,
+        and ``"fragment_sizes": "fragment_sizes.png"`` (the ``pictures`` of summary.json).
+    """
+    folder = Path(folder)
+    try:
+        render_png(mesh, u, stats.fragment, folder / "final.png", scale=scale, force=True)
+        pictures = {"final": "final.png", "displacement_scale": scale}
+    except RenderError as err:
+        pictures = {"final_error": str(err)}
+    plot_fragment_sizes(stats.areas, folder / "fragment_sizes.png", force=True)
+    pictures["fragment_sizes"] = "fragment_sizes.png"
+    return pictures
 
 
 def write_summary(path, summary, force=False):

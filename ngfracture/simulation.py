@@ -966,21 +966,12 @@ class Simulation:
         return {**{k: v for k, v in asdict(self.control).items() if k != "max_steps"}, "contact": self.contact}
 
     def _final_outputs(self, state, prob, stats, summary):
-        from .output import RenderError, picture_scale, plot_fragment_sizes, render_png, write_summary
+        from .output import final_pictures, picture_scale, write_summary
         t0 = time.perf_counter()
         pictures = {}
-        if self.pictures != "none":
-            try:
-                scale = picture_scale(state.arrays.points, state.u)
-                render_png(prob.mesh, prob.u, stats.fragment, self.out / "final.png", scale=scale,
-                           force=True)   # ours: a resumed run redraws it
-                pictures["final"] = "final.png"
-                pictures["displacement_scale"] = scale
-            except RenderError as err:
-                pictures["final_error"] = str(err)
-            # matplotlib's import and first figure cost 2-3 s, a fifth of a plate run
-            plot_fragment_sizes(stats.areas, self.out / "fragment_sizes.png", force=True)
-            pictures["fragment_sizes"] = "fragment_sizes.png"
+        if self.pictures != "none":     # ours: a resumed run redraws them
+            pictures = final_pictures(self.out, prob.mesh, prob.u, stats,
+                                      picture_scale(state.arrays.points, state.u))
         seconds = time.perf_counter() - t0
         self.timings["output"] += seconds
         summary["timings"]["output"] = round(self.timings["output"], 6)
