@@ -33,23 +33,13 @@ Usage: python benchmarks/ensemble.py [--samples 8] [--maxh 0.12] [--workers 2] [
 """
 import argparse
 import functools
-import json
 import os
 import sys
 import tempfile
 
 import benchmark_json
 from ngfracture import scenes
-from ngfracture.ensemble import Ensemble
-
-
-def comparable(report):
-    """ensemble.json without timings and the execution block."""
-    report = json.loads(json.dumps(report))
-    report.pop("execution")
-    for s in report["samples"]:
-        s.pop("timings")
-    return report
+from ngfracture.ensemble import Ensemble, comparable_report
 
 
 def measure(workers, samples, maxh, steps):
@@ -92,7 +82,7 @@ def main(argv=None):
     many["slowdown"] = many["task_sum"] / one["task_sum"]
     many["cpu_efficiency"] = one["cpu_seconds"] / many["cpu_seconds"]
     result = {"scene": "plate", "maxh": args.maxh, "weibull_m": 8, "contact": "never", "cpu_count": os.cpu_count(),
-              "cases": [one, many], "same_result": comparable(one_report) == comparable(many_report)}
+              "cases": [one, many], "same_result": comparable_report(one_report) == comparable_report(many_report)}
     benchmark_json.write(args, result)
     return 0
 

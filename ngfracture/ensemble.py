@@ -23,7 +23,6 @@ displacement parameter (contact without gap keeps the problem homogeneous of deg
 in x); St Venant-Kirchhoff at strains ~1e-4 departs from it by that order.
 """
 import json
-import math
 import os
 import signal
 import sys
@@ -75,6 +74,30 @@ def peak_load(history):
         if h["x"] > 0 and 2 * h["elastic_energy"] / h["x"] > best:
             best, at = 2 * h["elastic_energy"] / h["x"], h["x"]
     return best, at
+
+
+def comparable_report(report):
+    """An ensemble report without what may differ between equal ensembles.
+
+    The run times of the samples and the execution block (workers, scheduler, which samples
+    were run, resumed or skipped) depend on where and when the samples ran; everything else
+    depends only on the scene, the seeds and the options.
+
+    Parameters
+    ----------
+    report : dict
+        The content of ensemble.json.
+
+    Returns
+    -------
+    dict
+        A copy (as from a JSON round trip) without ``execution`` and the samples' ``timings``.
+    """
+    report = json.loads(json.dumps(report))
+    report.pop("execution")
+    for s in report["samples"]:
+        s.pop("timings")
+    return report
 
 
 def sample_record(summary, index, seed):

@@ -18,7 +18,7 @@ import pytest
 from conftest import child_env
 
 from ngfracture import scenes
-from ngfracture.ensemble import KILL_HOOK, Ensemble
+from ngfracture.ensemble import KILL_HOOK, Ensemble, comparable_report
 from ngfracture.statistics import fit_fragment_sizes, fragment_size_statistics
 
 FACTORY = functools.partial(scenes.plate, maxh=0.15, weibull_m=8)
@@ -27,15 +27,6 @@ OPTIONS = dict(control={"max_steps": 14}, contact="never", progress=False)
 CLI_ARGS = ["ensemble", "plate", "--samples", "3", "--set", "weibull_m=8", "--set", "maxh=0.15", "--steps", "14",
             "--contact", "never", "--workers", "1", "--quiet"]
 SEEDS = [0, 1, 2]
-
-
-def comparable(report):
-    """ensemble.json without what may differ between equal ensembles: timings and the execution."""
-    report = json.loads(json.dumps(report))
-    report.pop("execution")
-    for s in report["samples"]:
-        s.pop("timings")
-    return report
 
 
 @pytest.fixture(scope="module")
@@ -59,7 +50,7 @@ def test_reference_ensemble_is_complete(reference):
 def test_one_and_two_workers_give_the_same_ensemble(reference, tmp_path):
     report = Ensemble(FACTORY, SEEDS, out=tmp_path, workers=2, **OPTIONS).run()
     assert report["execution"]["workers"] == 2
-    assert comparable(report) == comparable(reference)
+    assert comparable_report(report) == comparable_report(reference)
 
 
 def test_a_killed_worker_has_its_sample_resumed_to_the_same_result(reference, tmp_path, monkeypatch):
@@ -70,7 +61,7 @@ def test_a_killed_worker_has_its_sample_resumed_to_the_same_result(reference, tm
     report = Ensemble(FACTORY, SEEDS, out=tmp_path / "ens", workers=2, **OPTIONS).run()
     assert marker.exists()
     assert len(report["execution"]["status"]["resumed"]) == 1
-    assert comparable(report) == comparable(reference)
+    assert comparable_report(report) == comparable_report(reference)
 
 
 CHILD = """
@@ -101,7 +92,7 @@ def test_a_killed_command_reruns_without_rerunning_finished_samples(reference, t
     report = json.loads((out / "ensemble.json").read_text())
     assert 0 in report["execution"]["status"]["skipped"]
     assert first.stat().st_mtime_ns == stamp
-    assert comparable(report) == comparable(reference)
+    assert comparable_report(report) == comparable_report(reference)
     assert "3 of 3 samples finished" in capsys.readouterr().out
 
 
