@@ -319,8 +319,8 @@ class ElasticProblem:
             # linear model: f - K u by one matrix-vector product instead of an assembly
             self._res.data = K * self.u.vec
             r = -(self._res.FV().NumPy() + load * self._load.FV().NumPy())
-        elif self._kernel_data() is not None:
-            kind, mu, lam, external = self._kernel_data()
+        elif (kernel := self._kernel_data()) is not None:
+            kind, mu, lam, external = kernel
             r = _C.InternalForces(self._points, self._elements, u, kind, mu, lam)
             r = (load * external - r) if external is not None else -r
         else:
