@@ -47,6 +47,15 @@ def encircles_origin(triangles, points, members):
     return False
 
 
+def disk_pieces(result):
+    """The final fragments of a disk run, its mesh arrays, and the fragments made of disk only."""
+    stats = FragmentStatistics(result.problem.mesh)
+    a = result.state.arrays
+    disk_region = a.region_names.index("disk") + 1
+    on_disk = [f for f in stats.ids if np.all(a.regions[stats.fragment == f] == disk_region)]
+    return stats, a, on_disk
+
+
 def test_encircling_check_on_a_ring_and_a_c_shape():
     from ngfracture.scenes import cored_disk_mesh
     a = mesh_to_arrays(cored_disk_mesh(maxh=0.2))
@@ -71,7 +80,7 @@ def disk_run(request):
 
 
 def test_disk_contact_leaves_no_overlap(disk_run):
-    """Measured at maxh 0.06: 2.5e-17 (8.2e-7 without the diagonal rows at four-way
+    """Measured at maxh 0.06: 2.2e-16 (8.2e-7 without the diagonal rows at four-way
     junctions, all of it in 38 triangle pairs across their diagonals)."""
     s = disk_run[0].summary
     assert s["max_overlap_area"] <= 1e-10 * s["area_initial"]
@@ -83,7 +92,7 @@ def test_disk_comminuted_zone_and_intact_ring(disk_run):
     holds the whole outer boundary and still goes around the hole, so every grain lies
     inside it).
 
-    Measured at maxh 0.06: 95 steps, 263 split vertices, 27 grains (docs/verification.md).
+    Measured at maxh 0.06: 77 steps, 232 split vertices, 27 grains (docs/verification.md).
     Where the grains lie inside the ring (around the hole, along the radial cracks) is not
     checked: no theory bounds their radius.
     """
@@ -91,10 +100,7 @@ def test_disk_comminuted_zone_and_intact_ring(disk_run):
     assert result.ok and result.reason == "load_max", result.message
     s = result.summary
     assert s["area_final"] == s["area_initial"]
-    a = result.state.arrays
-    stats = FragmentStatistics(result.problem.mesh)
-    disk_region = a.region_names.index("disk") + 1
-    on_disk = [f for f in stats.ids if np.all(a.regions[stats.fragment == f] == disk_region)]
+    stats, a, on_disk = disk_pieces(result)
     ring = max(on_disk, key=lambda f: stats.areas[np.searchsorted(stats.ids, f)])
     grains = [f for f in on_disk if f != ring]
     assert len(grains) > min_grains, len(grains)
@@ -117,10 +123,7 @@ def test_disintegration_falls_apart_on_a_coarse_mesh():
     assert result.ok and result.reason == "load_max", result.message
     s = result.summary
     assert s["max_overlap_area"] <= 1e-10 * s["area_initial"]
-    stats = FragmentStatistics(result.problem.mesh)
-    a = result.state.arrays
-    disk_region = a.region_names.index("disk") + 1
-    on_disk = [f for f in stats.ids if np.all(a.regions[stats.fragment == f] == disk_region)]
+    stats, a, on_disk = disk_pieces(result)
     assert len(on_disk) >= 2
     assert not any(encircles_origin(a.triangles, a.points, np.flatnonzero(stats.fragment == f)) for f in on_disk)
     assert s["area_final"] == s["area_initial"]
@@ -140,10 +143,7 @@ def test_disintegration_many_disjoint_fragments(maxh):
     assert result.ok and result.reason == "load_max", result.message
     s = result.summary
     assert s["max_overlap_area"] <= 1e-10 * s["area_initial"]
-    stats = FragmentStatistics(result.problem.mesh)
-    a = result.state.arrays
-    disk_region = a.region_names.index("disk") + 1
-    on_disk = [f for f in stats.ids if np.all(a.regions[stats.fragment == f] == disk_region)]
+    stats, a, on_disk = disk_pieces(result)
     assert len(on_disk) > 20
     # no piece of the disk goes around the hole any more
     assert not any(encircles_origin(a.triangles, a.points, np.flatnonzero(stats.fragment == f)) for f in on_disk)
