@@ -1,8 +1,8 @@
-"""The benchmarks' common output options: ``--json FILE`` and ``--force``.
+"""The benchmarks' common outputs: ``--json FILE``, ``--force`` and plots.
 
 Every benchmark writes its result as JSON, to stdout or, with ``--json FILE``, atomically
-to FILE (``ngfracture.cli.write_json_atomic``). An existing FILE is refused before any
-measurement unless ``--force``: a benchmark can run for hours, and a finished result is
+to FILE (``ngfracture.cli.write_json_atomic``). An existing FILE (or plot) is refused before
+any measurement unless ``--force``: a benchmark can run for hours, and a finished result is
 not overwritten by mistake.
 """
 import json
@@ -24,6 +24,16 @@ def refuse_existing(parser, args, *more_paths):
     for path in (args.json, *more_paths):
         if path is not None and os.path.exists(path) and not args.force:
             parser.error(f"{path} exists; pass --force to overwrite it")
+
+
+def save_figure(fig, path):
+    """Save a matplotlib figure as PNG at ``path`` atomically (a temporary file, then a rename)
+    and close it."""
+    import matplotlib.pyplot as plt
+    tmp = f"{path}.tmp.png"
+    fig.savefig(tmp, dpi=120)
+    plt.close(fig)
+    os.replace(tmp, path)
 
 
 def write(args, result):

@@ -35,7 +35,6 @@ paper (relative L2 error against number of vertices, log-log).
 """
 import argparse
 import gc
-import os
 import sys
 import time
 
@@ -179,10 +178,7 @@ def plot_fig6b(cases, path):
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
     fig.tight_layout()
-    tmp = f"{path}.tmp.png"
-    fig.savefig(tmp, dpi=120)
-    plt.close(fig)
-    os.replace(tmp, path)
+    benchmark_json.save_figure(fig, path)
 
 
 def main(argv=None):

@@ -21,7 +21,6 @@ Usage::
 Without ``--json`` the JSON goes to stdout.
 """
 import argparse
-import json
 import os
 import sys
 import time
@@ -32,7 +31,9 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."
 from critical_distance_util import plate_initiation   # noqa: E402  (shared with the tests)
 
 from ngfracture import scenes   # noqa: E402
-from ngfracture.cli import _int_at_least, write_json_atomic   # noqa: E402
+from ngfracture.cli import _int_at_least   # noqa: E402
+
+import benchmark_json   # noqa: E402
 from ngfracture.simulation import Simulation   # noqa: E402
 
 NOTCH_TO_NOTCH = 0.92
@@ -102,10 +103,7 @@ def plot(result, path):
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=8)
     fig.tight_layout()
-    tmp = f"{path}.tmp.png"
-    fig.savefig(tmp, dpi=120)
-    plt.close(fig)
-    os.replace(tmp, path)
+    benchmark_json.save_figure(fig, path)
 
 
 def _positive_float(text):
@@ -118,27 +116,19 @@ def _positive_float(text):
 def main(argv=None):
     parser = argparse.ArgumentParser(description="Mesh objectivity of the crack criterion on the "
                                                  "notched plate: one-ring vs critical distance.")
-    parser.add_argument("--json", metavar="FILE", help="write the JSON here (atomically); refused "
-                        "if FILE exists, unless --force")
+    benchmark_json.add_options(parser, force_help="overwrite existing output files")
     parser.add_argument("--plot", metavar="FILE", help="write the refinement plot as PNG")
-    parser.add_argument("--force", action="store_true", help="overwrite existing output files")
     parser.add_argument("--radius", type=_positive_float, default=0.02, help="critical distance r")
     parser.add_argument("--levels", type=_int_at_least(2), default=3,
                         help="initiation levels h = r/2 ... r/2^levels (default 3)")
     parser.add_argument("--crack-maxh", type=_positive_float, nargs="*", default=[0.034],
                         help="mesh sizes of the plate simulations (default 0.034; none: skip)")
     args = parser.parse_args(argv)
-    for path in (args.json, args.plot):
-        if path is not None and os.path.exists(path) and not args.force:
-            parser.error(f"{path} exists; pass --force to overwrite it")
+    benchmark_json.refuse_existing(parser, args, args.plot)
     result = {"problem": "notched plate", "radius": args.radius,
               "initiation": initiation(args.radius, args.levels),
               "crack": crack(args.radius, sorted(args.crack_maxh, reverse=True))}
-    if args.json:
-        write_json_atomic(args.json, result, force=args.force)
-    else:
-        json.dump(result, sys.stdout, indent=2)
-        print()
+    benchmark_json.write(args, result)
     if args.plot:
         plot(result, args.plot)
     return 0

@@ -8,7 +8,7 @@ import pytest
 from conftest import child_env
 
 ROOT = Path(__file__).resolve().parent.parent
-BENCHMARKS = ["contact", "crack", "ensemble", "lshape", "meshcheck", "scenes"]
+BENCHMARKS = ["contact", "crack", "ensemble", "lshape", "meshcheck", "objectivity", "scenes"]
 
 
 def run_benchmark(name, *args):
