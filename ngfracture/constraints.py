@@ -131,6 +131,7 @@ class ConstraintSet:
         self.dirichlet = []
         self.points = []
         self.rows = []  # (C, g, label)
+        self._dofs_on = {}  # boundary names -> scalar dofs: the space never changes, assembly repeats
 
     # -- adding constraints (validated at once, before any assembly) ----------------
     def add_dirichlet(self, boundaries, value=(0.0, 0.0), component=None):
@@ -280,9 +281,12 @@ class ConstraintSet:
         Read from the boundary elements: converting the space's BitArray to numpy
         iterates over every dof (0.13 s at 360k dofs).
         """
-        names = set(names)
-        dofs = [d for el in self.fes.Elements(ng.BND) if el.mat in names for d in el.dofs if 0 <= d < n]
-        return np.unique(np.array(dofs, dtype=np.int64))
+        key = tuple(sorted(set(names)))
+        if key not in self._dofs_on:
+            names = set(key)
+            dofs = [d for el in self.fes.Elements(ng.BND) if el.mat in names for d in el.dofs if 0 <= d < n]
+            self._dofs_on[key] = np.unique(np.array(dofs, dtype=np.int64))
+        return self._dofs_on[key]
 
     @staticmethod
     def _merge(values, dofs, vals, source, tol):

@@ -66,6 +66,7 @@ detect-and-solve loops use tol > 0 (0.1 h worked in the tests); the rows with a 
 gap it adds are what the active set must release when their multiplier is adhesive.
 """
 from dataclasses import dataclass
+import functools
 
 import numpy as np
 import scipy.linalg as sla
@@ -98,10 +99,18 @@ class ContactConstraints:
         Signed distance at the predicted configuration (negative = penetration).
     angle : numpy.ndarray, shape (m,)
         Rule-3 angle (radians) between master edge and slave edges.
-    C : scipy.sparse.csr_matrix, shape (m, 2 nv)
-        Gap rows (component-blocked dofs).
     g : numpy.ndarray, shape (m,)
         Constant part: C u + g is the linearised signed gap.
+    nv : int
+        Number of vertices (C has 2 nv columns).
+
+    Attributes
+    ----------
+    C : scipy.sparse.csr_matrix, shape (m, 2 nv)
+        Gap rows (component-blocked dofs), :func:`gap_rows` of slave, a, c, xi and normal;
+        built at first use and kept. Selecting and stacking rows never touches it: the
+        contact rounds select and stack rows tens of times per solve and use few of the
+        matrices.
     """
     slave: np.ndarray
     a: np.ndarray
@@ -113,11 +122,16 @@ class ContactConstraints:
     normal: np.ndarray
     dist: np.ndarray
     angle: np.ndarray
-    C: sp.csr_matrix
     g: np.ndarray
+    nv: int
 
     def __len__(self):
         return len(self.g)
+
+    @functools.cached_property
+    def C(self):
+        """The gap rows as a sparse matrix, shape (m, 2 nv), built at first use (see the class)."""
+        return _gap_matrix(self.slave, self.a, self.c, self.xi, self.normal, self.nv)
 
     @classmethod
     def stack(cls, parts):
@@ -132,12 +146,16 @@ class ContactConstraints:
         -------
         ContactConstraints
             The rows of ``parts[0]``, then those of ``parts[1]``, ...
+
+        Raises
+        ------
+        ValueError
+            Parts of meshes with different numbers of vertices.
         """
-        fields = ("slave", "a", "c", "master_tri", "slave_tri", "pair", "xi", "normal",
-                  "dist", "angle")
-        return cls(*(np.concatenate([getattr(p, f) for p in parts]) for f in fields),
-                   C=sp.vstack([p.C for p in parts]).tocsr(),
-                   g=np.concatenate([p.g for p in parts]))
+        nv = parts[0].nv
+        if any(p.nv != nv for p in parts):
+            raise ValueError(f"ContactConstraints.stack: rows of meshes with {sorted(set(p.nv for p in parts))} vertices")
+        return cls(*(np.concatenate([getattr(p, f) for p in parts]) for f in _ROW_FIELDS), nv=nv)
 
     def subset(self, rows):
         """The constraints ``rows`` (an index array or boolean mask), C and g included.
@@ -155,19 +173,18 @@ class ContactConstraints:
         rows = np.asarray(rows)
         if rows.dtype != bool:
             rows = rows.astype(np.int64)
-        return ContactConstraints(
-            *(getattr(self, f)[rows] for f in
-              ("slave", "a", "c", "master_tri", "slave_tri", "pair", "xi", "normal",
-               "dist", "angle")),
-            C=self.C[rows], g=self.g[rows])
+        return ContactConstraints(*(getattr(self, f)[rows] for f in _ROW_FIELDS), nv=self.nv)
 
 
 def _no_constraints(nv):
     e = np.zeros(0, dtype=np.int32)
     f = np.zeros(0)
     return ContactConstraints(slave=e, a=e, c=e, master_tri=e, slave_tri=e, pair=e, xi=f,
-                              normal=np.zeros((0, 2)), dist=f, angle=f,
-                              C=sp.csr_matrix((0, 2 * nv)), g=f)
+                              normal=np.zeros((0, 2)), dist=f, angle=f, g=f, nv=nv)
+
+
+#: the per-row arrays of ContactConstraints, in constructor order
+_ROW_FIELDS = ("slave", "a", "c", "master_tri", "slave_tri", "pair", "xi", "normal", "dist", "angle", "g")
 
 
 def gap_rows(coords, slave, a, c, xi, normal):
@@ -209,16 +226,31 @@ def gap_rows(coords, slave, a, c, xi, normal):
     for name, v in (("slave", slave), ("a", a), ("c", c)):
         if m and (v.min() < 0 or v.max() >= nv):
             raise ValueError(f"{name} holds vertex indices outside [0, {nv})")
-    w = np.stack([np.ones(m), -xi, xi - 1.0], axis=1)          # weights of b, a, c
-    verts = np.stack([slave, a, c], axis=1)
+    return _gap_matrix(slave, a, c, xi, n, nv), _gap_offset(X, slave, a, c, xi, n)
+
+
+def _gap_weights(xi):
+    return np.stack([np.ones(len(xi)), -xi, xi - 1.0], axis=1)     # weights of b, a, c
+
+
+def _gap_matrix(slave, a, c, xi, n, nv):
+    """C of :func:`gap_rows`, for arrays already checked."""
+    m = len(slave)
+    w = _gap_weights(xi)
+    verts = np.stack([slave, a, c], axis=1).astype(np.int64)
     rows = np.repeat(np.arange(m), 6)
     cols = np.concatenate([verts, verts + nv], axis=1).ravel()  # x dofs, then y dofs
     vals = np.concatenate([w * n[:, :1], w * n[:, 1:]], axis=1).ravel()
     C = sp.csr_matrix((vals, (rows, cols)), shape=(m, 2 * nv))
     C.eliminate_zeros()                                          # xi = 0 or 1: node-to-node
-    pos = np.einsum("ij,ijk->ik", w, X[verts])                   # X_b - xi X_a - (1-xi) X_c
-    g = np.einsum("ij,ij->i", pos, n)
-    return C, g
+    return C
+
+
+def _gap_offset(X, slave, a, c, xi, n):
+    """g of :func:`gap_rows`, for arrays already checked."""
+    verts = np.stack([slave, a, c], axis=1)
+    pos = np.einsum("ij,ijk->ik", _gap_weights(xi), X[verts])      # X_b - xi X_a - (1-xi) X_c
+    return np.einsum("ij,ij->i", pos, n)
 
 
 def select_contacts(coords, displacement, tris, boundary_edges, pairs, tol=0.0,
@@ -290,11 +322,11 @@ def select_contacts(coords, displacement, tris, boundary_edges, pairs, tol=0.0,
     xi = geo[:, 0]
     xi[xi < xi_snap] = 0.0
     xi[xi > 1.0 - xi_snap] = 1.0
-    C, g = gap_rows(X, ids[:, 0], ids[:, 1], ids[:, 2], geo[:, 0], geo[:, 1:3])
     return ContactConstraints(
         slave=ids[:, 0], a=ids[:, 1], c=ids[:, 2], master_tri=ids[:, 3],
         slave_tri=ids[:, 4], pair=ids[:, 5], xi=geo[:, 0], normal=geo[:, 1:3].copy(),
-        dist=geo[:, 3], angle=geo[:, 4], C=C, g=g)
+        dist=geo[:, 3], angle=geo[:, 4],
+        g=_gap_offset(X, ids[:, 0], ids[:, 1], ids[:, 2], geo[:, 0], geo[:, 1:3]), nv=X.shape[0])
 
 
 def _unit_rows(M):

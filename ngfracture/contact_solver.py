@@ -481,6 +481,7 @@ class ContactSolver:
             result.rounds = rnd
             t0 = time.perf_counter()
             U = vertex_displacement(prob.u)
+            at_U = None      # the rows of the last round, all linearised at U (when made)
             if seam_rows is None:
                 # built once, at the predicted configuration, and frozen for this solve
                 seam_rows, k = seam_constraints(seams, arrays.points, U, kink_angle=self.kink_angle)
@@ -491,8 +492,8 @@ class ContactSolver:
                 # every row at the configuration just solved: the gaps the set update
                 # judges are those of this configuration, to second order in the last step
                 old = contact.ContactConstraints.stack([seam_rows, n2s])
-                fresh = _refreshed(old, self._relinearised(old, len(seam_keys), seam_keys, seams, arrays.points, U),
-                                   U, 0.01 * self.penetration_tol)
+                at_U = self._relinearised(old, len(seam_keys), seam_keys, seams, arrays.points, U)
+                fresh = _refreshed(old, at_U, U, 0.01 * self.penetration_tol)
                 seam_rows = fresh.subset(np.arange(len(seam_keys)))
                 n2s = fresh.subset(np.arange(len(seam_keys), len(fresh)))
             # node-to-segment rows: a row keeps the linearisation it was found with while
@@ -539,7 +540,16 @@ class ContactSolver:
                 # settled for the rows as linearised; re-linearised at the solution, their
                 # gaps are the true ones of this configuration
                 t0 = time.perf_counter()
-                fresh = self._relinearised(pool, len(seam_keys), seam_keys, seams, arrays.points, U)
+                if at_U is None:
+                    fresh = self._relinearised(pool, len(seam_keys), seam_keys, seams, arrays.points, U)
+                else:
+                    # the rows of the last round were re-linearised at this U when the round
+                    # began (a row re-linearised twice at one U is the same, bit for bit):
+                    # only the rows found in this round are new
+                    fresh = contact.ContactConstraints.stack([
+                        at_U.subset(np.concatenate([np.arange(len(seam_keys)),
+                                                    len(seam_keys) + np.array(old, dtype=np.int64)])),
+                        relinearise_node_to_segment(found.subset(new), arrays.points, U)])
                 gap = fresh.C @ U.T.ravel() + fresh.g
                 penetration = float(max(0.0, -gap[other].min(initial=0.0)))
                 result.timings["contact"] += time.perf_counter() - t0
@@ -623,10 +633,10 @@ def relinearise_node_to_segment(cs, X, U):
     n *= np.where(np.einsum("ij,ij->i", n, cs.normal) < 0, -1.0, 1.0)[:, None]
     t = np.einsum("ij,ij->i", x[cs.slave] - x[cs.a], e) / length2
     xi = np.where((cs.xi == 0.0) | (cs.xi == 1.0), cs.xi, np.clip(1.0 - t, 0.0, 1.0))
-    C, g = contact.gap_rows(X, cs.slave, cs.a, cs.c, xi, n)
     dist = np.einsum("ij,ij->i", x[cs.slave] - xi[:, None] * x[cs.a] - (1 - xi)[:, None] * x[cs.c], n)
     return contact.ContactConstraints(cs.slave, cs.a, cs.c, cs.master_tri, cs.slave_tri, cs.pair, xi, n,
-                                      dist, cs.angle, C, g)
+                                      dist, cs.angle, contact._gap_offset(X, cs.slave, cs.a, cs.c, xi, n),
+                                      nv=len(X))
 
 
 def reachable(cs, U, tol):

@@ -43,7 +43,6 @@ import math
 import netgen.geom2d
 import ngsolve as ng
 import numpy as np
-from scipy.optimize import brentq
 
 from .materials import lame_parameters
 
@@ -72,6 +71,8 @@ def singular_exponent(omega=OMEGA):
     ValueError
         If omega is not in (pi/2, pi) (then there is no singular root in (0, 1)).
     """
+    from scipy.optimize import brentq   # here: scipy.optimize costs 0.2 s of every command's start
+
     if not math.pi / 2 < omega < math.pi:
         raise ValueError(f"omega must lie in (pi/2, pi), got {omega!r}")
     f = lambda a: a * math.sin(2.0 * omega) + math.sin(2.0 * omega * a)

@@ -606,10 +606,11 @@ def fragment_size_bins(areas):
 
 
 def plot_fragment_sizes(areas, path, force=False, title="Fragment-size distribution"):
-    """Histogram and cumulative distribution of fragment areas, log scale (matplotlib, Agg).
+    """Histogram and cumulative distribution of fragment areas (matplotlib, Agg).
 
     Left: number of fragments per logarithmic area bin. Right: fraction of fragments with
-    area >= A (the complementary cumulative distribution), log-log.
+    area >= A (the complementary cumulative distribution). Axes whose values span a decade
+    or more are logarithmic.
 
     Parameters
     ----------
@@ -636,6 +637,7 @@ def plot_fragment_sizes(areas, path, force=False, title="Fragment-size distribut
     """
     from matplotlib.figure import Figure   # no pyplot: no global backend, no display
     from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.ticker import LogFormatter, NullFormatter
     A = np.asarray(areas, dtype=float).ravel()
     if A.size == 0:
         raise ValueError("plot_fragment_sizes: no fragment areas")
@@ -651,15 +653,22 @@ def plot_fragment_sizes(areas, path, force=False, title="Fragment-size distribut
     # fixed margins: the constrained layout engine took 2 s of a 20 s plate run
     fig.subplots_adjust(left=0.07, right=0.98, bottom=0.13, top=0.88, wspace=0.3)
     ax1.hist(A, bins=bins, color="tab:blue", edgecolor="black", linewidth=0.5)
-    ax1.set_xscale("log")
     ax1.set_xlabel("fragment area")
     ax1.set_ylabel("number of fragments")
     s = np.sort(A)
-    ax2.step(s, 1.0 - np.arange(A.size) / A.size, where="post", color="tab:red")
-    ax2.set_xscale("log")
-    ax2.set_yscale("log")
+    fraction = 1.0 - np.arange(A.size) / A.size
+    ax2.step(s, fraction, where="post", color="tab:red")
     ax2.set_xlabel("fragment area A")
     ax2.set_ylabel("fraction of fragments with area >= A")
+    # log axes where the values span a decade or more, with plain tick labels ("0.001"):
+    # matplotlib's default "10^-3" goes through its TeX parser, which took longer than the
+    # rest of the figure; a log axis over less than a decade would have no labelled tick
+    for ax, which, values in ((ax1, "x", bins), (ax2, "x", s), (ax2, "y", fraction)):
+        if values.max() >= 10 * values.min():
+            axis = ax.xaxis if which == "x" else ax.yaxis
+            ax.set_xscale("log") if which == "x" else ax.set_yscale("log")
+            axis.set_major_formatter(LogFormatter())
+            axis.set_minor_formatter(NullFormatter())
     fig.suptitle(f"{title} ({A.size} fragments)")
     buf = io.BytesIO()
     fig.savefig(buf, format=path.suffix.lstrip(".") or "png", dpi=120)

@@ -60,7 +60,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .contact import ContactConstraints, gap_rows
+from .contact import ContactConstraints, _gap_offset
 
 __all__ = ["Seams", "find_seams", "seam_constraints", "KINK_ANGLE", "SLIP"]
 
@@ -336,11 +336,11 @@ def _facing(x, master, slave, normal, reach):
 
 
 def _rows(X, x, master, slave, normal):
-    C, g = gap_rows(X, slave, master, master, np.ones(len(slave)), normal)
     m = len(slave)
+    normal = np.asarray(normal, float).reshape(-1, 2)
+    slave, master = np.asarray(slave, np.int64), np.asarray(master, np.int64)
     none = np.full(m, -1, dtype=np.int64)
     dist = np.einsum("ij,ij->i", x[slave] - x[master], normal) if m else np.zeros(0)
-    return ContactConstraints(slave=np.asarray(slave, np.int64), a=np.asarray(master, np.int64),
-                              c=np.asarray(master, np.int64), master_tri=none, slave_tri=none,
-                              pair=none, xi=np.ones(m), normal=np.asarray(normal, float).reshape(-1, 2),
-                              dist=dist, angle=np.zeros(m), C=C, g=g)
+    return ContactConstraints(slave=slave, a=master, c=master, master_tri=none, slave_tri=none,
+                              pair=none, xi=np.ones(m), normal=normal, dist=dist, angle=np.zeros(m),
+                              g=_gap_offset(X, slave, master, master, np.ones(m), normal), nv=len(X))
