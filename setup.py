@@ -60,6 +60,7 @@ setup(
         "scipy",
         "pyvista",
         "matplotlib",
+        "pillow",          # final.png: a raster of the triangles (already a dependency of matplotlib)
         "threadpoolctl",   # one BLAS thread for the small dense solves (see README)
         # ensembles of runs (ngfracture.ensemble): a maintained distributed engine with a
         # LocalCluster, rescheduling of the tasks of a dead worker, and cluster deployments

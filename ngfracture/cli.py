@@ -334,7 +334,7 @@ def _run_render(args):
     u = np.asarray(arrays["u"]).reshape(2, -1)[:, :mesh.nv].T
     stats = FragmentStatistics(mesh)
     scale = picture_scale(MeshArrays.from_dict(arrays).points, u)      # as the run draws it
-    pictures = final_pictures(folder, mesh, u, stats, scale)
+    pictures = final_pictures(folder, mesh, u, stats, scale, sizes_min_fragments=1)   # asked for: both
     if "final_error" in pictures:
         print(f"final.png was not drawn: {pictures['final_error']}", file=sys.stderr)
         return 1

@@ -564,6 +564,10 @@ class ConstrainedSolver:
         self._tmp = factor.K.CreateColVector()
         self.C = sp.csr_matrix(C)
         self.m = self.C.shape[0]
+        # kept: every solve and its refinement use them (thousands of solves per run);
+        # |C| at its first use (abs() sorts C's indices in place, which would change the
+        # order of the sums in the Schur columns)
+        self._Ct, self._C_abs = self.C.T, None
         # all vectors below are full length: zero at fixed dofs (R, Z) and pins (Z)
         self._R = (sp.csr_matrix(modes) if modes is not None and modes.shape[1]
                    else sp.csr_matrix((self.ndof, 0)))
@@ -588,6 +592,7 @@ class ConstrainedSolver:
         factor.factorise()        # here, outside a TaskManager (see EliminatedFactor.factorise)
         if self.m:
             self._R, A = factor.corrected_modes(self._R)
+            self._Rt = self._R.T
             self._Z = factor.columns(self.C)
             S = self.C @ self._Z
             S = 0.5 * (S + S.T)
@@ -664,7 +669,7 @@ class ConstrainedSolver:
                 Kabs = abs(self.factor._free_block) @ np.abs(du[free])
                 force_size = (np.linalg.norm(Kabs) + np.linalg.norm((abs(self.C.T) @ np.abs(lam))[free])
                               + np.linalg.norm(r[free]) + np.linalg.norm(q[free]))
-                rows_size = np.linalg.norm(h) + np.linalg.norm(abs(self.C) @ np.abs(du))
+                rows_size = np.linalg.norm(h) + np.linalg.norm(self._C_abs @ np.abs(du))
                 error = max(np.linalg.norm(res) / max(force_size, 1e-300), np.linalg.norm(res_rows) / max(rows_size, 1e-300))
                 if not error < 1e-6:
                     raise SingularSystem(f"the constrained system is singular or too badly conditioned "
@@ -682,7 +687,7 @@ class ConstrainedSolver:
         q, du = self._unconstrained(r, du_fixed)
         lam = np.zeros(self.m)
         if self.m:
-            rhs = np.concatenate([self.C @ du - h, -(self._R.T @ q)])
+            rhs = np.concatenate([self.C @ du - h, -(self._Rt @ q)])
             sol = self._scale * sla.lu_solve(self._coarse, self._scale * rhs)
             lam, alpha = sol[:self.m], sol[self.m:]
             du -= self._Z @ lam
@@ -716,12 +721,14 @@ class ConstrainedSolver:
         default plate: half of all solves refined twice for nothing)."""
         self._tmp.FV().NumPy()[:] = du
         Kdu = (self.K * self._tmp).Evaluate().FV().NumPy()
-        Ct_lam = self.C.T @ lam
+        Ct_lam = self._Ct @ lam
         free = self.free
         res = np.where(free, r - Kdu - Ct_lam, 0.0)
         Cdu = self.C @ du
         force_scale = (np.linalg.norm(r[free]) + np.linalg.norm(Kdu[free]) + np.linalg.norm(Ct_lam[free]))
-        row_scale = np.linalg.norm(h) + np.linalg.norm(abs(self.C) @ np.abs(du))
+        if self._C_abs is None:
+            self._C_abs = abs(self.C)
+        row_scale = np.linalg.norm(h) + np.linalg.norm(self._C_abs @ np.abs(du))
         return res, h - Cdu, max(force_scale, 1e-300), max(row_scale, 1e-300)
 
     def _unconstrained(self, r, du_fixed):

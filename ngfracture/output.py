@@ -44,7 +44,7 @@ from .problem import check_mesh
 
 __all__ = ["vertex_arrays", "element_strain", "to_pyvista", "cracks_to_pyvista",
            "TimeSeriesWriter", "RenderError", "render_png", "plot_fragment_sizes", "final_pictures",
-           "write_summary"]
+           "SIZES_MIN_FRAGMENTS", "write_summary"]
 
 
 # -- arrays ---------------------------------------------------------------------------------
@@ -172,36 +172,82 @@ def to_pyvista(mesh, u=None, fragment=None, strain="green", point_data=None, cel
         Arrays whose length does not fit the mesh, non-finite displacement.
     """
     import pyvista as pv
+    return pv.wrap(_vtk_mesh(mesh, u, fragment, strain, point_data, cell_data, arrays))
+
+
+def _vtk_mesh(mesh, u=None, fragment=None, strain="green", point_data=None, cell_data=None, arrays=None):
+    """The vtkUnstructuredGrid of :func:`to_pyvista` (plain VTK: the time series writes it
+    without importing pyvista, a fifth of a small run's output time)."""
     a = arrays if arrays is not None else vertex_arrays(mesh)
     ne, nv = len(a.triangles), len(a.points)
-    cells = np.column_stack([np.full(ne, 3, dtype=np.int64), a.triangles]).ravel()
-    grid = pv.UnstructuredGrid(cells, np.full(ne, pv.CellType.TRIANGLE, dtype=np.uint8),
-                               _pad3(a.points))
-    grid.cell_data["region"] = a.regions - 1     # 0-based index into region_names
-    grid.field_data["region_names"] = np.array(a.region_names if a.region_names else [""])
+    cells, points = {}, {}
+    cells["region"] = a.regions - 1     # 0-based index into region_names
     if fragment is not None:
         f = np.asarray(fragment)
         if f.shape != (ne,) or not np.issubdtype(f.dtype, np.integer):
             raise ValueError(f"ngfracture.output: fragment must be {ne} integers (one per "
                              f"triangle), got shape {f.shape} dtype {f.dtype}")
-        grid.cell_data["fragment"] = f
+        cells["fragment"] = f
     if u is not None:
         U = _displacement(mesh, u)
-        grid.point_data["displacement"] = _pad3(U)
+        points["displacement"] = _pad3(U)
         if strain is not None:
             E = element_strain(mesh, U, strain, a)
             val, d = crack.principal(E)
-            grid.cell_data["strain"] = _tensor9(E)
-            grid.cell_data["principal_strain"] = val
-            grid.cell_data["principal_direction"] = _pad3(d)
+            cells["strain"] = _tensor9(E)
+            cells["principal_strain"] = val
+            cells["principal_direction"] = _pad3(d)
             En = crack.vertex_strain(mesh, U, strain)
             val, d = crack.principal(En)
-            grid.point_data["nodal_strain"] = _tensor9(En)
-            grid.point_data["nodal_principal_strain"] = val
-            grid.point_data["nodal_principal_direction"] = _pad3(d)
-    _add_user_data(grid.point_data, point_data, nv, "point_data")
-    _add_user_data(grid.cell_data, cell_data, ne, "cell_data")
+            points["nodal_strain"] = _tensor9(En)
+            points["nodal_principal_strain"] = val
+            points["nodal_principal_direction"] = _pad3(d)
+    _add_user_data(points, point_data, nv, "point_data")
+    _add_user_data(cells, cell_data, ne, "cell_data")
+    from vtkmodules.vtkCommonDataModel import vtkUnstructuredGrid
+    grid = vtkUnstructuredGrid()
+    _fill_vtk(grid, a.points, a.triangles, points, cells, a.region_names if a.region_names else [""])
     return grid
+
+
+def _fill_vtk(data, points, cells, point_data, cell_data, region_names=None):
+    """Points (z = 0), cells of one kind (triangles: 3 columns, lines: 2), arrays and the
+    field data ``region_names`` into a vtkUnstructuredGrid or vtkPolyData. The first point
+    and cell arrays are the active scalars (what ParaView colours by at first)."""
+    from vtkmodules.util.numpy_support import numpy_to_vtk
+    from vtkmodules.vtkCommonCore import VTK_ID_TYPE, vtkPoints, vtkStringArray
+    from vtkmodules.vtkCommonDataModel import VTK_TRIANGLE, vtkCellArray
+
+    def array(name, values):
+        v = np.ascontiguousarray(values)
+        arr = numpy_to_vtk(v.astype(np.uint8) if v.dtype == bool else v, deep=True)
+        arr.SetName(name)
+        return arr
+
+    pts = vtkPoints()
+    pts.SetData(numpy_to_vtk(np.ascontiguousarray(_pad3(points), dtype=np.float64), deep=True))
+    data.SetPoints(pts)
+    corners = cells.shape[1]
+    offsets = np.arange(0, corners * len(cells) + 1, corners, dtype=np.int64)
+    cell_array = vtkCellArray()
+    cell_array.SetData(numpy_to_vtk(offsets, deep=True, array_type=VTK_ID_TYPE),
+                       numpy_to_vtk(np.ascontiguousarray(cells, dtype=np.int64).ravel(), deep=True,
+                                    array_type=VTK_ID_TYPE))
+    if corners == 3:
+        data.SetCells(VTK_TRIANGLE, cell_array)
+    else:
+        data.SetLines(cell_array)
+    for attributes, arrays in ((data.GetPointData(), point_data), (data.GetCellData(), cell_data)):
+        for i, (name, values) in enumerate(arrays.items()):
+            attributes.AddArray(array(name, values))
+            if i == 0:
+                attributes.SetActiveScalars(name)
+    if region_names is not None:
+        names = vtkStringArray()
+        names.SetName("region_names")
+        for n in region_names:
+            names.InsertNextValue(n)
+        data.GetFieldData().AddArray(names)
 
 
 def cracks_to_pyvista(mesh, u=None, boundary="crack", arrays=None):
@@ -231,19 +277,22 @@ def cracks_to_pyvista(mesh, u=None, boundary="crack", arrays=None):
         Not a 2D triangle mesh, or a displacement that does not fit it.
     """
     import pyvista as pv
+    return pv.wrap(_vtk_cracks(mesh, u, boundary, arrays))
+
+
+def _vtk_cracks(mesh, u=None, boundary="crack", arrays=None):
+    """The vtkPolyData of :func:`cracks_to_pyvista` (plain VTK, see :func:`_vtk_mesh`)."""
+    from vtkmodules.vtkCommonDataModel import vtkPolyData
     a = arrays if arrays is not None else vertex_arrays(mesh)
     seg = a.boundary_segments(boundary)
+    poly = vtkPolyData()
+    if len(seg) == 0:
+        return poly
     used, local = np.unique(seg, return_inverse=True)
-    local = local.reshape(seg.shape)
-    if len(seg):
-        # points and lines together: PolyData(points) alone would add a vertex cell per point
-        poly = pv.PolyData(_pad3(a.points[used]),
-                           lines=np.column_stack([np.full(len(seg), 2, dtype=np.int64), local]).ravel())
-    else:
-        return pv.PolyData()          # pyvista refuses empty (0, 3) point arrays
-    poly.point_data["vertex"] = used
+    points = {"vertex": used}
     if u is not None:
-        poly.point_data["displacement"] = _pad3(_displacement(mesh, u)[used])
+        points["displacement"] = _pad3(_displacement(mesh, u)[used])
+    _fill_vtk(poly, a.points[used], local.reshape(seg.shape), points, {})
     return poly
 
 
@@ -286,13 +335,26 @@ def _publish(tmp, path, force):
     _fsync_dir(Path(path).parent)
 
 
+#: compression of the binary VTK arrays -> the VTK writer's setter
+_COMPRESSIONS = {"lz4": "SetCompressorTypeToLZ4", "zlib": "SetCompressorTypeToZLib",
+                 "lzma": "SetCompressorTypeToLZMA", None: "SetCompressorTypeToNone"}
+
+
 def _save_vtk(obj, path, compression):
-    """Save a pyvista object through a temp file in the same folder, then rename."""
+    """Save a vtkUnstructuredGrid (.vtu) or vtkPolyData (.vtp), binary, through a temp
+    file in the same folder, then rename."""
+    from vtkmodules.vtkIOXML import vtkXMLPolyDataWriter, vtkXMLUnstructuredGridWriter
     path = Path(path)
+    writer = vtkXMLUnstructuredGridWriter() if path.suffix == ".vtu" else vtkXMLPolyDataWriter()
+    writer.SetDataModeToBinary()
+    getattr(writer, _COMPRESSIONS[compression])()
+    writer.SetInputData(obj)
     fd, tmp = tempfile.mkstemp(prefix=".tmp_ngf_", suffix=path.suffix, dir=path.parent)
     os.close(fd)
     try:
-        obj.save(tmp, binary=True, compression=compression)
+        writer.SetFileName(tmp)
+        if writer.Write() != 1:
+            raise OSError(f"ngfracture.output: VTK could not write {path.name}")
         os.replace(tmp, path)
     except BaseException:
         if os.path.exists(tmp):
@@ -336,7 +398,8 @@ class TimeSeriesWriter:
     FileNotFoundError
         ``resume`` on a folder without ``results.pvd``, or a step file it lists is missing.
     ValueError
-        ``force`` together with ``resume``; ``last_step`` without ``resume``; with
+        ``force`` together with ``resume``; ``last_step`` without ``resume``; an unknown
+        ``compression``; with
         ``resume``, a ``results.pvd`` that is not valid XML or lists foreign files.
     """
 
@@ -350,6 +413,8 @@ class TimeSeriesWriter:
             raise ValueError("TimeSeriesWriter: force=True deletes results, resume=True keeps them; choose one")
         if last_step is not None and not resume:
             raise ValueError("TimeSeriesWriter: last_step is only meaningful with resume=True")
+        if compression not in _COMPRESSIONS:
+            raise ValueError(f"TimeSeriesWriter: compression must be one of {list(_COMPRESSIONS)}, got {compression!r}")
         self.folder = Path(folder)
         self.folder.mkdir(parents=True, exist_ok=True)
         self.compression = compression
@@ -462,9 +527,9 @@ class TimeSeriesWriter:
         for p in (vtu, vtp):
             if p.exists():   # a file the collection does not list: never overwrite it silently
                 raise FileExistsError(f"TimeSeriesWriter.write: {p} exists but is not in the collection")
-        _save_vtk(to_pyvista(mesh, u, fragment, strain, point_data, cell_data, arrays=a), vtu,
+        _save_vtk(_vtk_mesh(mesh, u, fragment, strain, point_data, cell_data, arrays=a), vtu,
                   self.compression)
-        _save_vtk(cracks_to_pyvista(mesh, u, crack_boundary, arrays=a), vtp, self.compression)
+        _save_vtk(_vtk_cracks(mesh, u, crack_boundary, arrays=a), vtp, self.compression)
         self.steps.append((step, time))
         self._write_collections()
         return vtu, vtp
@@ -475,6 +540,9 @@ class TimeSeriesWriter:
 class RenderError(RuntimeError):
     """A picture could not be drawn; the message says why."""
 
+
+#: render_png draws at this multiple of the picture's size and reduces (antialiasing)
+_SUPERSAMPLING = 2
 
 _FRAGMENT_COLOURS = ["#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2",
                      "#7f7f7f", "#bcbd22", "#17becf", "#aec7e8", "#ffbb78", "#98df8a", "#ff9896",
@@ -505,8 +573,8 @@ def render_png(mesh, u, fragment, path, window_size=(1200, 900), scale=1.0, crac
                line_width=2.0, force=False):
     """A PNG of the deformed configuration coloured by fragment, crack faces drawn in black.
 
-    Drawn with matplotlib's Agg backend: no display and no OpenGL are needed (the VTK
-    files are for ParaView and PyVista).
+    Drawn with Pillow as a raster of the triangles (no plotting library, no display, no
+    OpenGL; the VTK files are for ParaView and PyVista).
 
     Parameters
     ----------
@@ -537,7 +605,7 @@ def render_png(mesh, u, fragment, path, window_size=(1200, 900), scale=1.0, crac
     Raises
     ------
     RenderError
-        matplotlib failed to draw or encode the picture (the message says how).
+        Pillow failed to draw or encode the picture (the message says how).
     ValueError
         ``fragment`` does not have one entry per triangle, or a bad displacement.
     FileExistsError
@@ -552,31 +620,30 @@ def render_png(mesh, u, fragment, path, window_size=(1200, 900), scale=1.0, crac
         raise ValueError(f"render_png: {fragment.size} fragment numbers for {len(a.triangles)} triangles")
     U = np.zeros((mesh.nv, 2)) if u is None else _displacement(mesh, u)
     X = a.points + scale * U
-    cracks = X[a.boundary_segments(crack_boundary)]
     width, height = (int(w) for w in window_size)
     try:
-        from matplotlib.backends.backend_agg import FigureCanvasAgg
-        from matplotlib.collections import LineCollection, PolyCollection
-        from matplotlib.figure import Figure
-        dpi = 100
-        fig = Figure(figsize=(width / dpi, height / dpi), dpi=dpi, facecolor="white")
-        FigureCanvasAgg(fig)
-        ax = fig.add_axes([0.02, 0.02, 0.96, 0.96])
-        ax.set_axis_off()
-        colours = np.array(_FRAGMENT_COLOURS)[fragment % len(_FRAGMENT_COLOURS)]
-        # edges in the face colour: no white seams between triangles of one fragment
-        ax.add_collection(PolyCollection(X[a.triangles], facecolors=colours, edgecolors=colours,
-                                         linewidths=0.3))
-        if len(cracks):
-            ax.add_collection(LineCollection(cracks, colors="black", linewidths=line_width * 72 / dpi))
+        from PIL import Image, ImageDraw
+        # drawn at twice the size and reduced: smooth edges without an antialiasing rasteriser
+        ss = _SUPERSAMPLING
         lo, hi = X.min(axis=0), X.max(axis=0)
-        ax.set_xlim(lo[0], hi[0])
-        ax.set_ylim(lo[1], hi[1])
-        ax.set_aspect("equal")
+        span = np.maximum(hi - lo, 1e-300)
+        zoom = ss * 0.96 * min(width / span[0], height / span[1])     # 2 % margins, equal aspect
+        centre = 0.5 * (lo + hi)
+        pixels = np.column_stack([ss * width / 2 + zoom * (X[:, 0] - centre[0]),
+                                  ss * height / 2 - zoom * (X[:, 1] - centre[1])])
+        image = Image.new("RGB", (ss * width, ss * height), "white")
+        draw = ImageDraw.Draw(image)
+        colours = [_FRAGMENT_COLOURS[f % len(_FRAGMENT_COLOURS)] for f in fragment.tolist()]
+        # outlines in the face colour: no white seams between triangles of one fragment
+        for corners, colour in zip(pixels[a.triangles].tolist(), colours):
+            draw.polygon([tuple(p) for p in corners], fill=colour, outline=colour)
+        pen = max(1, round(ss * line_width))
+        for (x0, y0), (x1, y1) in ((pixels[s0], pixels[s1]) for s0, s1 in a.boundary_segments(crack_boundary)):
+            draw.line([(x0, y0), (x1, y1)], fill="black", width=pen)
         buf = io.BytesIO()
-        fig.savefig(buf, format="png", dpi=dpi, facecolor="white")
+        image.reduce(ss).save(buf, format="PNG")
     except Exception as e:
-        raise RenderError(f"ngfracture.output: matplotlib could not draw {path.name} "
+        raise RenderError(f"ngfracture.output: Pillow could not draw {path.name} "
                           f"({type(e).__name__}: {e})") from e
     _atomic_bytes(path, buf.getvalue(), force)
     return path
@@ -703,12 +770,17 @@ def _jsonable(obj, where):
     raise TypeError(f"write_summary: {where} is a {type(obj).__name__}, which JSON cannot hold")
 
 
-def final_pictures(folder, mesh, u, stats, scale):
-    """Draw a run's ``final.png`` and ``fragment_sizes.png`` into ``folder`` (both replaced).
+#: fewer fragments than this: no fragment_sizes.png at the end of a run (a distribution of
+#: one to four pieces says nothing that summary.json's fragment_areas does not)
+SIZES_MIN_FRAGMENTS = 5
 
-    A picture that cannot be drawn is a fact of the output, not a failed run: the
-    fragment sizes are drawn in any case, and the returned record says why final.png is
-    missing.
+
+def final_pictures(folder, mesh, u, stats, scale, sizes_min_fragments=SIZES_MIN_FRAGMENTS):
+    """Draw a run's ``final.png`` and, for enough fragments, ``fragment_sizes.png`` into ``folder``.
+
+    A picture that cannot be drawn is a fact of the output, not a failed run: the returned
+    record says why final.png is missing. Both files are replaced; a fragment_sizes.png
+    left from before is removed when none is drawn.
 
     Parameters
     ----------
@@ -720,12 +792,15 @@ def final_pictures(folder, mesh, u, stats, scale):
         Fragment per triangle and fragment areas.
     scale : float
         Displacement magnification (:func:`picture_scale`).
+    sizes_min_fragments : int
+        Draw fragment_sizes.png from this many fragments on (1: always).
 
     Returns
     -------
     dict
         ``{"final": "final.png", "displacement_scale": scale}`` or ``{"final_error": reason}``,
-        and ``"fragment_sizes": "fragment_sizes.png"`` (the ``pictures`` of summary.json).
+        and ``"fragment_sizes": "fragment_sizes.png"`` if drawn (the ``pictures`` of
+        summary.json).
     """
     folder = Path(folder)
     try:
@@ -733,8 +808,12 @@ def final_pictures(folder, mesh, u, stats, scale):
         pictures = {"final": "final.png", "displacement_scale": scale}
     except RenderError as err:
         pictures = {"final_error": str(err)}
-    plot_fragment_sizes(stats.areas, folder / "fragment_sizes.png", force=True)
-    pictures["fragment_sizes"] = "fragment_sizes.png"
+    sizes = folder / "fragment_sizes.png"
+    if stats.count >= sizes_min_fragments:
+        plot_fragment_sizes(stats.areas, sizes, force=True)
+        pictures["fragment_sizes"] = sizes.name
+    elif sizes.exists():
+        sizes.unlink()
     return pictures
 
 

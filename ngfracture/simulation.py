@@ -445,8 +445,9 @@ class Simulation:
     resume : bool
         Continue from the newest checkpoint in ``out``.
     pictures : {"final", "every", "none"}
-        PNG of the final state (and the fragment-size plot), of every step too, or no
-        picture at all.
+        PNG of the final state (and the fragment-size plot when the body ends in
+        ``output.SIZES_MIN_FRAGMENTS`` pieces or more), of every step too, or no picture
+        at all.
     checkpoint_every : int
         Write a checkpoint after every this many accepted steps (and at the end).
     progress : callable(dict), optional
