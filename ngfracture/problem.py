@@ -167,6 +167,7 @@ class ElasticProblem:
         self._regions = arrays.regions, arrays.region_names
         self._internal = None     # the C++ kernel's per-element data, made at first need
         self._reference_areas = None
+        self._pieces = None       # the mesh's connected components: the mesh never changes
 
     # -- set-up ---------------------------------------------------------------------
     def add_dirichlet(self, boundaries, value=(0.0, 0.0), component=None):
@@ -381,7 +382,10 @@ class ElasticProblem:
         piece : numpy.ndarray of int, shape (nv,)
             Piece id of every vertex.
         """
-        return rigid.pieces(self._elements, self.mesh.nv)
+        if self._pieces is None:
+            self._pieces = rigid.pieces(self._elements, self.mesh.nv)
+        count, piece = self._pieces
+        return count, piece.copy()
 
     def support(self, rows):
         """The rigid modes that single-dof rows leave free, with pins to factorise around them.
