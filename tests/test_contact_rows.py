@@ -138,6 +138,23 @@ def test_pressed_blocks_rows():
     assert len(keep_b) == len(keep) == np.linalg.matrix_rank(A[keep_b])
 
 
+def test_selected_and_stacked_rows_carry_their_own_matrix():
+    """subset and stack never touch C; the C built afterwards is that of gap_rows for the
+    same rows, entry for entry, in the order of the rows."""
+    X, U, T, frag = two_blocks(n=8, overlap=0.01)
+    E = boundary_edges_of(T)
+    cs = contact.select_contacts(X, U, T, E, collision.detect_collisions(X, U, T, boundary_edges=E, fragment=frag))
+    rows = np.array([5, 0, 3, 3, len(cs) - 1])
+    picked = contact.ContactConstraints.stack([cs.subset(rows), cs.subset(cs.xi == 1.0)])
+    expected = sp.vstack([cs.C[rows], cs.C[np.flatnonzero(cs.xi == 1.0)]]).tocsr()
+    C_ref, g_ref = contact.gap_rows(X, picked.slave, picked.a, picked.c, picked.xi, picked.normal)
+    for C in (expected, C_ref):
+        assert C.shape == picked.C.shape and (C != picked.C).nnz == 0
+    assert np.array_equal(picked.g, g_ref)
+    with pytest.raises(ValueError, match="different numbers|vertices"):
+        contact.ContactConstraints.stack([cs, contact._no_constraints(len(X) + 1)])
+
+
 def test_banded_and_pivoted_agree_on_long_chains():
     # 3-node rows along a chain of vertices, with duplicates and Fig. 5 style cycles
     rng = np.random.default_rng(9)
