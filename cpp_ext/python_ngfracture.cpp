@@ -2,6 +2,7 @@
 #include <python_comp.hpp>
 #include "vertex_average.hpp"
 #include "internal_force.hpp"
+#include "sparse_triangular.hpp"
 
 namespace py = pybind11;
 using namespace ngfracture;
@@ -123,11 +124,60 @@ RuntimeError
 )doc");
 }
 
+static void ExportSparseTriangular (py::module & m)
+{
+  using I64 = py::array_t<int64_t, py::array::c_style | py::array::forcecast>;
+  using I32 = py::array_t<int32_t, py::array::c_style | py::array::forcecast>;
+  using F64 = py::array_t<double, py::array::c_style | py::array::forcecast>;
+  m.def("SparseLowerSolve",
+        [] (int64_t n, I64 lp, I32 li, F64 lx, bool unit_diagonal, I64 bp, I32 bi, F64 bx)
+        {
+          if (lp.ndim() != 1 || lp.shape(0) != n + 1 || li.shape(0) < lp.data()[n] || lx.shape(0) < lp.data()[n])
+            throw Exception("ngfracture.SparseLowerSolve: L must be CSC of an n x n matrix");
+          if (bp.ndim() != 1 || bp.shape(0) < 1 || bi.shape(0) < bp.data()[bp.shape(0) - 1]
+              || bx.shape(0) < bp.data()[bp.shape(0) - 1])
+            throw Exception("ngfracture.SparseLowerSolve: B must be CSC with n rows");
+          std::vector<int64_t> xp;
+          std::vector<int32_t> xi;
+          std::vector<double> xx;
+          {
+            py::gil_scoped_release release;
+            SparseLowerSolve(n, lp.data(), li.data(), lx.data(), unit_diagonal, bp.shape(0) - 1,
+                             bp.data(), bi.data(), bx.data(), xp, xi, xx);
+          }
+          return py::make_tuple(py::array_t<int64_t>(xp.size(), xp.data()),
+                                py::array_t<int32_t>(xi.size(), xi.data()),
+                                py::array_t<double>(xx.size(), xx.data()));
+        },
+        py::arg("n"), py::arg("lp"), py::arg("li"), py::arg("lx"), py::arg("unit_diagonal"),
+        py::arg("bp"), py::arg("bi"), py::arg("bx"),
+        R"doc(X = L^-1 B for sparse lower-triangular L and sparse B (both CSC), Gilbert-Peierls.
+
+Parameters
+----------
+n : int
+    Order of L.
+lp, li, lx : numpy.ndarray
+    CSC of L (int64 pointers, int32 rows, values); each column holds its diagonal (unless
+    unit_diagonal) and entries below it.
+unit_diagonal : bool
+    L[j, j] = 1 (a stored diagonal is ignored).
+bp, bi, bx : numpy.ndarray
+    CSC of B (n rows).
+
+Returns
+-------
+(xp, xi, xx)
+    CSC of X; the rows of a column are its reach in L (topological order, unsorted), zeros
+    that cancel exactly included.)doc");
+}
+
 PYBIND11_MODULE(_ngfracture, m)
 {
   m.doc() = "ngfracture's C++ kernels (vertex averaging, crack splitting, collision detection).";
   ExportVertexAverage(m);
   ExportInternalForces(m);
+  ExportSparseTriangular(m);
   ExportCrack(m);
   ExportCollision(m);
 }

@@ -21,6 +21,7 @@ import scipy.sparse.linalg as spla
 
 import ngfracture as nf
 from ngfracture.contact_solver import ContactSolver
+from ngfracture import kkt as kkt_module
 from ngfracture.kkt import ConstrainedSolver, to_scipy
 from ngfracture.solver import NewtonSolver
 
@@ -69,9 +70,12 @@ def whole_kkt_solution(K, rows, r, du_fixed, h):
     return x[:ndof], x[ndof + nfix:]
 
 
-@pytest.mark.parametrize("path, inverse", [("augmented", "superlu"), ("schur", "superlu"),
-                                           ("schur", "sparsecholesky")])
-def test_constrained_solve_equals_whole_kkt_solve(contact_state, path, inverse):
+@pytest.mark.parametrize("path, inverse, sparse_schur", [("augmented", "superlu", False), ("schur", "superlu", False),
+                                                         ("schur", "superlu", True), ("schur", "sparsecholesky", False)])
+def test_constrained_solve_equals_whole_kkt_solve(contact_state, path, inverse, sparse_schur, monkeypatch):
+    """sparse_schur: the Schur complement from sparse triangular solves (the path of large
+    meshes, forced here on a small one), no kept columns."""
+    monkeypatch.setattr(kkt_module, "SPARSE_SCHUR_MIN_DOFS", 0 if sparse_schur else 10 ** 9)
     prob, rows, support, result = contact_state
     n_contact = len(result.multipliers)
     assert n_contact > 0 and np.any(result.multipliers < 0)     # pieces pressed together
@@ -87,11 +91,39 @@ def test_constrained_solve_equals_whole_kkt_solve(contact_state, path, inverse):
     h = 1e-3 * rng.standard_normal(rows.C.shape[0])
     kkt = ConstrainedSolver(K, rows.fixed_dofs, rows.C, inverse=inverse, modes=support.modes, pins=support.pins,
                             path=path)
-    assert kkt.path == path
+    assert kkt.path == path and (kkt.path == "schur" and kkt._Z is None) == sparse_schur
     du, lam = kkt.solve(r, du_fixed, h)
     du_ref, lam_ref = whole_kkt_solution(Ks, rows, r, du_fixed, h)
     assert np.linalg.norm(du - du_ref) <= 1e-10 * np.linalg.norm(du_ref)
     assert np.linalg.norm(lam - lam_ref) <= 1e-10 * np.linalg.norm(lam_ref)
+
+
+def test_sparse_schur_complement_and_complementarity_equal_the_columns(contact_state, monkeypatch):
+    """C K^+ C^T from the sparse triangular solves equals C (K^+ C^T) from full solves to
+    rounding (1e-13 of its largest entry), and the complementarity problem chooses the same
+    rows with the same multipliers (1e-10), rows met before taken from the cache."""
+    prob, rows, support, result = contact_state
+    K = prob.tangent()
+    ndof = prob.fes.ndof
+    rng = np.random.default_rng(5)
+    r = np.where(np.isin(np.arange(ndof), rows.fixed_dofs), 0.0, rng.standard_normal(ndof))
+    h = 1e-3 * rng.standard_normal(rows.C.shape[0])
+    solved = {}
+    for sparse_schur in (False, True):
+        monkeypatch.setattr(kkt_module, "SPARSE_SCHUR_MIN_DOFS", 0 if sparse_schur else 10 ** 9)
+        factor = kkt_module.EliminatedFactor(K, rows.fixed_dofs, support.pins)
+        uni = ConstrainedSolver(None, rows.fixed_dofs, rows.C, modes=support.modes, pins=support.pins,
+                                factor=factor, dependent_rows=True)
+        contact = np.arange(len(result.multipliers))     # the hold rows stay equalities
+        solved[sparse_schur] = (uni._S, uni.solve_unilateral(r, np.zeros(ndof), h, contact))
+        if sparse_schur:     # again, half of the rows known: the same matrix
+            again = factor.schur(rows.C[: rows.C.shape[0] // 2])
+            assert np.array_equal(again, factor.schur(rows.C)[: rows.C.shape[0] // 2, : rows.C.shape[0] // 2])
+    (S0, (du0, lam0, act0)), (S1, (du1, lam1, act1)) = solved[False], solved[True]
+    assert np.abs(S1 - S0).max() <= 1e-13 * np.abs(S0).max()
+    assert np.array_equal(act0, act1)
+    assert np.linalg.norm(lam1 - lam0) <= 1e-10 * np.linalg.norm(lam0)
+    assert np.linalg.norm(du1 - du0) <= 1e-10 * np.linalg.norm(du0)
 
 
 def test_the_configurations_exercise_the_rigid_modes(contact_state):
