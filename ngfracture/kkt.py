@@ -159,9 +159,11 @@ SUPERLU_MAX_DOFS = 40000
 #: from this many factorised dofs on (SuperLU), the Schur complement C K^-1 C^T is built by
 #: triangular solves that follow only the reach of each row's few nonzeros in the factors
 #: (EliminatedFactor.schur) instead of full solves for K^-1 C^T. Measured on the notched
-#: plate, 149 contact-like rows: 31478 dofs 0.36 s against 0.60 s, 8090 dofs 0.086 s
-#: against 0.090 s.
-SPARSE_SCHUR_MIN_DOFS = 15000
+#: plate (benchmarks/schur.py, 68 to 149 contact-like rows): 2216 dofs 5.3 against 11 ms,
+#: 8210 dofs 48 against 96 ms, 31716 dofs 0.18 against 0.66 s. Below, the default scenes
+#: keep the columns (and their results bit for bit); the path costs one more solve per
+#: KKT solve.
+SPARSE_SCHUR_MIN_DOFS = 5000
 
 #: up to this many free dofs a fresh tangent with general rows is factorised as the
 #: augmented matrix (SuperLU); above, SuperLU's fill of the augmented matrix grows fast

@@ -8,7 +8,7 @@ import pytest
 from conftest import child_env
 
 ROOT = Path(__file__).resolve().parent.parent
-BENCHMARKS = ["contact", "crack", "ensemble", "lshape", "meshcheck", "objectivity", "scenes"]
+BENCHMARKS = ["contact", "crack", "ensemble", "lshape", "meshcheck", "objectivity", "scenes", "schur"]
 
 
 def run_benchmark(name, *args):
@@ -35,3 +35,11 @@ def test_json_file_written_and_forced(tmp_path):
         assert r.stdout == ""  # the JSON goes to the file, not to stdout
         (case,) = json.loads(target.read_text())["cases"]
         assert set(case) == {"ntri", "t_check", "t_check_cracked", "t_solve", "ratio"}
+
+
+def test_schur_benchmark_builds_the_same_complement_both_ways(tmp_path):
+    target = tmp_path / "schur.json"
+    r = run_benchmark("schur", "--factors", "1", "--json", str(target))
+    assert r.returncode == 0, r.stderr
+    (case,) = json.loads(target.read_text())["cases"]
+    assert case["rows"] > 10 and case["relative_difference"] < 1e-13     # rounding of two solves

@@ -1,0 +1,73 @@
+"""Benchmark of the Schur complement S = C K^-1 C^T of contact rows: kept columns against
+sparse triangular solves (kkt.SPARSE_SCHUR_MIN_DOFS).
+
+For the notched plate at mesh factors f (maxh 0.034 / sqrt f), rows like the contact rows
+of a crack across the middle (node to node between neighbouring vertices near x = 0.5, unit
+normals): one SuperLU factorisation of the uncracked tangent, then S both ways
+(``EliminatedFactor.columns`` then C Z; ``EliminatedFactor.schur``), each on a fresh
+factorisation, best of three. Reported per case: dofs, rows, seconds of each, their ratio,
+and the largest difference of the two S relative to its largest entry. The factorisation
+itself is the same for both and not counted.
+
+Usage: python benchmarks/schur.py [--factors 1 2 4 8 16] [--json FILE [--force]]
+"""
+import argparse
+import time
+
+import numpy as np
+import scipy.sparse as sp
+
+import benchmark_json
+from ngfracture import kkt, scenes
+from ngfracture.problem import ElasticProblem
+
+
+def contact_like_rows(mesh, ndof, count=150, width=0.02):
+    """Node-to-node rows n . (u_b - u_a) between neighbouring vertices near x = 0.5."""
+    X = np.array([v.point for v in mesh.vertices])
+    line = np.flatnonzero(np.abs(X[:, 0] - 0.5) < width)[:count]
+    half = ndof // 2
+    rows, cols, vals = [], [], []
+    for r, (b, a) in enumerate(zip(line[:-1], line[1:])):
+        for vertex, sign in ((b, 1.0), (a, -1.0)):
+            for comp, n in ((0, 0.8), (1, 0.6)):
+                rows.append(r)
+                cols.append(comp * half + vertex)
+                vals.append(sign * n)
+    return sp.csr_matrix((vals, (rows, cols)), shape=(len(line) - 1, ndof))
+
+
+def case(factor, repeat=3):
+    scene = scenes.plate(maxh=0.034 / np.sqrt(factor))
+    prob = ElasticProblem(scene.mesh, scene.material)
+    scene.apply_load(prob, scene.dx)
+    K, fixed = prob.tangent(), prob.assemble_constraints().fixed_dofs
+    C = contact_like_rows(scene.mesh, prob.fes.ndof)
+    seconds, S = {}, {}
+    for name in ("columns", "sparse"):
+        best = np.inf
+        for _ in range(repeat):
+            f = kkt.EliminatedFactor(K, fixed, inverse="superlu")
+            f.factorise()
+            t0 = time.perf_counter()
+            S[name] = C @ f.columns(C) if name == "columns" else f.schur(C)
+            best = min(best, time.perf_counter() - t0)
+        seconds[name] = best
+    return {"factor": factor, "dofs": prob.fes.ndof, "rows": C.shape[0], "ntri": scene.mesh.ne,
+            "columns_s": seconds["columns"], "sparse_s": seconds["sparse"],
+            "speedup": seconds["columns"] / seconds["sparse"],
+            "relative_difference": float(np.abs(S["sparse"] - S["columns"]).max() / np.abs(S["columns"]).max())}
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--factors", nargs="+", type=float, default=[1, 2, 4, 8, 16])
+    benchmark_json.add_options(parser)
+    args = parser.parse_args(argv)
+    benchmark_json.refuse_existing(parser, args)
+    cases = [case(f) for f in args.factors]
+    benchmark_json.write(args, {"cases": cases, "sparse_schur_min_dofs": kkt.SPARSE_SCHUR_MIN_DOFS})
+
+
+if __name__ == "__main__":
+    main()
