@@ -512,7 +512,6 @@ class EliminatedFactor:
         self._columns = {key: Z[:, i] for i, key in enumerate(keys)}
         return Z
 
-
     @property
     def sparse_schur(self):
         """True if :meth:`schur` takes the sparse triangular solves (SuperLU, from
@@ -550,61 +549,63 @@ class EliminatedFactor:
             raise ValueError("EliminatedFactor.schur needs the SuperLU factorisation")
         self.factorise()
         t0 = time.perf_counter()
-        if self._triangles is None:
-            n = self._lu.shape[0]
-            index = -np.ones(self.ndof, dtype=np.int64)
-            index[self.factor_free] = np.arange(n)      # dof -> row of K_ff
-            L = self._lu.L
-            lower = (L.indptr.astype(np.int64), L.indices.astype(np.int32), L.data)
-            if np.array_equal(self._lu.perm_r, self._lu.perm_c):
-                # diagonal pivots only: K_ff symmetric gives U = D L^T, S = Y^T D^-1 Y
-                upper_t, pivots = None, self._lu.U.diagonal()
-            else:
-                Ut = self._lu.U.tocsr()                 # CSR of U = CSC of the lower U^T
-                upper_t, pivots = (Ut.indptr.astype(np.int64), Ut.indices.astype(np.int32), Ut.data), None
-            self._triangles = (n, index, lower, upper_t, pivots)
-        n, index, lower, upper_t, pivots = self._triangles
         C = sp.csr_matrix(C)
         keys = [C.indices[s:e].tobytes() + C.data[s:e].tobytes() for s, e in zip(C.indptr[:-1], C.indptr[1:])]
         new = [i for i, key in enumerate(keys) if key not in self._reach]
-        if new:
-            B = C[new].tocoo()
-            rows = index[B.col]
-            keep = rows >= 0
-            solved = []
-            for factor, perm, unit in ((lower, self._lu.perm_r, True), (upper_t, self._lu.perm_c, False)):
-                if factor is None:          # symmetric: X = D^-1 Y
-                    yp, yi, yx = solved[0]
-                    solved.append((yp, yi, yx / pivots[yi]))
-                    continue
-                lp, li, lx = factor
-                rhs = sp.csc_matrix((B.data[keep], (perm[rows[keep]], B.row[keep])), shape=(n, len(new)))
-                try:
-                    solved.append(_ext.SparseLowerSolve(n, lp, li, lx, unit, rhs.indptr.astype(np.int64),
-                                                        rhs.indices.astype(np.int32), rhs.data))
-                except RuntimeError as err:
-                    raise SingularSystem(f"sparse triangular solve failed: {err}") from None
-            (yp, yi, yx), (xp, xi, xx) = solved
-            fresh = {keys[i]: (yi[yp[j]:yp[j + 1]], yx[yp[j]:yp[j + 1]], xi[xp[j]:xp[j + 1]], xx[xp[j]:xp[j + 1]])
-                     for j, i in enumerate(new)}
-        else:
-            fresh = {}
+        fresh = dict(zip((keys[i] for i in new), self._reach_solves(C[new]))) if new else {}
         self._reach = {key: self._reach[key] if key in self._reach else fresh[key] for key in keys}
-        parts = [self._reach[key] for key in keys]
-        lengths_y = np.array([len(p[0]) for p in parts], dtype=np.int64)
-        lengths_x = np.array([len(p[2]) for p in parts], dtype=np.int64)
-        m = len(keys)
-        Y = sp.csc_matrix((np.concatenate([p[1] for p in parts]) if m else np.zeros(0),
-                           np.concatenate([p[0] for p in parts]) if m else np.zeros(0, np.int32),
-                           np.concatenate([[0], np.cumsum(lengths_y)])), shape=(n, m))
-        X = sp.csc_matrix((np.concatenate([p[3] for p in parts]) if m else np.zeros(0),
-                           np.concatenate([p[2] for p in parts]) if m else np.zeros(0, np.int32),
-                           np.concatenate([[0], np.cumsum(lengths_x)])), shape=(n, m))
+        n = self._lu.shape[0]
+        Y = _sparse_columns([self._reach[key][0] for key in keys], n)
+        X = _sparse_columns([self._reach[key][1] for key in keys], n)
         S = (X.T @ Y).toarray()
         if not np.all(np.isfinite(S)):
             raise SingularSystem("the sparse triangular solves produced NaN/inf: singular (a floating body?)")
         self.seconds += time.perf_counter() - t0
         return S
+
+    def _reach_solves(self, C):
+        """Per row of C: ((rows, values) of its column of Y, the same of X), see :meth:`schur`."""
+        n = self._lu.shape[0]
+        if self._triangles is None:
+            index = -np.ones(self.ndof, dtype=np.int64)
+            index[self.factor_free] = np.arange(n)      # dof -> row of K_ff
+            L = self._lu.L
+            lower = (L.indptr.astype(np.int64), L.indices.astype(np.int32), L.data)
+            if np.array_equal(self._lu.perm_r, self._lu.perm_c):
+                upper_t, pivots = None, self._lu.U.diagonal()
+            else:
+                Ut = self._lu.U.tocsr()                 # CSR of U = CSC of the lower U^T
+                upper_t, pivots = (Ut.indptr.astype(np.int64), Ut.indices.astype(np.int32), Ut.data), None
+            self._triangles = (index, lower, upper_t, pivots)
+        index, lower, upper_t, pivots = self._triangles
+        B = C.tocoo()
+        rows = index[B.col]
+        keep = rows >= 0
+
+        def solve(factor, perm, unit):
+            lp, li, lx = factor
+            rhs = sp.csc_matrix((B.data[keep], (perm[rows[keep]], B.row[keep])), shape=(n, C.shape[0]))
+            try:
+                return _ext.SparseLowerSolve(n, lp, li, lx, unit, rhs.indptr.astype(np.int64),
+                                             rhs.indices.astype(np.int32), rhs.data)
+            except RuntimeError as err:
+                raise SingularSystem(f"sparse triangular solve failed: {err}") from None
+
+        yp, yi, yx = solve(lower, self._lu.perm_r, True)
+        if upper_t is None:
+            xp, xi, xx = yp, yi, yx / pivots[yi]       # U = D L^T
+        else:
+            xp, xi, xx = solve(upper_t, self._lu.perm_c, False)
+        return [((yi[yp[j]:yp[j + 1]], yx[yp[j]:yp[j + 1]]), (xi[xp[j]:xp[j + 1]], xx[xp[j]:xp[j + 1]]))
+                for j in range(C.shape[0])]
+
+
+def _sparse_columns(columns, n):
+    """A CSC matrix (n, len(columns)) from per-column (rows, values)."""
+    lengths = np.array([len(r) for r, _ in columns], dtype=np.int64)
+    rows = np.concatenate([r for r, _ in columns]) if columns else np.zeros(0, np.int32)
+    values = np.concatenate([v for _, v in columns]) if columns else np.zeros(0)
+    return sp.csc_matrix((values, rows, np.concatenate([[0], np.cumsum(lengths)])), shape=(n, len(columns)))
 
 
 class ConstrainedSolver:
