@@ -679,7 +679,7 @@ def transfer(u, result):
     return gf
 
 
-def split_by_tensor(mesh, tensors, critical, crack_name="crack", skip_neighbours=False):
+def split_by_tensor(mesh, tensors, critical, crack_name="crack", skip_neighbours=False, first_only=False):
     """One splitting pass from a vertex tensor field supplied by the caller.
 
     Parameters
@@ -694,6 +694,10 @@ def split_by_tensor(mesh, tensors, critical, crack_name="crack", skip_neighbours
         Boundary name of the new crack faces.
     skip_neighbours : bool
         See :func:`split_vertices`.
+    first_only : bool
+        Split only the first vertex of the order that splits anything (one event per pass:
+        every other vertex is judged again after the next equilibrium); the vertices before
+        it, which split nothing (rules 2a, none), are in the record.
 
     Returns
     -------
@@ -714,12 +718,18 @@ def split_by_tensor(mesh, tensors, critical, crack_name="crack", skip_neighbours
     if t.shape != (mesh.nv, 3):
         raise ValueError(f"ngfracture.crack: tensor field must have shape ({mesh.nv}, 3), got {t.shape}")
     validate_mesh(mesh)
-    return _split_pass(mesh, t, c, crack_name, skip_neighbours)
+    return _split_pass(mesh, t, c, crack_name, skip_neighbours, first_only)
 
 
-def _split_pass(mesh, tensors, critical, crack_name, skip_neighbours=False):
+def _split_pass(mesh, tensors, critical, crack_name, skip_neighbours=False, first_only=False):
     values, dirs = principal(tensors)
     order = _C.CrackSelect(values, critical)
+    if first_only:
+        # the engine processes a whole order: find the first vertex that splits alone
+        for k in range(len(order)):
+            if split_vertices(mesh, order[k:k + 1], dirs[order[k:k + 1]], crack_name).nsplit:
+                order = order[:k + 1]
+                break
     res = split_vertices(mesh, order, dirs[order], crack_name, skip_neighbours)
     res.record["principal"] = values[order]
     return res

@@ -226,12 +226,14 @@ class StepControl:
         Newton iterations per solve.
     unloaded_fraction : float
         See Scene.stop_when_unloaded.
-    split : {"spread", "all"}
+    split : {"spread", "all", "one"}
         Which overstrained vertices one crack pass splits: "all" (the paper's literal
         rule) or, by default, "spread": in decreasing order of overstrain, skipping the
         vertices next to one split earlier in the pass; they are judged again after the
         next equilibrium, which the split has changed, instead of on their strain from
-        before it.
+        before it. "one": only the most overstrained vertex that splits anything, every
+        other one judged again after the next equilibrium (one event at a time; more
+        passes; docs/criterion.md).
 
     **settings
         The fields above by name (keyword only); the others take their defaults. Only
@@ -346,7 +348,7 @@ class StepControl:
                   ("tol", number(self.tol) and 0 < self.tol < 1),
                   ("maxit", integer(self.maxit) and self.maxit >= 1),
                   ("unloaded_fraction", number(self.unloaded_fraction) and 0 < self.unloaded_fraction < 1),
-                  ("split", self.split in ("spread", "all"))]
+                  ("split", self.split in ("spread", "all", "one"))]
         for name, ok in checks:
             if not ok:
                 raise ValueError(f"StepControl.{name} = {getattr(self, name)!r} is out of range")
@@ -672,7 +674,8 @@ class Simulation:
         """One splitting pass; returns (new problem or None, number of split vertices, strength)."""
         tensors = self._normalised_strain(prob, strength)
         t0 = time.perf_counter()
-        res = split_by_tensor(prob.mesh, tensors, 1.0, skip_neighbours=self.control.split == "spread")
+        res = split_by_tensor(prob.mesh, tensors, 1.0, skip_neighbours=self.control.split == "spread",
+                              first_only=self.control.split == "one")
         self.timings["split"] += time.perf_counter() - t0 - sum(res.timings.get(k, 0.0) for k in ("netgen", "ngsolve_mesh"))
         self.timings["rebuild"] += res.timings.get("netgen", 0.0) + res.timings.get("ngsolve_mesh", 0.0)
         if res.nsplit == 0:

@@ -211,3 +211,27 @@ def test_crack_normals_point_out_of_the_material():
 if __name__ == "__main__":
     import pytest as _pytest
     raise SystemExit(_pytest.main([__file__, "-q"]))
+
+
+def test_first_only_splits_the_first_vertex_that_splits():
+    """One event per pass: the order's leading vertices that split nothing (rule 2a) are
+    passed over, the first one that splits is split, nothing after it."""
+    m = grid_mesh(4, 4)
+    nv = m.nv
+    tensors = np.zeros((nv, 3))
+    edge, inner, other = vid(4, 2, 0), vid(4, 2, 2), vid(4, 1, 1)
+    tensors[edge] = [0.0, 3.0, 0.0]      # largest, but along the boundary: rule 2a
+    tensors[inner] = [2.0, 0.0, 0.0]     # next: splits (rule 1)
+    tensors[other] = [1.5, 0.0, 0.0]     # overstrained too, left for the next pass
+    res = crack.split_by_tensor(m, tensors, 1.0, first_only=True)
+    check_invariants(m, res)
+    assert list(res.record["vertex"]) == [edge, inner]
+    assert res.record["rule"][0] == crack.RULE_2 | crack.RULE_2A and res.record["rule"][1] & crack.RULE_1
+    def cut(r):          # the processed vertices that cut edges
+        return set(r.record["vertex"][np.diff(r.record["edge_offsets"]) > 0].tolist())
+    assert cut(res) == {inner} and np.array_equal(res.record["principal"], [3.0, 2.0])
+    every = crack.split_by_tensor(m, tensors, 1.0)
+    assert set(every.record["vertex"]) == {edge, inner, other} and cut(every) == {inner, other}
+    # nothing splittable: the whole order processed, nothing split, the same mesh
+    none = crack.split_by_tensor(m, np.where(np.arange(nv)[:, None] == edge, tensors, 0.0), 1.0, first_only=True)
+    assert none.nsplit == 0 and none.mesh is m
