@@ -149,3 +149,26 @@ def test_default_path_by_size_and_the_complementarity_path_is_schur(contact_stat
     assert unilateral.path == "schur"
     with pytest.raises(ValueError, match="path"):
         ConstrainedSolver(K, rows.fixed_dofs, rows.C, modes=support.modes, pins=support.pins, path="qr")
+
+
+def test_a_cracking_run_takes_the_same_path_with_the_sparse_schur_complement(monkeypatch):
+    """The coarse plate run to broken through, every Schur complement from the sparse
+    triangular solves (forced below its size threshold) against the kept columns: the same
+    steps and split vertices, and crack length, energy and the displacement of the final
+    state equal to the rounding of the solves (1e-9 relative)."""
+    from ngfracture import scenes
+    from ngfracture.simulation import Simulation
+
+    runs = {}
+    for sparse in (False, True):
+        monkeypatch.setattr(kkt_module, "SPARSE_SCHUR_MIN_DOFS", 0 if sparse else 10 ** 9)
+        monkeypatch.setattr(kkt_module, "AUGMENTED_MAX_DOFS", -1)      # every solve on the Schur path
+        runs[sparse] = Simulation(scenes.plate(maxh=0.06)).run()
+    a, b = runs[False], runs[True]
+    assert a.ok and b.ok and a.summary["reason"] == b.summary["reason"] == "broken"
+    for key in ("n_steps", "n_split_vertices", "n_fragments"):
+        assert a.summary[key] == b.summary[key], key
+    assert [h["split_vertices"] for h in a.summary["history"]] == [h["split_vertices"] for h in b.summary["history"]]
+    assert abs(a.summary["crack_length"] - b.summary["crack_length"]) <= 1e-9 * a.summary["crack_length"]
+    ua, ub = a.state.u, b.state.u
+    assert np.linalg.norm(ua - ub) <= 1e-9 * np.linalg.norm(ua)
