@@ -190,7 +190,7 @@ namespace ngfracture
     return false;
   }
 
-  void CrackSplitter :: ProcessVertex (int v, const double * dir)
+  void CrackSplitter :: ProcessVertex (int v, const double * dir, double enter_angle, bool single_edge_tips)
   {
     int rule = 0;
     int nv_before = NV();
@@ -228,7 +228,21 @@ namespace ngfracture
     auto better = [] (const Edge & a, const Edge & b)
       { return a.score != b.score ? a.score > b.score : a.x < b.x; };
 
-    if (bnd.empty() || tip)
+    if (tip && single_edge_tips)
+      {
+        rule |= RULE_TIP | RULE_TIP1;
+        // the half of the crack line away from the crack: opposite to the crack faces
+        double sign = edges[bnd[0]].side > 0 ? -1.0 : 1.0;
+        int e1 = -1;
+        for (size_t i = 0; i < edges.size(); i++)
+          if (edges[i].count != 1 &&
+              (e1 < 0 || sign * edges[i].side > sign * edges[e1].side ||
+               (sign * edges[i].side == sign * edges[e1].side && edges[i].x < edges[e1].x)))
+            e1 = int(i);
+        if (e1 < 0) { rule |= RULE_NONE; finish(); return; }
+        cuts.push_back(edges[e1].x);
+      }
+    else if (bnd.empty() || tip)
       {
         rule |= RULE_1;
         std::vector<Edge> cand;
@@ -279,6 +293,16 @@ namespace ngfracture
         int e1 = -1;
         for (size_t i = 0; i < edges.size(); i++)
           if (e1 < 0 || better(edges[i], edges[e1])) e1 = int(i);
+        if (edges[e1].count == 1 && enter_angle > 0)
+          {
+            // the crack line runs along the boundary here, or the vertex is a corner (a
+            // notch tip) whose flank is best: the crack enters the body on the best
+            // interior edge if that is within enter_angle of the line
+            int e2 = -1;
+            for (size_t i = 0; i < edges.size(); i++)
+              if (edges[i].count != 1 && (e2 < 0 || better(edges[i], edges[e2]))) e2 = int(i);
+            if (e2 >= 0 && edges[e2].score >= std::cos(enter_angle)) { e1 = e2; rule |= RULE_2C; }
+          }
         if (edges[e1].count == 1) { rule |= RULE_2A; finish(); return; }   // along the boundary: no split
         cuts.push_back(edges[e1].x);
       }
@@ -292,7 +316,8 @@ namespace ngfracture
     finish();
   }
 
-  void CrackSplitter :: Run (const int * order, const double * dirs, int n, bool skip_neighbours)
+  void CrackSplitter :: Run (const int * order, const double * dirs, int n, bool skip_neighbours,
+                              double enter_angle, bool single_edge_tips)
   {
     int nv_start = NV();
     std::vector<char> waits(skip_neighbours ? nv_start : 0, 0);
@@ -308,7 +333,7 @@ namespace ngfracture
                                       " is zero or not finite");
         if (skip_neighbours && waits[v]) continue;
         int nv_before = NV();
-        ProcessVertex(v, d);
+        ProcessVertex(v, d, enter_angle, single_edge_tips);
         if (skip_neighbours && NV() > nv_before)
           // the triangles around v in the input mesh: their vertices wait for the next pass
           for (int k = star_off[v]; k < star_off[v+1]; k++)

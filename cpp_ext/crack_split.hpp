@@ -27,7 +27,11 @@ namespace ngfracture
       RULE_2A     = 16,   // boundary vertex whose best edge is a boundary edge: no split
       RULE_2B     = 32,   // far end of the rule-2 edge split too
       RULE_TIP    = 64,   // crack tip (open fan closing on itself): handled by rule 1
-      RULE_NONE   = 128   // nothing split (no admissible edge, pinched or isolated vertex)
+      RULE_NONE   = 128,  // nothing split (no admissible edge, pinched or isolated vertex)
+      RULE_2C     = 256,  // boundary vertex whose best edge is a boundary edge: the best
+                          // interior edge within enter_angle of the crack line cut instead
+      RULE_TIP1   = 512   // crack tip extended by one edge, the one nearest the crack line
+                          // ahead of the tip (single_edge_tips)
     };
 
   class CrackSplitter
@@ -42,7 +46,14 @@ namespace ngfracture
     // direction of order[i]. Vertices created during the pass are not processed.
     // skip_neighbours: a vertex that shares a triangle with one split earlier in this
     // pass is skipped (its strain predates that split; it is judged again next pass).
-    void Run (const int * order, const double * dirs, int n, bool skip_neighbours = false);
+    // enter_angle (radians, 0: the paper's rule 2a): a boundary vertex whose best edge is a
+    // boundary edge cuts its best interior edge if that lies within enter_angle of the
+    // crack line (the crack enters the body, rule 2c), else nothing (rule 2a).
+    // single_edge_tips: a crack tip cuts one edge, the interior edge nearest the half of the
+    // crack line that points away from the crack (rule tip1), instead of two (rule 1):
+    // a crack grows from its tip and does not fork there.
+    void Run (const int * order, const double * dirs, int n, bool skip_neighbours = false,
+              double enter_angle = 0.0, bool single_edge_tips = false);
 
     // After Run: segments of the new mesh and the fragments.
     void Finish ();
@@ -87,7 +98,7 @@ namespace ngfracture
     // Fan components of w's triangles with the edges (w, cut[i]) removed; labels per star entry.
     int Components (int w, const int * cut, int ncut, std::vector<int> & label) const;
     bool SplitAt (int w, const int * cut, int ncut);   // cut: far vertices of removed edges
-    void ProcessVertex (int v, const double * dir);
+    void ProcessVertex (int v, const double * dir, double enter_angle, bool single_edge_tips);
     bool ShareTriangle (int v, const Edge & a, const Edge & b) const;
   };
 }

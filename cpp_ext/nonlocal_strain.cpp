@@ -163,33 +163,72 @@ namespace ngfracture
       return 0.5*(T(v,0)+T(v,1)) + hypot(0.5*(T(v,0)-T(v,1)), T(v,2));
     }
 
+    // Sharp tips: boundary vertices whose corner angle inside the body is at least
+    // SHARP_ANGLE, crack tips (360 degrees) and sharp notch tips. Their strain is singular,
+    // they are the stress concentrations from which the critical distance is measured.
+    constexpr double SHARP_ANGLE = 300.0 * M_PI / 180.0;
+
+    std::vector<char> SharpTips (const Mesh2 & m)
+    {
+      size_t nv = m.x.size();
+      std::vector<double> angle(nv, 0.0);
+      std::vector<char> boundary(nv, 0);
+      for (size_t e = 0; e < m.tri.size(); e++)
+        for (int i = 0; i < 3; i++)
+          {
+            int a = m.tri[e][i], b = m.tri[e][(i+1)%3], c = m.tri[e][(i+2)%3];
+            double bx = m.x[b]-m.x[a], by = m.y[b]-m.y[a], cx = m.x[c]-m.x[a], cy = m.y[c]-m.y[a];
+            angle[a] += std::atan2(bx*cy - by*cx, bx*cx + by*cy);
+            if (m.nb[e][i] < 0) { boundary[b] = 1; boundary[c] = 1; }
+          }
+      std::vector<char> sharp(nv, 0);
+      for (size_t v = 0; v < nv; v++)
+        sharp[v] = boundary[v] && angle[v] >= SHARP_ANGLE;
+      return sharp;
+    }
+
+    // A sharp tip's own field reaches farther than r: the opening stress of the mode-I
+    // singular field across a line parallel to the crack is largest at 60 degrees from it,
+    // 3 sqrt(3)/4 times its value straight ahead at the same distance, so a vertex within
+    // (3 sqrt(3)/4)^2 r = 27/16 r of the tip can see more than the tip's own measure. That
+    // is the tip's field seen from the side, not a concentration of its own.
+    constexpr double TIP_ZONE = 27.0 / 16.0;
+
     // v is a hot spot when it leads every vertex within distance r that the mesh connects to
-    // it inside that disk: larger local value, ties to the smaller vertex number.
-    bool HotSpot (const Mesh2 & m, FlatMatrix<double> T, int v, double r,
+    // it inside that disk, and no sharp tip lies within TIP_ZONE r (connected likewise).
+    // A sharp tip leads every vertex that is not one (its one-ring value is an average over
+    // the singular field, not the field's size); otherwise the larger local value leads,
+    // ties to the smaller vertex number.
+    bool HotSpot (const Mesh2 & m, FlatMatrix<double> T, const std::vector<char> & sharp, int v, double r,
                   std::vector<int> & mark, std::vector<int> & queue)
     {
       const double lv = LocalValue(T, v);
       const double r2 = r * r;
+      const double zone2 = sharp[v] ? r2 : TIP_ZONE * TIP_ZONE * r2;
       queue.clear();
       queue.push_back(v);
       mark[v] = v;
-      bool hot = true;
-      for (size_t q = 0; q < queue.size() && hot; q++)
+      for (size_t q = 0; q < queue.size(); q++)
         {
           int w = queue[q];
-          for (int k = m.vt_begin[w]; k < m.vt_begin[w+1] && hot; k++)
+          for (int k = m.vt_begin[w]; k < m.vt_begin[w+1]; k++)
             for (int u : m.tri[m.vt[k]])
               {
                 if (mark[u] == v) continue;
                 mark[u] = v;
                 double dx = m.x[u]-m.x[v], dy = m.y[u]-m.y[v];
-                if (dx*dx + dy*dy > r2) continue;
-                double lu = LocalValue(T, u);
-                if (lu > lv || (lu == lv && u < v)) { hot = false; break; }
+                double d2 = dx*dx + dy*dy;
+                if (d2 > zone2) continue;
+                if (sharp[u] && !sharp[v]) return false;
+                if (d2 <= r2 && sharp[u] == sharp[v])
+                  {
+                    double lu = LocalValue(T, u);
+                    if (lu > lv || (lu == lv && u < v)) return false;
+                  }
                 queue.push_back(u);
               }
         }
-      return hot;
+      return true;
     }
   }
 
@@ -210,12 +249,13 @@ namespace ngfracture
     std::vector<double> value(ndir);
     std::vector<char> ok(ndir);
     std::vector<int> mark(nv, -1), queue;
+    const std::vector<char> sharp = SharpTips(m);
     // Serial: deterministic, and a few ms per 10k vertices at r = 4h.
     for (size_t v = 0; v < nv; v++)
       {
         result(v,0) = result(v,1) = result(v,2) = 0.0;
         if (!(radius[v] > 0) || m.vt_begin[v] == m.vt_begin[v+1]) continue;
-        if (!HotSpot(m, T, int(v), radius[v], mark, queue)) continue;
+        if (!HotSpot(m, T, sharp, int(v), radius[v], mark, queue)) continue;
         int kbest = -1;
         for (int k = 0; k < ndir; k++)
           {

@@ -41,7 +41,8 @@ void ExportCrack (py::module & m)
   py::dict rules;
   rules["1"] = int(RULE_1); rules["1a"] = int(RULE_1A); rules["1b"] = int(RULE_1B);
   rules["2"] = int(RULE_2); rules["2a"] = int(RULE_2A); rules["2b"] = int(RULE_2B);
-  rules["tip"] = int(RULE_TIP); rules["none"] = int(RULE_NONE);
+  rules["tip"] = int(RULE_TIP); rules["none"] = int(RULE_NONE); rules["2c"] = int(RULE_2C);
+  rules["tip1"] = int(RULE_TIP1);
   m.attr("CRACK_RULES") = rules;   // bit flags of the split record's "rule" entries
 
   m.def("CrackElementStrain",
@@ -191,7 +192,7 @@ Returns
 
   m.def("CrackSplit",
         [] (shared_ptr<netgen::Mesh> ngmesh, iarray vertices, darray directions, std::string crack_name,
-            bool skip_neighbours)
+            bool skip_neighbours, double enter_angle, bool single_edge_tips)
         {
           auto t0 = std::chrono::steady_clock::now();
           MeshArrays a = ExtractArrays(*ngmesh);
@@ -202,7 +203,9 @@ Returns
             throw Exception("ngfracture.CrackSplit: directions must have shape (len(vertices), 2) = (" +
                             ToString(n) + ", 2)");
           CrackSplitter split(a.points.data(), a.nv, a.trigs.data(), a.ne, a.segs.data(), a.ns);
-          split.Run(vertices.data(), directions.data(), int(n), skip_neighbours);
+          if (!(enter_angle >= 0 && enter_angle < M_PI / 2))
+            throw Exception("ngfracture.CrackSplit: enter_angle must be in [0, pi/2), got " + ToString(enter_angle));
+          split.Run(vertices.data(), directions.data(), int(n), skip_neighbours, enter_angle, single_edge_tips);
           split.Finish();
           auto t1 = std::chrono::steady_clock::now();
           auto newmesh = RebuildMesh(*ngmesh, split, crack_name);
@@ -230,7 +233,7 @@ Returns
           return res;
         },
         py::arg("ngmesh"), py::arg("vertices"), py::arg("directions"), py::arg("crack_name") = "crack",
-        py::arg("skip_neighbours") = false,
+        py::arg("skip_neighbours") = false, py::arg("enter_angle") = 0.0, py::arg("single_edge_tips") = false,
         R"doc(Split vertices of a 2D netgen mesh along the edges most orthogonal to a direction.
 
 Low-level: use ngfracture.crack.split_vertices.
@@ -247,6 +250,13 @@ crack_name : str
     Boundary name of the new boundary segments.
 skip_neighbours : bool
     Skip a vertex that shares a triangle with a vertex split earlier in this pass.
+enter_angle : float
+    Radians in [0, pi/2); 0: the paper's rule 2a. Else a boundary vertex whose best edge is
+    a boundary edge cuts its best interior edge if that is within enter_angle of the crack
+    line (rule 2c).
+single_edge_tips : bool
+    A crack tip cuts one edge, the interior edge nearest the half of the crack line away
+    from the crack (rule tip1), instead of two (rule 1).
 
 Returns
 -------

@@ -97,7 +97,7 @@ CONTROL_OPTIONS = [
     ("dx_min", "float", "smallest increment (default: the scene's dx / 64)"),
     ("dx_max", "float", "largest increment (default: 8 times the scene's dx)"),
     ("max_retries", "int0", "failed attempts in a row before the run stops (default 6)"),
-    ("split", ("spread", "all", "one"), "which overstrained vertices a crack pass splits (default spread)"),
+    ("split", ("spread", "all", "one"), "which overstrained vertices a crack pass splits (default: spread; one for a scene with a critical distance)"),
 ]
 
 

@@ -43,6 +43,12 @@ Rules as implemented (paper section 3; decisions where the paper is silent)
   (propagation), otherwise two new edges are cut (branching).
 * Boundary vertex (rule 2, also on crack faces): the best edge among all its edges; if it
   is a boundary edge nothing is split (rule 2a), else it is cut.
+* Growth rules (``SplitRules``, used with the critical-distance criterion): a crack tip
+  cuts one edge, the interior edge nearest the half of the crack line away from the crack
+  (rule tip1: a crack grows from its tip, it does not fork there); a boundary vertex
+  whose best edge is a boundary edge cuts its best interior edge if that lies within
+  ``enter_angle`` of the crack line (rule 2c: a crack starts at a V-notch tip, whose
+  flank is often the best edge).
 * Rules 1b/2b and "never two pieces joined by a single vertex": after the cut, the far end
   of every cut edge is split if its fan fell apart (it was on the boundary, on a crack face
   or a crack tip). Only the processed vertex and those far ends change their fans.
@@ -63,7 +69,8 @@ from . import _ngfracture as _C
 from .meshcheck import validate_mesh
 
 __all__ = [
-    "RULE_1", "RULE_1A", "RULE_1B", "RULE_2", "RULE_2A", "RULE_2B", "RULE_TIP", "RULE_NONE",
+    "RULE_1", "RULE_1A", "RULE_1B", "RULE_2", "RULE_2A", "RULE_2B", "RULE_2C", "RULE_TIP", "RULE_TIP1",
+    "RULE_NONE", "SplitRules", "PAPER_RULES", "GROWTH_RULES",
     "StrainCriterion", "SplitResult", "vertex_displacement", "element_strain", "vertex_strain",
     "equivalent_strain", "nonlocal_opening", "toughness", "critical_distance", "principal",
     "select", "split_vertices", "transfer", "transfer_vertex_field", "split_by_tensor",
@@ -79,9 +86,45 @@ RULE_2A = 16     # boundary vertex whose best edge is a boundary edge: nothing s
 RULE_2B = 32     # the far end of the rule-2 edge was split as well
 RULE_TIP = 64    # crack tip (fan open only along a crack): treated by rule 1
 RULE_NONE = 128  # nothing split (no admissible edge pair, isolated or pinched vertex)
+RULE_2C = 256    # boundary vertex whose best edge is a boundary edge: the crack entered the body (enter_angle)
+RULE_TIP1 = 512  # crack tip extended by one edge (single_edge_tips)
 
 _RULE_NAMES = [(RULE_1, "1"), (RULE_1A, "1a"), (RULE_1B, "1b"), (RULE_2, "2"),
-               (RULE_2A, "2a"), (RULE_2B, "2b"), (RULE_TIP, "tip"), (RULE_NONE, "none")]
+               (RULE_2A, "2a"), (RULE_2B, "2b"), (RULE_TIP, "tip"), (RULE_NONE, "none"), (RULE_2C, "2c"),
+               (RULE_TIP1, "tip1")]
+
+
+@dataclass(frozen=True)
+class SplitRules:
+    """Which edges a pass cuts at crack tips and boundary vertices.
+
+    Parameters
+    ----------
+    enter_angle : float
+        Radians in [0, pi/2). 0: the paper's rule 2a. Else a boundary vertex whose best
+        edge is a boundary edge cuts its best interior edge if that lies within
+        ``enter_angle`` of the crack line (rule 2c).
+    single_edge_tips : bool
+        A crack tip cuts one edge, ahead of the crack (rule tip1), instead of two (rule 1).
+
+    Raises
+    ------
+    ValueError
+        An ``enter_angle`` outside [0, pi/2).
+    """
+    enter_angle: float = 0.0
+    single_edge_tips: bool = False
+
+    def __post_init__(self):
+        if not (isinstance(self.enter_angle, (int, float)) and 0 <= self.enter_angle < math.pi / 2):
+            raise ValueError(f"ngfracture.crack: enter_angle must be in [0, pi/2) radians, got {self.enter_angle!r}")
+
+
+PAPER_RULES = SplitRules()
+# The critical-distance criterion's: 30 degrees lets a crack along the bisector of a V-notch
+# (flank 14 degrees off in the plate) enter the body, and keeps out a crack line along a
+# straight boundary, whose interior edges are 45 degrees or more off on netgen's meshes.
+GROWTH_RULES = SplitRules(enter_angle=math.radians(30.0), single_edge_tips=True)
 
 
 def rule_names(flags):
@@ -288,9 +331,13 @@ def nonlocal_opening(mesh, element_tensors, radius, ndir=72):
 
     The element tensors are averaged at the vertices (area weights) and interpolated
     linearly; from every vertex, rays of length ``radius`` in ``ndir`` directions are walked
-    through the mesh (a ray that meets the boundary or a crack face before its end does not
-    count); a ray's value is the smallest opening component n.T.n (n perpendicular to the
-    ray) along it, the vertex's value the largest over the rays (refined by a parabola).
+    through the mesh (a ray that meets the boundary or a crack face before its end is judged
+    up to it; a direction that points out of the body does not count); a ray's value is the
+    smallest opening component n.T.n (n perpendicular to the ray) along it, the vertex's
+    value the largest over the rays (refined by a parabola). Only hot spots are judged: a
+    sharp tip (a crack tip or a notch tip, corner angle of at least 300 degrees) leads every
+    other vertex within 27/16 ``radius``, otherwise a vertex must have the largest nodal
+    principal value within ``radius``; the others get 0.
 
     Parameters
     ----------
@@ -541,7 +588,7 @@ class SplitResult:
         return len(self.parent) - int(self.record["nv_old"])
 
 
-def split_vertices(mesh, vertices, directions, crack_name="crack", skip_neighbours=False):
+def split_vertices(mesh, vertices, directions, crack_name="crack", skip_neighbours=False, rules=PAPER_RULES):
     """Split vertices along the edges most orthogonal to given directions (rules 1-2b).
 
     The mesh itself is not checked here (crack_step and split_by_tensor run
@@ -561,6 +608,8 @@ def split_vertices(mesh, vertices, directions, crack_name="crack", skip_neighbou
         Skip a vertex that shares a triangle with a vertex split earlier in the pass: its
         strain predates that split, which relieves it; it is judged again after the
         next equilibrium. (False: every listed vertex is processed, the paper's pass.)
+    rules : SplitRules
+        ``PAPER_RULES`` (rules 1-2b) or ``GROWTH_RULES`` (single-edge tips, rule 2c).
 
     Returns
     -------
@@ -589,7 +638,10 @@ def split_vertices(mesh, vertices, directions, crack_name="crack", skip_neighbou
         raise ValueError("ngfracture.crack: a vertex appears twice in the processing order")
     if not np.all(np.isfinite(d)) or np.any(np.all(d == 0, axis=1)):
         raise ValueError("ngfracture.crack: directions must be finite and nonzero")
-    r = _C.CrackSplit(mesh.ngmesh, v, d, crack_name, bool(skip_neighbours))
+    if not isinstance(rules, SplitRules):
+        raise TypeError(f"ngfracture.crack: rules must be a SplitRules, got {type(rules).__name__}")
+    r = _C.CrackSplit(mesh.ngmesh, v, d, crack_name, bool(skip_neighbours), float(rules.enter_angle),
+                      bool(rules.single_edge_tips))
     t0 = time.perf_counter()
     # nothing split: keep the very same mesh, so callers keep their spaces and factorisations
     newmesh = mesh if len(r["parent"]) == mesh.nv else ngsolve.Mesh(r["ngmesh"])
@@ -679,7 +731,8 @@ def transfer(u, result):
     return gf
 
 
-def split_by_tensor(mesh, tensors, critical, crack_name="crack", skip_neighbours=False, first_only=False):
+def split_by_tensor(mesh, tensors, critical, crack_name="crack", skip_neighbours=False, first_only=False,
+                    rules=PAPER_RULES):
     """One splitting pass from a vertex tensor field supplied by the caller.
 
     Parameters
@@ -698,6 +751,8 @@ def split_by_tensor(mesh, tensors, critical, crack_name="crack", skip_neighbours
         Split only the first vertex of the order that splits anything (one event per pass:
         every other vertex is judged again after the next equilibrium); the vertices before
         it, which split nothing (rules 2a, none), are in the record.
+    rules : SplitRules
+        See :func:`split_vertices`.
 
     Returns
     -------
@@ -718,19 +773,19 @@ def split_by_tensor(mesh, tensors, critical, crack_name="crack", skip_neighbours
     if t.shape != (mesh.nv, 3):
         raise ValueError(f"ngfracture.crack: tensor field must have shape ({mesh.nv}, 3), got {t.shape}")
     validate_mesh(mesh)
-    return _split_pass(mesh, t, c, crack_name, skip_neighbours, first_only)
+    return _split_pass(mesh, t, c, crack_name, skip_neighbours, first_only, rules)
 
 
-def _split_pass(mesh, tensors, critical, crack_name, skip_neighbours=False, first_only=False):
+def _split_pass(mesh, tensors, critical, crack_name, skip_neighbours=False, first_only=False, rules=PAPER_RULES):
     values, dirs = principal(tensors)
     order = _C.CrackSelect(values, critical)
     if first_only:
         # the engine processes a whole order: find the first vertex that splits alone
         for k in range(len(order)):
-            if split_vertices(mesh, order[k:k + 1], dirs[order[k:k + 1]], crack_name).nsplit:
+            if split_vertices(mesh, order[k:k + 1], dirs[order[k:k + 1]], crack_name, rules=rules).nsplit:
                 order = order[:k + 1]
                 break
-    res = split_vertices(mesh, order, dirs[order], crack_name, skip_neighbours)
+    res = split_vertices(mesh, order, dirs[order], crack_name, skip_neighbours, rules)
     res.record["principal"] = values[order]
     return res
 

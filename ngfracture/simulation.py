@@ -54,10 +54,10 @@ from typing import Callable
 import numpy as np
 import ngsolve as ng
 
-from . import checkpoint
+from . import checkpoint, rigid
 from .contact_solver import ContactSolver, fragment_overlap_area
-from .crack import (StrainCriterion, element_strain, equivalent_strain, nonlocal_opening,
-                    split_by_tensor, transfer, transfer_vertex_field)
+from .crack import (GROWTH_RULES, PAPER_RULES, StrainCriterion, element_strain, equivalent_strain,
+                    nonlocal_opening, split_by_tensor, transfer, transfer_vertex_field)
 from .fragments import FragmentStatistics
 from .kkt import single_threaded_blas
 from .loadpath import load_path_cut, prescribed_increment
@@ -233,7 +233,8 @@ class StepControl:
         next equilibrium, which the split has changed, instead of on their strain from
         before it. "one": only the most overstrained vertex that splits anything, every
         other one judged again after the next equilibrium (one event at a time; more
-        passes; docs/criterion.md).
+        passes; docs/criterion.md); the default for a scene with a critical distance
+        (``Scene.radius``) unless the scene's or the user's control sets it.
 
     **settings
         The fields above by name (keyword only); the others take their defaults. Only
@@ -476,7 +477,11 @@ class Simulation:
         self.critical = scene.validate()
         # the user's control overrides only the fields it sets; neither object is changed
         user = control if control is not None else StepControl()
-        self.control = user.over(scene.control).resolved(scene.dx)
+        control = user.over(scene.control)
+        if scene.radius is not None and "split" not in control.explicit:
+            # cracks judged at a critical distance grow one event at a time (docs/criterion.md)
+            control = control.over({"split": "one"})
+        self.control = control.resolved(scene.dx)
         self._method = self.control.method      # the Newton variant of the current attempt
         if pictures not in ("final", "every", "none"):
             raise ValueError(f"pictures must be 'final', 'every' or 'none', got {pictures!r}")
@@ -674,8 +679,10 @@ class Simulation:
         """One splitting pass; returns (new problem or None, number of split vertices, strength)."""
         tensors = self._normalised_strain(prob, strength)
         t0 = time.perf_counter()
+        # cracks judged at a critical distance grow from their tips (docs/criterion.md)
+        rules = PAPER_RULES if self.scene.radius is None else GROWTH_RULES
         res = split_by_tensor(prob.mesh, tensors, 1.0, skip_neighbours=self.control.split == "spread",
-                              first_only=self.control.split == "one")
+                              first_only=self.control.split == "one", rules=rules)
         self.timings["split"] += time.perf_counter() - t0 - sum(res.timings.get(k, 0.0) for k in ("netgen", "ngsolve_mesh"))
         self.timings["rebuild"] += res.timings.get("netgen", 0.0) + res.timings.get("ngsolve_mesh", 0.0)
         if res.nsplit == 0:
@@ -709,6 +716,8 @@ class Simulation:
                 raise StepFailed("relaxation", "relaxation", f"cracks still grow after {c.max_relax_passes} passes at fixed load")
             prob = new_prob
             keys = self._equilibrium(prob, "relaxation", warm=keys)
+            if self.scene.stop_when_unloaded and self._cut_through(prob.mesh, prob.assemble_constraints()):
+                break     # the run ends with this step: no crack in the separated pieces
             new_prob, n, strength = self._crack_pass(prob, strength)
             total += n
         return prob, first, total, strength, keys
@@ -877,16 +886,25 @@ class Simulation:
     def _broken(self, state):
         """Why the accepted state is broken through (Scene.stop_when_unloaded), or ""."""
         last = state.history[-1]
-        if last["fragments"] > 1:
-            # the prescribed values at x (state.fixed_*, on this mesh) against those at 0
-            unloaded = self._problem(self._mesh, 0.0).assemble_constraints()
-            dofs, increment = prescribed_increment(unloaded.fixed_dofs, unloaded.fixed_values,
-                                                   state.fixed_dofs, state.fixed_values)
-            if load_path_cut(state.arrays.points, state.arrays.triangles, dofs, increment):
-                return "the body is broken through (no fragment connects boundaries the load moves apart)"
+        if last["fragments"] > 1 and self._cut_through(self._mesh, state):
+            return "the body is broken through (no fragment connects boundaries the load moves apart)"
         if last["crack_length"] > 0 and last["elastic_energy"] < self.control.unloaded_fraction * state.peak_energy:
             return "the body is broken through (elastic energy released)"
         return ""
+
+    def _cut_through(self, mesh, loaded):
+        """True when no fragment of ``mesh`` connects boundaries the load moves apart.
+
+        ``loaded``: the fixed dofs and values at the load (constraint rows or a State).
+        """
+        arrays = mesh_to_arrays(mesh)
+        if rigid.pieces(arrays.triangles, mesh.nv)[0] < 2:
+            return False
+        # the prescribed values at x against those at 0, on this mesh
+        unloaded = self._problem(mesh, 0.0).assemble_constraints()
+        dofs, increment = prescribed_increment(unloaded.fixed_dofs, unloaded.fixed_values,
+                                               loaded.fixed_dofs, loaded.fixed_values)
+        return load_path_cut(arrays.points, arrays.triangles, dofs, increment)
 
     def _summary(self, state, prob, stats, area_initial, reason, message, wall):
         hist = state.history

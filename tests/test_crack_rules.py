@@ -235,3 +235,65 @@ def test_first_only_splits_the_first_vertex_that_splits():
     # nothing splittable: the whole order processed, nothing split, the same mesh
     none = crack.split_by_tensor(m, np.where(np.arange(nv)[:, None] == edge, tensors, 0.0), 1.0, first_only=True)
     assert none.nsplit == 0 and none.mesh is m
+
+
+@pytest.mark.parametrize("enter_deg, rule", [(0.0, crack.RULE_2 | crack.RULE_2A), (24.0, crack.RULE_2 | crack.RULE_2A),
+                                             (30.0, crack.RULE_2 | crack.RULE_2C)])
+def test_rule_2c_a_crack_from_a_corner_enters_the_body(enter_deg, rule):
+    """Corner (0, 0) of the grid: a crack line at 20 degrees to the bottom edge. The best
+    edge is that boundary edge (20 degrees off); the only interior edge, the diagonal, is
+    25 degrees off: cut (rule 2c) when enter_angle allows 25 degrees, else nothing (2a)."""
+    m = grid_mesh(4, 4)
+    v = vid(4, 0, 0)
+    a = np.radians(20.0)
+    res = crack.split_vertices(m, [v], [[-np.sin(a), np.cos(a)]], rules=crack.SplitRules(enter_angle=np.radians(enter_deg)))
+    check_invariants(m, res)
+    assert res.record["rule"][0] == rule
+    if rule & crack.RULE_2C:
+        assert edge_set(res) == {(v, vid(4, 1, 1))} and res.mesh.nv == m.nv + 1
+        assert crack_length(res.mesh) == pytest.approx(2 * np.sqrt(2.0), rel=1e-14)   # both faces
+        assert crack.rule_names(res.record["rule"][0]) == ["2", "2c"]
+    else:
+        assert res.mesh.nv == m.nv
+
+
+def test_rule_2c_keeps_a_crack_line_along_the_boundary_out():
+    """On a straight edge, a crack line along the boundary has its best interior edge 45
+    degrees off (the grid) or more: nothing is split for any enter_angle below that."""
+    m = grid_mesh(4, 4)
+    res = crack.split_vertices(m, [vid(4, 2, 0)], Y, rules=crack.SplitRules(enter_angle=np.radians(44.0)))
+    assert res.record["rule"][0] == crack.RULE_2 | crack.RULE_2A and res.mesh.nv == m.nv
+    with pytest.raises(ValueError, match="enter_angle"):
+        crack.SplitRules(enter_angle=np.pi / 2)
+
+
+def test_single_edge_tip_grows_without_forking():
+    """The tip of test_branching_at_tip under the growth rules: one edge, the grid diagonal
+    along the half of the crack line away from the crack (the paper's rule 1 forks there)."""
+    m = grid_mesh(6, 6)
+    res = split1(m, vid(6, 3, 3), X)
+    tip = vid(6, 3, 4)
+    d = np.array([[1.0, -1.0]]) / np.sqrt(2)
+    res2 = crack.split_vertices(res.mesh, [tip], d, rules=crack.GROWTH_RULES)
+    check_invariants(res.mesh, res2)
+    assert res2.record["rule"][0] == crack.RULE_TIP | crack.RULE_TIP1
+    assert crack.rule_names(res2.record["rule"][0]) == ["tip", "tip1"]
+    assert edge_set(res2) == {(tip, vid(6, 4, 5))}
+    assert res2.mesh.nv == res.mesh.nv + 1 and res2.nfragments == 1
+    assert crack_length(res2.mesh) == pytest.approx(4.0 + 2 * np.sqrt(2.0), rel=1e-14)
+    # the same crack line with the other orientation of the direction: the same edge
+    res3 = crack.split_vertices(res.mesh, [tip], -d, rules=crack.GROWTH_RULES)
+    assert edge_set(res3) == {(tip, vid(6, 4, 5))}
+
+
+def test_single_edge_tip_reaches_the_boundary():
+    """A tip one edge from the boundary grows through to it: the far end splits (rule 1b)
+    and the body falls in two, as under the paper's rules."""
+    m = grid_mesh(4, 4)
+    res = split1(m, vid(4, 2, 2), X)
+    res2 = crack.split_vertices(res.mesh, [vid(4, 2, 3)], X, rules=crack.GROWTH_RULES)
+    assert res2.record["rule"][0] == crack.RULE_TIP | crack.RULE_TIP1 | crack.RULE_1B
+    assert edge_set(res2) == {(vid(4, 2, 3), vid(4, 2, 4))}
+    res3 = crack.split_vertices(res2.mesh, [vid(4, 2, 1)], X, rules=crack.GROWTH_RULES)
+    assert res3.nfragments == 2
+    assert crack_length(res3.mesh) == pytest.approx(8.0, rel=1e-14)

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 import ngsolve as ng
 
-from ngfracture.crack import StrainCriterion, critical_distance, principal, toughness
+from ngfracture.crack import StrainCriterion, critical_distance, nonlocal_opening, principal, toughness
 from critical_distance_util import centre_crack_mesh, plate_initiation, solve_linear, tada_centre_crack
 from ngfracture.materials import LinearElastic
 
@@ -193,3 +193,46 @@ def test_scene_radius_is_checked_before_any_work():
         scene.validate()
     with pytest.raises(ValueError, match="radius"):
         scenes.plate(maxh=0.1, radius=0.0)
+
+
+def test_a_critical_distance_scene_splits_one_vertex_per_pass_unless_told_otherwise():
+    from ngfracture import scenes
+    from ngfracture.simulation import Simulation, StepControl
+    assert Simulation(scenes.plate(maxh=0.1)).control.split == "spread"
+    assert Simulation(scenes.plate(maxh=0.1, radius=0.05)).control.split == "one"
+    assert Simulation(scenes.plate(maxh=0.1, radius=0.05), StepControl(split="spread")).control.split == "spread"
+    scene = scenes.plate(maxh=0.1, radius=0.05)
+    scene.control = {"split": "all"}
+    assert Simulation(scene).control.split == "all"
+
+
+def test_crack_tips_lead_their_zone(crack_r40):
+    """Under mode I the two crack tips carry the largest measure."""
+    a, r, mesh = crack_r40
+    mat = LinearElastic(E, NU, plane="stress")
+    crit = StrainCriterion(CRITICAL, "linear", radius=r, material=mat)
+    values, _ = principal(crit.vertex_tensor(mesh, _tension(mesh, mat)))
+    P = mesh.ngmesh.Coordinates()[:, :2]
+    tips = np.flatnonzero(np.minimum(np.hypot(*(P - [a, 0]).T), np.hypot(*(P + [a, 0]).T)) == 0)
+    assert len(tips) == 2 and int(np.argmax(values)) in tips
+
+
+@pytest.mark.parametrize("distance, judged", [(1.5, False), (1.8, True)])
+def test_a_hot_spot_within_27_16_r_of_a_tip_is_not_judged(crack_r40, distance, judged):
+    """A sharp tip leads every vertex within 27/16 r, (3 sqrt(3)/4)^2 r: the largest angular
+    factor of the mode-I opening stress across lines parallel to the crack, squared
+    (docs/criterion.md). Uniform opening stress with a bump of 1.5 on the triangles around
+    one vertex w at 60 degrees from the crack line: w leads its disk of radius r by its local
+    value, and is judged only outside the tip's zone."""
+    a, r, mesh = crack_r40
+    P = mesh.ngmesh.Coordinates()[:, :2]
+    target = [a + distance * r / 2, distance * r * math.sqrt(3) / 2]
+    w = int(np.argmin(np.hypot(*(P - target).T)))
+    d = np.hypot(*(P[w] - [a, 0]))
+    assert (d > 27 / 16 * r) == judged and abs(d / r - distance) < 0.1
+    T = np.array([[v.nr for v in el.vertices] for el in mesh.Elements(ng.VOL)])
+    tensors = np.tile([0.0, 1.0, 0.0], (mesh.ne, 1))
+    tensors[np.any(T == w, axis=1), 1] = 1.5
+    values, _ = principal(nonlocal_opening(mesh, tensors, r))
+    # judged: the smallest opening stress along the best ray of length r, the uniform 1
+    assert values[w] == (pytest.approx(1.0, rel=1e-4) if judged else 0.0)
