@@ -52,7 +52,6 @@ from pathlib import Path
 from typing import Callable
 
 import numpy as np
-import ngsolve as ng
 
 from . import checkpoint, rigid
 from .contact_solver import ContactSolver, fragment_overlap_area
