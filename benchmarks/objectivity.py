@@ -17,6 +17,7 @@ Usage::
 
     PYTHONPATH=. python benchmarks/objectivity.py [--json F] [--plot F.png] [--force]
         [--radius 0.02] [--levels 3] [--crack-maxh 0.034 0.017]
+        [--crack-criteria one-ring critical-distance]
 
 Without ``--json`` the JSON goes to stdout.
 """
@@ -58,10 +59,11 @@ def initiation(radius, levels):
     return rows
 
 
-def crack(radius, maxhs):
+def crack(radius, maxhs, criteria=("one-ring", "critical-distance")):
     """One plate simulation per mesh size and criterion."""
     rows = []
-    for criterion in (None, radius):
+    chosen = {"one-ring": None, "critical-distance": radius}
+    for criterion in (chosen[name] for name in criteria):
         part = []
         for maxh in maxhs:
             t0 = time.perf_counter()
@@ -123,11 +125,14 @@ def main(argv=None):
                         help="initiation levels h = r/2 ... r/2^levels (default 3)")
     parser.add_argument("--crack-maxh", type=_positive_float, nargs="*", default=[0.034],
                         help="mesh sizes of the plate simulations (default 0.034; none: skip)")
+    parser.add_argument("--crack-criteria", nargs="+", choices=("one-ring", "critical-distance"),
+                        default=["one-ring", "critical-distance"],
+                        help="criteria of the plate simulations (default both)")
     args = parser.parse_args(argv)
     benchmark_json.refuse_existing(parser, args, args.plot)
     result = {"problem": "notched plate", "radius": args.radius,
               "initiation": initiation(args.radius, args.levels),
-              "crack": crack(args.radius, sorted(args.crack_maxh, reverse=True))}
+              "crack": crack(args.radius, sorted(args.crack_maxh, reverse=True), args.crack_criteria)}
     benchmark_json.write(args, result)
     if args.plot:
         plot(result, args.plot)

@@ -194,11 +194,12 @@ namespace ngfracture
     // is the tip's field seen from the side, not a concentration of its own.
     constexpr double TIP_ZONE = 27.0 / 16.0;
 
-    // v is a hot spot when it leads every vertex within distance r that the mesh connects to
-    // it inside that disk, and no sharp tip lies within TIP_ZONE r (connected likewise).
-    // A sharp tip leads every vertex that is not one (its one-ring value is an average over
-    // the singular field, not the field's size); otherwise the larger local value leads,
-    // ties to the smaller vertex number.
+    // v is a hot spot when it is a sharp tip, or when no sharp tip lies within TIP_ZONE r
+    // and v leads every vertex within distance r, both counted among the vertices the mesh
+    // connects to v inside those disks: the larger local value leads, ties to the smaller
+    // vertex number. Every sharp tip is judged (each is a stress concentration of its own,
+    // and one that cannot split must not silence another); the one-ring value of a vertex
+    // near a tip is an average over the singular field, not the field's size.
     bool HotSpot (const Mesh2 & m, FlatMatrix<double> T, const std::vector<char> & sharp, int v, double r,
                   std::vector<int> & mark, std::vector<int> & queue)
     {
@@ -220,7 +221,7 @@ namespace ngfracture
                 double d2 = dx*dx + dy*dy;
                 if (d2 > zone2) continue;
                 if (sharp[u] && !sharp[v]) return false;
-                if (d2 <= r2 && sharp[u] == sharp[v])
+                if (d2 <= r2 && !sharp[u] && !sharp[v])
                   {
                     double lu = LocalValue(T, u);
                     if (lu > lv || (lu == lv && u < v)) return false;

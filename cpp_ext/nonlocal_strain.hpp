@@ -8,10 +8,10 @@
 // the whole segment of length r must be overstressed for a crack to run along it. The
 // vertex keeps the largest value over the directions and its opening direction n.
 //
-// Only hot spots are judged: a sharp tip (boundary vertex with a corner angle of at least
-// 300 degrees: a crack tip, a sharp notch) unless another one leads it within r, and a
-// vertex with no sharp tip within 27/16 r whose local (nodal) principal value is the
-// largest among the vertices within distance r connected to it (ties: smaller number).
+// Only hot spots are judged: every sharp tip (boundary vertex with a corner angle of at
+// least 300 degrees: a crack tip, a sharp notch), and a vertex with no sharp tip within
+// 27/16 r whose local (nodal) principal value is the largest among the vertices within
+// distance r connected to it (ties: smaller number).
 // The critical distance is measured from the stress concentration, as in the theory of
 // critical distances; the other vertices of its zone get 0 (they are judged once they lead).
 //
