@@ -203,9 +203,10 @@ namespace ngfracture
     bool HotSpot (const Mesh2 & m, FlatMatrix<double> T, const std::vector<char> & sharp, int v, double r,
                   std::vector<int> & mark, std::vector<int> & queue)
     {
+      if (sharp[v]) return true;
       const double lv = LocalValue(T, v);
       const double r2 = r * r;
-      const double zone2 = sharp[v] ? r2 : TIP_ZONE * TIP_ZONE * r2;
+      const double zone2 = TIP_ZONE * TIP_ZONE * r2;
       queue.clear();
       queue.push_back(v);
       mark[v] = v;
@@ -220,8 +221,8 @@ namespace ngfracture
                 double dx = m.x[u]-m.x[v], dy = m.y[u]-m.y[v];
                 double d2 = dx*dx + dy*dy;
                 if (d2 > zone2) continue;
-                if (sharp[u] && !sharp[v]) return false;
-                if (d2 <= r2 && !sharp[u] && !sharp[v])
+                if (sharp[u]) return false;
+                if (d2 <= r2)
                   {
                     double lu = LocalValue(T, u);
                     if (lu > lv || (lu == lv && u < v)) return false;

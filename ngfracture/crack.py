@@ -334,10 +334,10 @@ def nonlocal_opening(mesh, element_tensors, radius, ndir=72):
     through the mesh (a ray that meets the boundary or a crack face before its end is judged
     up to it; a direction that points out of the body does not count); a ray's value is the
     smallest opening component n.T.n (n perpendicular to the ray) along it, the vertex's
-    value the largest over the rays (refined by a parabola). Only hot spots are judged: a
-    sharp tip (a crack tip or a notch tip, corner angle of at least 300 degrees) leads every
-    other vertex within 27/16 ``radius``, otherwise a vertex must have the largest nodal
-    principal value within ``radius``; the others get 0.
+    value the largest over the rays (refined by a parabola). Only hot spots are judged:
+    every sharp tip (a crack tip or a notch tip, corner angle of at least 300 degrees), and
+    a vertex with no sharp tip within 27/16 ``radius`` and the largest nodal principal
+    value within ``radius``; the others get 0.
 
     Parameters
     ----------

@@ -53,7 +53,7 @@ from typing import Callable
 
 import numpy as np
 
-from . import checkpoint, rigid
+from . import checkpoint
 from .contact_solver import ContactSolver, fragment_overlap_area
 from .crack import (GROWTH_RULES, PAPER_RULES, StrainCriterion, element_strain, equivalent_strain,
                     nonlocal_opening, split_by_tensor, transfer, transfer_vertex_field)
@@ -715,7 +715,8 @@ class Simulation:
                 raise StepFailed("relaxation", "relaxation", f"cracks still grow after {c.max_relax_passes} passes at fixed load")
             prob = new_prob
             keys = self._equilibrium(prob, "relaxation", warm=keys)
-            if self.scene.stop_when_unloaded and self._cut_through(prob.mesh, prob.assemble_constraints()):
+            if (self.scene.stop_when_unloaded and prob.fragments()[0] > 1
+                    and self._cut_through(mesh_to_arrays(prob.mesh), prob.mesh, prob.assemble_constraints())):
                 break     # the run ends with this step: no crack in the separated pieces
             new_prob, n, strength = self._crack_pass(prob, strength)
             total += n
@@ -885,20 +886,18 @@ class Simulation:
     def _broken(self, state):
         """Why the accepted state is broken through (Scene.stop_when_unloaded), or ""."""
         last = state.history[-1]
-        if last["fragments"] > 1 and self._cut_through(self._mesh, state):
+        if last["fragments"] > 1 and self._cut_through(state.arrays, self._mesh, state):
             return "the body is broken through (no fragment connects boundaries the load moves apart)"
         if last["crack_length"] > 0 and last["elastic_energy"] < self.control.unloaded_fraction * state.peak_energy:
             return "the body is broken through (elastic energy released)"
         return ""
 
-    def _cut_through(self, mesh, loaded):
-        """True when no fragment of ``mesh`` connects boundaries the load moves apart.
+    def _cut_through(self, arrays, mesh, loaded):
+        """True when no fragment of the mesh connects boundaries the load moves apart.
 
-        ``loaded``: the fixed dofs and values at the load (constraint rows or a State).
+        ``arrays``: the mesh's arrays; ``loaded``: the fixed dofs and values at the load
+        (constraint rows or a State).
         """
-        arrays = mesh_to_arrays(mesh)
-        if rigid.pieces(arrays.triangles, mesh.nv)[0] < 2:
-            return False
         # the prescribed values at x against those at 0, on this mesh
         unloaded = self._problem(mesh, 0.0).assemble_constraints()
         dofs, increment = prescribed_increment(unloaded.fixed_dofs, unloaded.fixed_values,
