@@ -265,6 +265,8 @@ def test_rule_2c_keeps_a_crack_line_along_the_boundary_out():
     assert res.record["rule"][0] == crack.RULE_2 | crack.RULE_2A and res.mesh.nv == m.nv
     with pytest.raises(ValueError, match="enter_angle"):
         crack.SplitRules(enter_angle=np.pi / 2)
+    with pytest.raises(TypeError, match="rules must be a SplitRules"):
+        crack.split_vertices(m, [vid(4, 2, 0)], Y, rules="growth")
 
 
 def test_single_edge_tip_grows_without_forking():
