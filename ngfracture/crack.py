@@ -782,8 +782,12 @@ def _split_pass(mesh, tensors, critical, crack_name, skip_neighbours=False, firs
     if first_only:
         # the engine processes a whole order: find the first vertex that splits alone
         for k in range(len(order)):
-            if split_vertices(mesh, order[k:k + 1], dirs[order[k:k + 1]], crack_name, rules=rules).nsplit:
-                order = order[:k + 1]
+            alone = split_vertices(mesh, order[k:k + 1], dirs[order[k:k + 1]], crack_name, rules=rules)
+            if alone.nsplit:
+                if k == 0:      # usually the most overstrained vertex: the pass is this split
+                    alone.record["principal"] = values[order[:1]]
+                    return alone
+                order = order[:k + 1]    # again, with the vertices before it in the record
                 break
     res = split_vertices(mesh, order, dirs[order], crack_name, skip_neighbours, rules)
     res.record["principal"] = values[order]
