@@ -233,12 +233,12 @@ namespace ngfracture
         rule |= RULE_TIP | RULE_TIP1;
         // the half of the crack line away from the crack: opposite to the crack faces
         double sign = edges[bnd[0]].side > 0 ? -1.0 : 1.0;
+        // as better(), on the signed cosine with that half-line
+        auto ahead = [sign] (const Edge & a, const Edge & b)
+          { return sign * a.side != sign * b.side ? sign * a.side > sign * b.side : a.x < b.x; };
         int e1 = -1;
         for (size_t i = 0; i < edges.size(); i++)
-          if (edges[i].count != 1 &&
-              (e1 < 0 || sign * edges[i].side > sign * edges[e1].side ||
-               (sign * edges[i].side == sign * edges[e1].side && edges[i].x < edges[e1].x)))
-            e1 = int(i);
+          if (edges[i].count != 1 && (e1 < 0 || ahead(edges[i], edges[e1]))) e1 = int(i);
         if (e1 < 0) { rule |= RULE_NONE; finish(); return; }
         cuts.push_back(edges[e1].x);
       }
