@@ -91,14 +91,21 @@ namespace ngfracture
       return nx*nx*xx + ny*ny*yy + 2*nx*ny*xy;
     }
 
-    // Smallest opening value along the segment from vertex v in direction (dx, dy) of
-    // length r, or up to the boundary if it meets one first; false if the direction points
-    // out of the body at v (or the walk does not end).
+    // Smallest opening value along the segment of length l from vertex v in direction
+    // (dx, dy). l = r, or up to the boundary (a free surface, a crack face) when the ray
+    // meets it first. From a sharp tip (tip = true) the walk looks on to 2r, and a ray that
+    // meets the boundary at a distance s < 2r is judged over l = s/2: a section thinner than
+    // 2r ahead of a tip is judged on its near half. For a linear stress profile (a ligament
+    // in tension and bending) the value at s/2 is the net-section stress, which the bending
+    // part cannot hide. The segment never ends inside the first triangle (the vertex's own
+    // value is not used). False if the direction points out of the body at v (or the walk
+    // does not end).
     bool RayMinimum (const Mesh2 & m, FlatMatrix<double> T, int v, double dx, double dy, double r,
-                     double & result)
+                     bool tip, double & result)
     {
       const double px = m.x[v], py = m.y[v];
-      const double qx = px + r*dx, qy = py + r*dy;
+      const double reach = tip ? 2 * r : r;
+      const double qx = px + reach*dx, qy = py + reach*dy;
       const double nx = -dy, ny = dx;
       // the triangle of v's fan whose corner at v holds the direction
       int t = -1;
@@ -113,12 +120,17 @@ namespace ngfracture
           if (bx*dy - by*dx >= 0 && dx*cy - dy*cx >= 0) t = f;
         }
       if (t < 0) return false;
+      // samples (distance, opening) at the start, the edge crossings and the end of the
+      // walk; the field is linear between two consecutive ones (they bound one triangle)
+      std::vector<std::pair<double,double>> samples;
+      samples.emplace_back(0.0, Opening(m, T, t, Bary(m, t, px, py), nx, ny));
+      double surface = std::numeric_limits<double>::infinity();
       // excluded edges: for the first triangle the two through v, later the entry edge
       int entered_from = -1;
-      double best = std::numeric_limits<double>::infinity();
       int steps_left = 100000;
-      while (steps_left-- > 0)
+      while (true)
         {
+          if (steps_left-- <= 0) return false;
           auto l0 = Bary(m, t, px, py), l1 = Bary(m, t, qx, qy);
           double t_out = std::numeric_limits<double>::infinity();
           int exit_edge = -1;
@@ -133,25 +145,33 @@ namespace ngfracture
             }
           if (exit_edge < 0 || t_out >= 1.0)
             {
-              best = std::min(best, Opening(m, T, t, l1, nx, ny));
-              result = best;
-              return true;
+              samples.emplace_back(reach, Opening(m, T, t, l1, nx, ny));
+              break;
             }
           std::array<double,3> lx;
           for (int i = 0; i < 3; i++) lx[i] = l0[i] + t_out * (l1[i] - l0[i]);
-          best = std::min(best, Opening(m, T, t, lx, nx, ny));
+          samples.emplace_back(t_out * reach, Opening(m, T, t, lx, nx, ny));
           int next = m.nb[t][exit_edge];
-          if (next < 0)
-            {
-              // the ray reaches a free surface or a crack face before r: a crack along it
-              // would run through to that surface, so the stretch up to it is what counts
-              result = best;
-              return true;
-            }
+          if (next < 0) { surface = t_out * reach; break; }
           entered_from = t;
           t = next;
         }
-      return false;
+      // a thin section's segment still reaches the first edge crossing (or r)
+      const double length = tip ? std::max(std::min(r, 0.5 * surface), std::min(r, samples[1].first))
+                                : std::min(r, surface);
+      double best = std::numeric_limits<double>::infinity();
+      for (size_t k = 1; k < samples.size(); k++)    // the start (v's own value) only interpolates
+        {
+          auto [d, val] = samples[k];
+          if (d <= length) { best = std::min(best, val); continue; }
+          // the end of the segment lies between samples k-1 and k
+          auto [d0, v0] = samples[k-1];
+          double w = (length - d0) / (d - d0);
+          best = std::min(best, v0 + w * (val - v0));
+          break;
+        }
+      result = best;
+      return true;
     }
   }
 
@@ -264,7 +284,7 @@ namespace ngfracture
             // half-step offset: no ray starts exactly along the x axis, where meshes
             // of straight cracks have their edges
             double th = (k + 0.5) * dtheta;
-            ok[k] = RayMinimum(m, T, int(v), cos(th), sin(th), radius[v], value[k]);
+            ok[k] = RayMinimum(m, T, int(v), cos(th), sin(th), radius[v], sharp[v], value[k]);
             if (ok[k] && (kbest < 0 || value[k] > value[kbest])) kbest = k;
           }
         if (kbest < 0) continue;

@@ -18,7 +18,11 @@
 // The walk goes through shared edges only: a ray that meets the boundary (an outer edge,
 // a notch flank, a crack face) before r ends there (a crack along it would run through to
 // that surface), so a vertex never sees the material across a crack; a direction that
-// points out of the body at the vertex does not count. Cost: ndir * (r/h + 1) triangle steps per vertex.
+// points out of the body at the vertex does not count. From a sharp tip the walk looks on
+// to 2r: a ray that meets the boundary at s < 2r is judged over its first s/2, so a
+// ligament thinner than 2r ahead of a tip is judged on its near half (for a linear stress
+// profile, the net-section stress). Cost: ndir * (r/h + 1) triangle steps per vertex,
+// twice that for a sharp tip.
 
 #include <comp.hpp>
 

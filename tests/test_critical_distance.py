@@ -12,6 +12,7 @@ import ngsolve as ng
 from ngfracture.crack import StrainCriterion, critical_distance, nonlocal_opening, principal, toughness
 from critical_distance_util import centre_crack_mesh, plate_initiation, solve_linear, tada_centre_crack
 from ngfracture.materials import LinearElastic
+from ngfracture import _ngfracture as _C
 
 E, NU, CRITICAL = 1.0, 0.25, 1e-3
 
@@ -249,3 +250,23 @@ def test_plate_breaks_along_one_crack_from_notch_to_notch():
     assert result.reason == "broken", result.message
     assert result.summary["n_fragments"] == 2
     assert 0.92 <= result.summary["crack_length"] <= 1.15 * 0.92
+
+
+@pytest.mark.parametrize("ligament, expected", [(1.0, 1 - 1.6 / 2), (3.0, 1 - 1.6 / 3)])
+def test_a_ligament_thinner_than_2r_ahead_of_a_tip_is_judged_on_its_net_section(ligament, expected):
+    """A crack tip at distance t from a free edge, opening stress falling linearly from 1 at
+    the tip to -0.6 at the edge (a ligament in tension and bending). For t < 2r the tip is
+    judged over the ligament's near half, where a linear profile has its mean: the
+    net-section stress 1 - 0.8 = 0.2, whatever the bending (the point method at r alone would
+    see the compressed side). For t > 2r it is the point method: the value at r, 1 - 1.6 r/t."""
+    r, a = 0.02, 0.2
+    t = ligament * r
+    mesh, tip, _ = centre_crack_mesh(a, r / 8, b=a + t, height=0.3, maxh=0.05, zone=2.5 * r)
+    x = mesh.ngmesh.Coordinates()[:, 0]
+    ahead = x >= a - 1e-12
+    # nodal field, linear on every triangle ahead of the tip; behind it compressed
+    nodal = np.zeros((mesh.nv, 3))
+    nodal[:, 1] = np.where(ahead, 1 - 1.6 * (x - a) / t, -1.0)
+    values, dirs = principal(_C.CrackNonlocalOpening(mesh, nodal, np.full(mesh.nv, r), 72))
+    assert values[tip] == pytest.approx(expected, abs=2e-3)
+    assert abs(dirs[tip][1]) == pytest.approx(1.0, abs=1e-3)     # opening vertical: a crack straight ahead
