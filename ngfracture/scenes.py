@@ -222,7 +222,7 @@ def cored_disk_mesh(maxh=0.06, radius=1.0, hole=0.25, core_inner=0.125):
 
 
 def disk(maxh=0.06, expansion=None, dx=None, core_stiffness=0.1, name="disk", confined=True,
-         E=GLASS["E"], nu=GLASS["nu"], critical=GLASS["critical"], core_nu=0.3,
+         E=GLASS["E"], nu=GLASS["nu"], critical=GLASS["critical"], core_nu=0.3, radius=None,
          weibull_m=None, weibull_scale=None, weibull_area=None, seed=None):
     """A brittle disk with a hole around an expanding softer core (paper Fig. 9).
 
@@ -233,8 +233,9 @@ def disk(maxh=0.06, expansion=None, dx=None, core_stiffness=0.1, name="disk", co
     its outer boundary is held). Free modes (rotations of pieces) are held by multiplier
     rows; without the ring all rigid modes of the disk's pieces are (see
     :func:`disintegration`). By default x runs to 50 times the expansion that first cracks the intact disk:
-    radial cracks grow from the hole and stop inside (the ring confines them), the inner
-    part breaks into grains, the outer part stays whole.
+    radial cracks grow from the hole and stop inside (the ring confines them); with the
+    one-ring criterion the inner part breaks into grains, with a critical distance
+    (``radius``) the radial cracks stay apart; the outer part stays whole.
 
     Parameters
     ----------
@@ -255,6 +256,11 @@ def disk(maxh=0.06, expansion=None, dx=None, core_stiffness=0.1, name="disk", co
         (plane strain); the default expansion and dx scale with ``critical``.
     core_nu : float
         Poisson's ratio of the core.
+    radius : float, optional
+        Critical distance of the disk's glass (docs/criterion.md); None: the paper's
+        one-ring criterion. Cracks may run anywhere in the disk, so the whole mesh is made
+        at most radius / 2 (0.12 keeps the default mesh: radial cracks from the hole, the
+        same eight at maxh 0.06 and 0.03).
     weibull_m, weibull_scale, weibull_area, seed
         Random strength of the disk (the core never cracks), see :func:`plate`.
 
@@ -263,6 +269,9 @@ def disk(maxh=0.06, expansion=None, dx=None, core_stiffness=0.1, name="disk", co
     Scene
     """
     maxh, core_stiffness = _positive("maxh", maxh), _positive("core_stiffness", core_stiffness)
+    if radius is not None:
+        radius = _positive("radius", radius)
+        maxh = min(maxh, radius / 2)      # h <= r/2 wherever a crack may run
     hole, core_inner, c = HOLE, CORE_INNER, _positive("critical", critical)
     first_crack = 1.5 * c * HOLE     # as FIRST_CRACK, for this critical strain
     expansion = _positive("expansion", expansion) if expansion is not None else 50 * first_crack
@@ -280,17 +289,17 @@ def disk(maxh=0.06, expansion=None, dx=None, core_stiffness=0.1, name="disk", co
     return Scene(name=name, mesh=mesh,
                  material={"disk": glass, "core": core}, critical={"disk": c}, apply_load=apply_load,
                  load_max=expansion, dx=dx, contact_tol=1e-3 * maxh, contact=True,
-                 load_description=DISK_LOAD,
+                 radius=radius, load_description=DISK_LOAD,
                  control={"max_new_cracks": 8}, fix_free_modes=True if confined else "all",
                  parameters={"maxh": maxh, "expansion": expansion, "dx": dx, "critical": c,
-                             "confined": confined,
+                             "confined": confined, "radius": radius,
                              "E": glass.E, "nu": glass.nu, "core_E": core.E, "core_nu": core.nu,
-                             "radius": 1.0, "hole": hole, "core_inner": core_inner, **strength_parameters},
+                             "disk_radius": 1.0, "hole": hole, "core_inner": core_inner, **strength_parameters},
                  strength=strength)
 
 
 def disintegration(maxh=0.08, expansion=None, dx=None, core_stiffness=0.1, E=GLASS["E"], nu=GLASS["nu"],
-                   critical=GLASS["critical"], core_nu=0.3,
+                   critical=GLASS["critical"], core_nu=0.3, radius=None,
                    weibull_m=None, weibull_scale=None, weibull_area=None, seed=None):
     """The disk scene free outside, expanded until it falls apart (paper Fig. 10).
 
@@ -315,8 +324,8 @@ def disintegration(maxh=0.08, expansion=None, dx=None, core_stiffness=0.1, E=GLA
         Mesh size. Coarser than :func:`disk`'s by default (0.08, about 1000 triangles), as
         the paper ran this case "using a coarse initial mesh": 116 steps and 31 pieces in
         about 40 s on one core; maxh 0.06 takes a few minutes (docs/verification.md).
-    expansion, dx, core_stiffness, E, nu, critical, core_nu, weibull_m, weibull_scale, weibull_area, seed
-        As for :func:`disk`.
+    expansion, dx, core_stiffness, E, nu, critical, core_nu, radius, weibull_m, weibull_scale, weibull_area, seed
+        As for :func:`disk` (radius 0.16 keeps the default mesh).
 
     Returns
     -------
@@ -324,7 +333,7 @@ def disintegration(maxh=0.08, expansion=None, dx=None, core_stiffness=0.1, E=GLA
     """
     expansion = expansion if expansion is not None else 150 * (1.5 * _positive("critical", critical) * HOLE)
     return disk(maxh, expansion, dx, core_stiffness, name="disintegration", confined=False, E=E, nu=nu,
-                critical=critical, core_nu=core_nu,
+                critical=critical, core_nu=core_nu, radius=radius,
                 weibull_m=weibull_m, weibull_scale=weibull_scale, weibull_area=weibull_area, seed=seed)
 
 
