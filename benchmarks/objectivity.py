@@ -16,7 +16,7 @@ criterion (``radius`` null) and the critical-distance criterion (docs/criterion.
 Usage::
 
     PYTHONPATH=. python benchmarks/objectivity.py [--json F] [--plot F.png] [--force]
-        [--radius 0.02] [--levels 3] [--crack-maxh 0.034 0.017]
+        [--radius 0.04] [--levels 3] [--crack-maxh 0.034 0.017]
         [--crack-criteria one-ring critical-distance]
 
 Without ``--json`` the JSON goes to stdout.
@@ -120,7 +120,8 @@ def main(argv=None):
                                                  "notched plate: one-ring vs critical distance.")
     benchmark_json.add_options(parser, force_help="overwrite existing output files")
     parser.add_argument("--plot", metavar="FILE", help="write the refinement plot as PNG")
-    parser.add_argument("--radius", type=_positive_float, default=0.02, help="critical distance r")
+    parser.add_argument("--radius", type=_positive_float, default=scenes.PLATE_RADIUS,
+                        help=f"critical distance r (default: the plate scene's, {scenes.PLATE_RADIUS})")
     parser.add_argument("--levels", type=_int_at_least(2), default=3,
                         help="initiation levels h = r/2 ... r/2^levels (default 3)")
     parser.add_argument("--crack-maxh", type=_positive_float, nargs="*", default=[0.034],

@@ -5,7 +5,7 @@ and f times more triangles, maxh / sqrt(f)) one simulation runs to its end (a pl
 once it is broken through), writing its outputs into a temporary folder (no pictures).
 Reported per case:
 
-  ntri, nsteps, reason, n_split_vertices, n_fragments
+  radius, ntri, nsteps, reason, n_split_vertices, n_fragments
   phases       seconds per phase of Simulation (solve, linear, assembly, strain, split,
                rebuild, collision, contact, output) and wall
   t_unit       one factorisation plus one solve of the uncracked configuration's tangent
@@ -32,7 +32,8 @@ runs until broken in at most 150 solve-equivalents. The modules the run loads on
 use (pyvista, matplotlib) are imported before the first case, as NGSolve itself is: a
 once-per-process cost that would otherwise land in the first case's "output" phase only.
 
-Usage: python benchmarks/scenes.py [--scenes plate disk] [--factors 1 4 16] [--steps N] [--json FILE [--force]]
+Usage: python benchmarks/scenes.py [--scenes plate disk] [--factors 1 4 16] [--steps N] [--one-ring]
+       [--json FILE [--force]]
 """
 import argparse
 import json
@@ -82,9 +83,10 @@ def unit_solve(scene):
     return best
 
 
-def run_case(name, factor, steps=None):
-    base = scenes.SCENES[name]()
-    scene = scenes.SCENES[name](maxh=base.parameters["maxh"] / math.sqrt(factor))
+def run_case(name, factor, steps=None, one_ring=False):
+    criterion = {"radius": None} if one_ring else {}
+    base = scenes.SCENES[name](**criterion)
+    scene = scenes.SCENES[name](maxh=base.parameters["maxh"] / math.sqrt(factor), **criterion)
     t_unit = unit_solve(scene)
     control = StepControl(**{**scene.control, "max_steps": steps}) if steps else None
     with tempfile.TemporaryDirectory() as out:
@@ -94,7 +96,8 @@ def run_case(name, factor, steps=None):
     linear = s["timings"].get("linear", float("nan"))
     assembly = s["timings"].get("assembly", float("nan"))
     nsteps = max(s["n_steps"], 1)
-    return {"scene": name, "factor": factor, "ntri": scene.mesh.ne, "reason": result.reason, "max_steps": steps,
+    return {"scene": name, "factor": factor, "radius": scene.radius, "ntri": scene.mesh.ne,
+            "reason": result.reason, "max_steps": steps,
             "nsteps": s["n_steps"], "n_split_vertices": s["n_split_vertices"],
             "n_fragments": s["n_fragments"], "phases": s["timings"], "linear": linear,
             "assembly": assembly, "t_unit": t_unit, "solve_equivalents": wall / t_unit,
@@ -127,6 +130,8 @@ def main(argv=None):
     p.add_argument("--steps", type=int, default=None,
                    help="stop every run after this many steps (for the finest meshes; the "
                         "shares are then those of the first steps)")
+    p.add_argument("--one-ring", action="store_true",
+                   help="the paper's one-ring criterion (radius=None) instead of the scenes' critical distance")
     benchmark_json.add_options(p)
     args = p.parse_args(argv)
     benchmark_json.refuse_existing(p, args)   # before hours of runs
@@ -134,7 +139,7 @@ def main(argv=None):
     cases = []
     for name in args.scenes:
         for f in args.factors:
-            cases.append(run_case(name, f, args.steps))
+            cases.append(run_case(name, f, args.steps, args.one_ring))
             print(json.dumps(cases[-1]), file=sys.stderr)
     benchmark_json.write(args, {"cases": cases, "growth": growth(cases)})
     return 0

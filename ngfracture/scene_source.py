@@ -139,7 +139,7 @@ def convert_value(name, text, default):
     """``text`` converted to the type of ``default``.
 
     float and int defaults take a number (an int default also takes ``1e3``-style text
-    if it is integral; a float default takes an integer); bool takes
+    if it is integral; a float default takes an integer, and ``none`` for None); bool takes
     true/false/yes/no/on/off/1/0; str takes the text itself. A default of None (or no
     default) takes a Python literal (``0.5``, ``None``, ``'text'``, ``(1, 2)``), or
     else the text as a string.
@@ -180,6 +180,8 @@ def convert_value(name, text, default):
             return int(value)
         raise ValueError(f"{name}={text}: expected an integer")
     if isinstance(default, float):
+        if text.strip().lower() == "none":     # e.g. radius=none: the paper's criterion
+            return None
         try:
             return float(text)
         except ValueError:

@@ -30,6 +30,12 @@ HOLE, CORE_INNER = 0.25, 0.125
 #: ring is squeezed too, about 1.5 times that at its inside
 FIRST_CRACK = 1.5 * GLASS["critical"] * HOLE
 
+#: critical distances of the scenes' glass (docs/criterion.md): the material length over which
+#: the crack criterion judges the stress. A material constant (with E and the critical strain
+#: it sets the toughness K_c = E critical sqrt(2 pi r)); each scene's value keeps its default
+#: mesh fine enough (h <= r/4 where the plate's crack runs, h <= r/2 in the disks)
+PLATE_RADIUS, DISK_RADIUS, DISINTEGRATION_RADIUS = 0.04, 0.12, 0.16
+
 #: the load parameters, for Scene.load_description and the command line's --help
 PLATE_LOAD = "total extension of the unit plate (length; equals the mean strain)"
 DISK_LOAD = "radial displacement of the core's inner boundary (length; the disk's radius is 1)"
@@ -111,7 +117,7 @@ def notched_plate_mesh(maxh=0.034, width=1.0, height=1.0, notch_depth=0.04, notc
 
 
 def plate(maxh=0.034, strain_max=1e-3, dx=None, material=None, critical=GLASS["critical"],
-          E=GLASS["E"], nu=GLASS["nu"], notch_maxh=None, radius=None,
+          E=GLASS["E"], nu=GLASS["nu"], notch_maxh=None, radius=PLATE_RADIUS,
           weibull_m=None, weibull_scale=None, weibull_area=None, seed=None):
     """The plate under tension of paper section 4.2 (Fig. 8).
 
@@ -138,10 +144,11 @@ def plate(maxh=0.034, strain_max=1e-3, dx=None, material=None, critical=GLASS["c
     notch_maxh : float, optional
         Mesh size at the notch tips; default a quarter of the notch depth (one-ring
         criterion) or radius / 4 (critical distance), at most maxh.
-    radius : float, optional
-        Critical distance of the crack criterion (docs/criterion.md); the mesh is then
-        at most radius / 4 within 2 radius of the tips and along the line between them,
-        where the crack runs. None: the paper's one-ring nodal strain.
+    radius : float or None
+        Critical distance of the crack criterion (docs/criterion.md, default 0.04); the
+        mesh is at most radius / 4 within 2 radius of the tips and along the line between
+        them, where the crack runs. None: the paper's one-ring nodal strain (mesh
+        dependent: its crack patterns change with maxh).
     weibull_m, weibull_scale, weibull_area, seed
         Random strength, see :func:`ngfracture.strength.scene_strength`: a Weibull
         modulus (None: uniform strength), the scale (default: mean = ``critical``), the
@@ -222,7 +229,7 @@ def cored_disk_mesh(maxh=0.06, radius=1.0, hole=0.25, core_inner=0.125):
 
 
 def disk(maxh=0.06, expansion=None, dx=None, core_stiffness=0.1, name="disk", confined=True,
-         E=GLASS["E"], nu=GLASS["nu"], critical=GLASS["critical"], core_nu=0.3, radius=None,
+         E=GLASS["E"], nu=GLASS["nu"], critical=GLASS["critical"], core_nu=0.3, radius=DISK_RADIUS,
          weibull_m=None, weibull_scale=None, weibull_area=None, seed=None):
     """A brittle disk with a hole around an expanding softer core (paper Fig. 9).
 
@@ -256,11 +263,12 @@ def disk(maxh=0.06, expansion=None, dx=None, core_stiffness=0.1, name="disk", co
         (plane strain); the default expansion and dx scale with ``critical``.
     core_nu : float
         Poisson's ratio of the core.
-    radius : float, optional
-        Critical distance of the disk's glass (docs/criterion.md); None: the paper's
-        one-ring criterion. Cracks may run anywhere in the disk, so the whole mesh is made
-        at most radius / 2 (0.12 keeps the default mesh: radial cracks from the hole, the
-        same eight at maxh 0.06 and 0.03).
+    radius : float or None
+        Critical distance of the disk's glass (docs/criterion.md, default 0.12): radial
+        cracks from the hole, the same cracked zone at maxh 0.06 and 0.03. Cracks may run
+        anywhere in the disk, so the whole mesh is made at most radius / 2. None: the
+        paper's one-ring criterion (the comminuted zone of the paper's Fig. 9, grains at
+        the mesh scale).
     weibull_m, weibull_scale, weibull_area, seed
         Random strength of the disk (the core never cracks), see :func:`plate`.
 
@@ -299,7 +307,7 @@ def disk(maxh=0.06, expansion=None, dx=None, core_stiffness=0.1, name="disk", co
 
 
 def disintegration(maxh=0.08, expansion=None, dx=None, core_stiffness=0.1, E=GLASS["E"], nu=GLASS["nu"],
-                   critical=GLASS["critical"], core_nu=0.3, radius=None,
+                   critical=GLASS["critical"], core_nu=0.3, radius=DISINTEGRATION_RADIUS,
                    weibull_m=None, weibull_scale=None, weibull_area=None, seed=None):
     """The disk scene free outside, expanded until it falls apart (paper Fig. 10).
 
@@ -325,7 +333,7 @@ def disintegration(maxh=0.08, expansion=None, dx=None, core_stiffness=0.1, E=GLA
         the paper ran this case "using a coarse initial mesh": 116 steps and 31 pieces in
         about 40 s on one core; maxh 0.06 takes a few minutes (docs/verification.md).
     expansion, dx, core_stiffness, E, nu, critical, core_nu, radius, weibull_m, weibull_scale, weibull_area, seed
-        As for :func:`disk` (radius 0.16 keeps the default mesh).
+        As for :func:`disk` (default radius 0.16; None: the paper's criterion, Fig. 10).
 
     Returns
     -------

@@ -288,7 +288,7 @@ def test_disk_expansion_runs_to_the_end():
     84 s)."""
     from ngfracture import scenes
     from ngfracture.simulation import Simulation
-    r = Simulation(scenes.disk(maxh=0.1, expansion=50 * scenes.FIRST_CRACK), pictures="none").run()
+    r = Simulation(scenes.disk(maxh=0.1, expansion=50 * scenes.FIRST_CRACK, radius=None), pictures="none").run()
     assert r.reason == "load_max", r.summary["message"]
     assert r.summary["max_overlap_area"] <= 1e-10 * r.summary["area_initial"]
 

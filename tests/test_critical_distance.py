@@ -185,7 +185,7 @@ def test_mode_one_grows_straight(crack_r40):
 def test_scene_radius_is_checked_before_any_work():
     """A bad critical distance is named by Scene.validate (Simulation's first call)."""
     from ngfracture import scenes
-    scene = scenes.plate(maxh=0.1)
+    scene = scenes.plate(maxh=0.1, radius=None)
     scene.radius = -0.01
     with pytest.raises(ValueError, match="critical distance"):
         scene.validate()
@@ -199,7 +199,7 @@ def test_scene_radius_is_checked_before_any_work():
 def test_a_critical_distance_scene_splits_one_vertex_per_pass_unless_told_otherwise():
     from ngfracture import scenes
     from ngfracture.simulation import Simulation, StepControl
-    assert Simulation(scenes.plate(maxh=0.1)).control.split == "spread"
+    assert Simulation(scenes.plate(maxh=0.1, radius=None)).control.split == "spread"
     assert Simulation(scenes.plate(maxh=0.1, radius=0.05)).control.split == "one"
     assert Simulation(scenes.plate(maxh=0.1, radius=0.05), StepControl(split="spread")).control.split == "spread"
     scene = scenes.plate(maxh=0.1, radius=0.05)
@@ -240,13 +240,15 @@ def test_a_hot_spot_within_27_16_r_of_a_tip_is_not_judged(crack_r40, distance, j
 
 
 def test_plate_breaks_along_one_crack_from_notch_to_notch():
-    """The plate with r = 0.02 on the paper's mesh size (h = r/4 along the line between the
-    notch tips): broken through into two halves, with a total crack length within 15 % of
-    the 0.92 from notch tip to notch tip (the issue's bound; a crack along mesh edges
-    zigzags by about 3 %). The one-ring criterion gives 2.85 here."""
+    """The default plate (critical distance r = 0.04, the paper's mesh size, h = r/4 along
+    the line between the notch tips): broken through into two halves, with a total crack
+    length within 15 % of the 0.92 from notch tip to notch tip (the issue's bound; a crack
+    along mesh edges zigzags by about 3 %). The one-ring criterion gives 2.85 here."""
     from ngfracture import scenes
     from ngfracture.simulation import Simulation
-    result = Simulation(scenes.plate(radius=0.02), pictures="none").run()
+    scene = scenes.plate()
+    assert scene.radius == scenes.PLATE_RADIUS == 0.04
+    result = Simulation(scene, pictures="none").run()
     assert result.reason == "broken", result.message
     assert result.summary["n_fragments"] == 2
     assert 0.92 <= result.summary["crack_length"] <= 1.15 * 0.92

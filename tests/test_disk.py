@@ -76,7 +76,7 @@ DISK_CASES = [pytest.param((0.12, 10), id="coarse"),
 @pytest.fixture(scope="module", params=DISK_CASES)
 def disk_run(request):
     maxh, min_grains = request.param
-    return Simulation(scenes.disk(maxh=maxh), pictures="none").run(), min_grains
+    return Simulation(scenes.disk(maxh=maxh, radius=None), pictures="none").run(), min_grains
 
 
 def test_disk_contact_leaves_no_overlap(disk_run):
@@ -117,7 +117,7 @@ def test_disintegration_falls_apart_on_a_coarse_mesh():
     disk's final expansion (a third of the scene's). Measured: 45 steps, 75 split vertices,
     14 disk pieces, overlap 1.2e-15, 38 s. Without the confining ring the radial cracks
     run through to the outside: the disk falls apart, no piece goes around the hole."""
-    scene = scenes.disintegration(maxh=0.2, expansion=50 * scenes.FIRST_CRACK)
+    scene = scenes.disintegration(maxh=0.2, expansion=50 * scenes.FIRST_CRACK, radius=None)
     assert scene.name == "disintegration" and scene.fix_free_modes == "all"
     result = Simulation(scene, pictures="none").run()
     assert result.ok and result.reason == "load_max", result.message
@@ -139,7 +139,7 @@ def test_disintegration_many_disjoint_fragments(maxh):
     with 19 disk pieces; with them but the contact solve's re-linearisations capped at five,
     step 106 failed seven times (penetration 8.1e-15 against 8e-15, still contracting by 20
     per update). 0.06 failed at step 33 until the KKT solves refined their solution."""
-    result = Simulation(scenes.disintegration(maxh=maxh), pictures="none").run()
+    result = Simulation(scenes.disintegration(maxh=maxh, radius=None), pictures="none").run()
     assert result.ok and result.reason == "load_max", result.message
     s = result.summary
     assert s["max_overlap_area"] <= 1e-10 * s["area_initial"]

@@ -135,7 +135,7 @@ def test_bad_input_is_refused_before_any_file(tmp_path):
     with pytest.raises(ValueError, match="repeat"):
         Ensemble(FACTORY, [1, 1], out=out)
     with pytest.raises(ValueError, match="takes no seed parameter"):
-        Ensemble(lambda maxh=0.2: scenes.plate(maxh=maxh), [0], out=out)
+        Ensemble(lambda maxh=0.2: scenes.plate(maxh=maxh, radius=None), [0], out=out)
     with pytest.raises(ValueError, match="seed has no effect without weibull_m"):
         Ensemble(functools.partial(scenes.plate, maxh=0.2), [0], out=out)
     with pytest.raises(ValueError, match="workers"):

@@ -46,7 +46,7 @@ def faulty_scene(base, x_fault, fault, on_split_mesh=False, times=1):
 
 @pytest.fixture(scope="module")
 def undisturbed():
-    return Simulation(scenes.plate(maxh=0.06)).run()
+    return Simulation(scenes.plate(maxh=0.06, radius=None)).run()
 
 
 @pytest.mark.parametrize("fault", ["nan", "inverted", "diverged"])
@@ -54,7 +54,7 @@ def test_failed_increment_is_retried_and_the_result_is_unchanged(undisturbed, fa
     ref = undisturbed.summary
     k = next(i for i, h in enumerate(ref["history"]) if h["split_vertices"])   # the step that cracks
     x_fault = ref["history"][k]["x"]
-    scene, injected = faulty_scene(scenes.plate(maxh=0.06), x_fault, fault)
+    scene, injected = faulty_scene(scenes.plate(maxh=0.06, radius=None), x_fault, fault)
     result = Simulation(scene).run()
     assert injected["done"] and result.ok, result.message
     s = result.summary
@@ -77,7 +77,7 @@ def test_failed_relaxation_leaks_no_split(undisturbed):
     ref = undisturbed.summary
     k = next(i for i, h in enumerate(ref["history"]) if h["split_vertices"])
     x_fault = ref["history"][k]["x"]
-    base = scenes.plate(maxh=0.06)
+    base = scenes.plate(maxh=0.06, radius=None)
     scene, injected = faulty_scene(base, x_fault, "nan", on_split_mesh=True)
     result = Simulation(scene).run()
     assert injected["done"] and result.ok, result.message
@@ -96,7 +96,7 @@ def test_failed_full_newton_retry_doubles_the_substeps_on_the_same_path(undistur
     same target in two Newton load steps, and the run equals the undisturbed one."""
     ref = undisturbed.summary
     k = next(i for i, h in enumerate(ref["history"]) if h["split_vertices"])
-    scene, injected = faulty_scene(scenes.plate(maxh=0.06), ref["history"][k]["x"], "nan", times=2)
+    scene, injected = faulty_scene(scenes.plate(maxh=0.06, radius=None), ref["history"][k]["x"], "nan", times=2)
     result = Simulation(scene).run()
     assert injected["count"] == 2 and result.ok, result.message
     s = result.summary
@@ -120,7 +120,7 @@ def test_failed_relaxation_cuts_dx_and_keeps_the_path_before(undisturbed):
     reference area is kept to the last bit)."""
     ref = undisturbed.summary
     k = next(i for i, h in enumerate(ref["history"]) if h["split_vertices"])
-    base = scenes.plate(maxh=0.06)
+    base = scenes.plate(maxh=0.06, radius=None)
     scene, injected = faulty_scene(base, ref["history"][k]["x"], "nan", on_split_mesh=True, times=2)
     result = Simulation(scene).run()
     assert injected["count"] == 2 and result.ok, result.message
@@ -137,7 +137,7 @@ def test_failed_relaxation_cuts_dx_and_keeps_the_path_before(undisturbed):
 
 
 def test_retries_exhausted_stop_cleanly(tmp_path):
-    base = scenes.plate(maxh=0.06)
+    base = scenes.plate(maxh=0.06, radius=None)
 
     def apply_load(prob, x):                       # every solve beyond 2 dx fails
         base.apply_load(prob, x)

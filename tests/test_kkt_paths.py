@@ -163,7 +163,7 @@ def test_a_cracking_run_takes_the_same_path_with_the_sparse_schur_complement(mon
     for sparse in (False, True):
         monkeypatch.setattr(kkt_module, "SPARSE_SCHUR_MIN_DOFS", 0 if sparse else 10 ** 9)
         monkeypatch.setattr(kkt_module, "AUGMENTED_MAX_DOFS", -1)      # every solve on the Schur path
-        runs[sparse] = Simulation(scenes.plate(maxh=0.06)).run()
+        runs[sparse] = Simulation(scenes.plate(maxh=0.06, radius=None)).run()
     a, b = runs[False], runs[True]
     assert a.ok and b.ok and a.summary["reason"] == b.summary["reason"] == "broken"
     for key in ("n_steps", "n_split_vertices", "n_fragments"):

@@ -104,7 +104,7 @@ def test_plate_run_ends_as_broken_when_the_crack_separates_the_pulled_sides(monk
 
     monkeypatch.setattr(Simulation, "_accept", spy)
     monkeypatch.setattr(Simulation, "_crack_pass", pass_spy)
-    result = Simulation(scenes.plate(maxh=0.06), pictures="none").run()
+    result = Simulation(scenes.plate(maxh=0.06, radius=None), pictures="none").run()
     assert result.reason == "broken", result.message
     assert "no fragment connects" in result.message
     separated = joined.index(False) + 1            # the first step without a joining fragment
@@ -114,7 +114,7 @@ def test_plate_run_ends_as_broken_when_the_crack_separates_the_pulled_sides(monk
 
 
 def test_apply_load_on_a_missing_boundary_is_refused_before_any_work(tmp_path):
-    scene = scenes.plate(maxh=0.1)
+    scene = scenes.plate(maxh=0.1, radius=None)
     scene.apply_load = lambda prob, x: prob.add_dirichlet("rigth", x, component="x")
     with pytest.raises(ValueError, match="'rigth'"):
         Simulation(scene, out=tmp_path / "never")

@@ -16,7 +16,7 @@ NOTCH_TIPS = np.array([[0.5, 0.04], [0.5, 0.96]])
 @pytest.fixture(scope="module")
 def plate_run(tmp_path_factory):
     out = tmp_path_factory.mktemp("plate")
-    result = Simulation(scenes.plate(), out=out, pictures="none").run()
+    result = Simulation(scenes.plate(radius=None), out=out, pictures="none").run()
     return out, result
 
 
@@ -74,7 +74,7 @@ def test_plate_summary_and_files(plate_run):
 
 def test_energy_bookkeeping_linear(tmp_path):
     """Before cracking, the reactions' work equals the elastic energy (trapezoid exact for linear)."""
-    scene = scenes.plate(material=LinearElastic(5e9, 0.18, plane="stress"))
+    scene = scenes.plate(material=LinearElastic(5e9, 0.18, plane="stress"), radius=None)
     scene.load_max = 6e-5          # below the first crack
     result = Simulation(scene, pictures="none").run()
     assert result.ok and result.summary["n_split_vertices"] == 0
@@ -92,7 +92,7 @@ def test_energy_released_by_cracking_is_positive(plate_run):
 def test_small_plate_run_leaves_no_overlap():
     """Contact rows re-linearised at the solution: the broken pieces of the driver's plate
     do not overlap (before: 1.6e-9 of the area on the default plate)."""
-    result = Simulation(scenes.plate(maxh=0.06), pictures="none").run()
+    result = Simulation(scenes.plate(maxh=0.06, radius=None), pictures="none").run()
     s = result.summary
     assert result.ok and s["n_fragments"] >= 2
     assert s["max_overlap_area"] < 1e-10 * s["area_initial"]
@@ -100,7 +100,7 @@ def test_small_plate_run_leaves_no_overlap():
 
 def test_too_many_cracks_cut_the_increment():
     """max_new_cracks = 0: every increment that cracks is retried with dx * cut down to dx_min."""
-    scene = scenes.plate(maxh=0.06)
+    scene = scenes.plate(maxh=0.06, radius=None)
     control = StepControl(max_new_cracks=0, dx_min=scene.dx / 16)
     result = Simulation(scene, control).run()
     assert result.ok
@@ -111,7 +111,7 @@ def test_too_many_cracks_cut_the_increment():
 
 def test_quiet_steps_grow_the_increment():
     """After grow_after crack-free steps in a row dx grows by grow, up to dx_max (paper 4.2)."""
-    scene = scenes.plate(maxh=0.1, critical=1.0, dx=1e-5)   # uncrackable: every step is quiet
+    scene = scenes.plate(maxh=0.1, critical=1.0, dx=1e-5, radius=None)   # uncrackable: every step is quiet
     control = StepControl(grow=1.5, grow_after=2, dx_max=2 * scene.dx, max_steps=5)
     result = Simulation(scene, control, pictures="none").run()
     hist = result.summary["history"]
@@ -122,20 +122,20 @@ def test_quiet_steps_grow_the_increment():
 
 def test_resume_with_other_options_is_refused_and_keeps_the_files(tmp_path):
     """Options that change the load path must be those of the interrupted run; max_steps may grow."""
-    Simulation(scenes.plate(maxh=0.1), StepControl(max_steps=1), out=tmp_path, pictures="none").run()
+    Simulation(scenes.plate(maxh=0.1, radius=None), StepControl(max_steps=1), out=tmp_path, pictures="none").run()
     before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
     with pytest.raises(checkpoint.CheckpointError, match="cut = 0.5, this run has 0.25"):
-        Simulation(scenes.plate(maxh=0.1), StepControl(cut=0.25), out=tmp_path, resume=True)
+        Simulation(scenes.plate(maxh=0.1, radius=None), StepControl(cut=0.25), out=tmp_path, resume=True)
     with pytest.raises(checkpoint.CheckpointError, match="contact = 'auto', this run has 'never'"):
-        Simulation(scenes.plate(maxh=0.1), out=tmp_path, resume=True, contact="never")
+        Simulation(scenes.plate(maxh=0.1, radius=None), out=tmp_path, resume=True, contact="never")
     assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
-    again = Simulation(scenes.plate(maxh=0.1), StepControl(max_steps=2), out=tmp_path, resume=True,
+    again = Simulation(scenes.plate(maxh=0.1, radius=None), StepControl(max_steps=2), out=tmp_path, resume=True,
                        pictures="none").run()
     assert again.summary["n_steps"] == 2
 
 
 def test_resume_equals_uninterrupted(tmp_path):
-    scene = lambda: scenes.plate(maxh=0.06)
+    scene = lambda: scenes.plate(maxh=0.06, radius=None)
     full = tmp_path / "full"
     part = tmp_path / "part"
     Simulation(scene(), out=full, pictures="none").run()
@@ -156,36 +156,36 @@ def test_resume_equals_uninterrupted(tmp_path):
 
 
 def test_existing_results_are_refused_and_kept(tmp_path):
-    Simulation(scenes.plate(maxh=0.06), StepControl(max_steps=1), out=tmp_path, pictures="none").run()
+    Simulation(scenes.plate(maxh=0.06, radius=None), StepControl(max_steps=1), out=tmp_path, pictures="none").run()
     before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
     with pytest.raises(FileExistsError, match="already holds results"):
-        Simulation(scenes.plate(maxh=0.06), out=tmp_path)
+        Simulation(scenes.plate(maxh=0.06, radius=None), out=tmp_path)
     assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
 
 
 def test_resume_of_another_scene_is_refused(tmp_path):
-    Simulation(scenes.plate(maxh=0.06), StepControl(max_steps=1), out=tmp_path, pictures="none").run()
+    Simulation(scenes.plate(maxh=0.06, radius=None), StepControl(max_steps=1), out=tmp_path, pictures="none").run()
     with pytest.raises(checkpoint.CheckpointError, match="parameters"):
-        Simulation(scenes.plate(maxh=0.05), out=tmp_path, resume=True)
+        Simulation(scenes.plate(maxh=0.05, radius=None), out=tmp_path, resume=True)
 
 
 def test_bad_scene_is_named_before_any_work(tmp_path):
-    scene = scenes.plate(maxh=0.06)
+    scene = scenes.plate(maxh=0.06, radius=None)
     scene.critical = {"glass": 1e-4}
     with pytest.raises(ValueError, match="'glass'"):
         Simulation(scene, out=tmp_path / "never")
     assert not (tmp_path / "never").exists()
-    scene = scenes.plate(maxh=0.06)
+    scene = scenes.plate(maxh=0.06, radius=None)
     scene.dx = -1.0
     with pytest.raises(ValueError, match="dx"):
         Simulation(scene)
     with pytest.raises(ValueError, match="cut"):
-        Simulation(scenes.plate(maxh=0.06), StepControl(cut=1.5))
+        Simulation(scenes.plate(maxh=0.06, radius=None), StepControl(cut=1.5))
 
 
 def test_failed_steps_stop_cleanly_with_the_last_good_state(tmp_path):
     """A load that makes every solve fail (NaN body force from x > limit): retries, then a clean stop."""
-    base = scenes.plate(maxh=0.06)
+    base = scenes.plate(maxh=0.06, radius=None)
     limit = 2.5 * base.dx
 
     def apply_load(prob, x):
@@ -217,14 +217,14 @@ def test_crack_length_of_a_straight_cut():
 def test_resuming_a_finished_run_redraws_its_final_outputs(tmp_path):
     """A run killed while writing its final files resumes from the last checkpoint and redraws them."""
     control = lambda: StepControl(max_steps=2)
-    first = Simulation(scenes.plate(maxh=0.1), control(), out=tmp_path).run()
+    first = Simulation(scenes.plate(maxh=0.1, radius=None), control(), out=tmp_path).run()
     assert first.reason == "max_steps"
     # the phases are disjoint parts of the wall time, the final pictures included
     t = json.loads((tmp_path / "summary.json").read_text())["timings"]
     phases = ("solve", "strain", "split", "rebuild", "collision", "contact", "output")
     assert sum(t[k] for k in phases) <= t["wall"] + 1e-5
     (tmp_path / "summary.json").unlink()                 # as if killed before the summary
-    again = Simulation(scenes.plate(maxh=0.1), control(), out=tmp_path, resume=True).run()
+    again = Simulation(scenes.plate(maxh=0.1, radius=None), control(), out=tmp_path, resume=True).run()
     assert again.reason == "max_steps" and again.summary["n_steps"] == 2
     assert (tmp_path / "summary.json").exists()
     assert again.summary["history"] == first.summary["history"]

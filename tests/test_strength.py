@@ -61,26 +61,26 @@ def test_bad_weibull_parameters_are_refused():
     with pytest.raises(ValueError, match="reference area"):
         strength.weibull_strength(10, 2.0, 1.0, seed=0, reference_area=1.0)
     with pytest.raises(ValueError, match="seed has no effect without weibull_m"):
-        scenes.plate(maxh=0.2, seed=3)
+        scenes.plate(maxh=0.2, seed=3, radius=None)
 
 
 def test_plate_scene_records_the_field_and_the_default_keeps_the_mean():
     """Default scale: the mean strength is the uniform critical strain (within the sampling error
     of the plate's vertices, 3 standard errors)."""
-    sc = scenes.plate(maxh=0.1, weibull_m=8, seed=5)
+    sc = scenes.plate(maxh=0.1, weibull_m=8, seed=5, radius=None)
     p = sc.parameters
     assert p["seed"] == 5 and p["weibull_m"] == 8.0 and p["weibull_area"] is None
     assert p["strength_digest"] == strength.field_digest(sc.strength)
     assert math.isclose(strength.weibull_mean(8, p["weibull_scale"]), scenes.GLASS["critical"], rel_tol=1e-12)
     sd = math.sqrt(strength.weibull_variance(8, p["weibull_scale"]) / sc.mesh.nv)
     assert abs(sc.strength.mean() - scenes.GLASS["critical"]) < 3 * sd
-    assert scenes.plate(maxh=0.1).strength is None       # uniform by default
+    assert scenes.plate(maxh=0.1, radius=None).strength is None       # uniform by default
 
 
 def test_split_copies_inherit_the_strength_and_a_resume_is_bitwise(tmp_path):
     """A random-strength plate: the split mesh's field is its vertex's; a run stopped and resumed
     ends with the same mesh, displacement and strength bit for bit."""
-    scene = lambda: scenes.plate(maxh=0.15, weibull_m=8, seed=2)
+    scene = lambda: scenes.plate(maxh=0.15, weibull_m=8, seed=2, radius=None)
     control = dict(max_steps=14)
     full = Simulation(scene(), control=StepControl(**control), contact="never").run()
     st = full.state

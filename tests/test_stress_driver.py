@@ -35,7 +35,7 @@ from ngfracture.simulation import Simulation, StepControl
 # -- critical strain 1e-12 ---------------------------------------------------------------------
 
 def test_critical_strain_1e_12_shatters_once_and_stops():
-    scene = scenes.plate(maxh=0.1)
+    scene = scenes.plate(maxh=0.1, radius=None)
     scene.critical = 1e-12          # 1e8 times below the strain of the first increment
     nv0, ne = scene.mesh.nv, scene.mesh.ne
     control = StepControl(max_steps=3, max_relax_passes=20)
@@ -65,7 +65,7 @@ def test_critical_strain_1e_12_shatters_once_and_stops():
 
 
 def test_critical_strain_1e_12_with_contact_runs():
-    scene = scenes.plate(maxh=0.1)
+    scene = scenes.plate(maxh=0.1, radius=None)
     scene.critical = 1e-12
     scene.stop_when_unloaded = False     # steps after shattering too (it is broken after step 1)
     result = Simulation(scene, StepControl(max_steps=3, max_relax_passes=20), contact="auto").run()
@@ -96,7 +96,7 @@ ng.SetNumThreads(n)
 ElasticProblem.PARALLEL_MIN_DOFS = 0          # assemble in the TaskManager on a small mesh
 with ng.TaskManager():
     assert ng.GetNumThreads() == n
-r = Simulation(scenes.plate(maxh=0.06)).run()
+r = Simulation(scenes.plate(maxh=0.06, radius=None)).run()
 s = r.summary
 np.savez(sys.argv[2], triangles=r.state.arrays.triangles, points=r.state.arrays.points, u=r.state.u,
          counts=np.array([s["n_steps"], s["n_split_vertices"], s["n_fragments"]]),
@@ -151,7 +151,7 @@ def test_two_identical_runs_give_identical_results(tmp_path):
     results = []
     for name in ("a", "b"):
         out = tmp_path / name
-        Simulation(scenes.plate(maxh=0.1), StepControl(max_steps=12), out=out, pictures="none").run()
+        Simulation(scenes.plate(maxh=0.1, radius=None), StepControl(max_steps=12), out=out, pictures="none").run()
         results.append((json.loads((out / "summary.json").read_text()), _vtk_arrays(out)))
     (sa, va), (sb, vb) = results
     assert sa["n_split_vertices"] > 0 and sa["crack_length"] > 0        # it cracked

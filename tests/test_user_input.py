@@ -26,7 +26,7 @@ def snapshot(root):
 
 @pytest.fixture(scope="module")
 def coarse_plate():
-    return scenes.plate(maxh=0.1)
+    return scenes.plate(maxh=0.1, radius=None)
 
 
 @pytest.fixture(scope="module")
@@ -68,7 +68,7 @@ def test_a_bad_material_region_is_refused_before_the_folder_is_touched(coarse_pl
 
 
 def test_user_control_overrides_only_what_it_sets():
-    disk = scenes.disk(maxh=0.3)
+    disk = scenes.disk(maxh=0.3, radius=None)
     assert disk.control == {"max_new_cracks": 8}
     user = StepControl(max_steps=3, tol=1e-9)
     sim = Simulation(disk, user)
@@ -158,7 +158,7 @@ def test_solver_notes_reach_history_and_summary(monkeypatch, tmp_path):
             result.notes.append("a note")
             return result
     monkeypatch.setattr(simulation, "ContactSolver", Noting)
-    scene = scenes.disk(maxh=0.3)             # separate bodies: contact from the first step
+    scene = scenes.disk(maxh=0.3, radius=None)             # separate bodies: contact from the first step
     result = Simulation(scene, StepControl(max_steps=2), out=tmp_path, pictures="none").run()
     s = result.summary
     assert [h["notes"] for h in s["history"]] == [["a note"], ["a note"]]
