@@ -105,3 +105,12 @@ def test_convert_value_of_a_tuple_default():
     assert convert_value("size", "(1, 2)", (0, 0)) == (1, 2)
     with pytest.raises(ValueError, match="expected a Python literal"):
         convert_value("size", "x y", (0, 0))
+
+
+def test_none_switches_a_scene_to_the_papers_criterion():
+    """A float parameter takes ``none`` for None: ``--set radius=none`` is the one-ring criterion."""
+    assert convert_value("radius", "none", 0.04) is None
+    assert convert_value("radius", " None ", 0.04) is None
+    assert parse_assignments(["radius=none"], scenes.plate) == {"radius": None}
+    assert scenes.plate(maxh=0.2, radius=None).radius is None
+    assert scenes.plate(maxh=0.2).radius == scenes.PLATE_RADIUS
