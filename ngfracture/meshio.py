@@ -242,6 +242,10 @@ def _half_edge_membership(triangles, segments):
     T = np.asarray(triangles, dtype=np.int64)
     S = np.asarray(segments, dtype=np.int64).reshape(-1, 2)
     n = int(max(T.max(initial=-1), S.max(initial=-1))) + 1
+    # only triangles at a segment's vertex can hold it: a few, not the whole mesh, to sort
+    on_segment = np.zeros(n, dtype=bool)
+    on_segment[S.ravel()] = True
+    T = T[on_segment[T].any(axis=1)]
     half = np.unique(T[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2) @ np.array([n, 1]))
     return np.isin(S @ np.array([n, 1]), half), np.isin(S[:, ::-1] @ np.array([n, 1]), half)
 
