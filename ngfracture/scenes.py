@@ -6,8 +6,11 @@ pass it to :class:`ngfracture.simulation.Simulation`.
 * :func:`plate`: a square glass plate with small notches on the top and bottom edges,
   pulled apart by gliding conditions on the left and right sides.
 * :func:`disk`: a brittle disk with a hole around a softer, separate core whose inner
-  boundary expands; contact passes the expansion on; the inner part of the disk
-  breaks into grains while the outer ring stays whole.
+  boundary expands; contact passes the expansion on; radial cracks grow from the hole
+  while the outer ring stays whole.
+
+Every scene judges cracks at a critical distance ``radius`` (docs/criterion.md);
+``radius=None`` selects the paper's one-ring criterion.
 * :func:`disintegration`: the same disk expanded further, until it falls apart.
 """
 import math
