@@ -97,11 +97,12 @@ namespace ngfracture
     // meets the boundary at a distance s < 2r is judged over l = s/2: a section thinner than
     // 2r ahead of a tip is judged on its near half. For a linear stress profile (a ligament
     // in tension and bending) the value at s/2 is the net-section stress, which the bending
-    // part cannot hide. The segment never ends inside the first triangle (the vertex's own
-    // value is not used). False if the direction points out of the body at v (or the walk
-    // does not end).
+    // part cannot hide; a tip's segment still reaches its first edge crossing or r,
+    // whichever is nearer. The vertex's own value only interpolates inside the first
+    // triangle. samples: scratch space. False if the direction points out of the body at v
+    // (or the walk does not end).
     bool RayMinimum (const Mesh2 & m, FlatMatrix<double> T, int v, double dx, double dy, double r,
-                     bool tip, double & result)
+                     bool tip, std::vector<std::pair<double,double>> & samples, double & result)
     {
       const double px = m.x[v], py = m.y[v];
       const double reach = tip ? 2 * r : r;
@@ -122,7 +123,7 @@ namespace ngfracture
       if (t < 0) return false;
       // samples (distance, opening) at the start, the edge crossings and the end of the
       // walk; the field is linear between two consecutive ones (they bound one triangle)
-      std::vector<std::pair<double,double>> samples;
+      samples.clear();
       samples.emplace_back(0.0, Opening(m, T, t, Bary(m, t, px, py), nx, ny));
       double surface = std::numeric_limits<double>::infinity();
       // excluded edges: for the first triangle the two through v, later the entry edge
@@ -271,6 +272,7 @@ namespace ngfracture
     std::vector<double> value(ndir);
     std::vector<char> ok(ndir);
     std::vector<int> mark(nv, -1), queue;
+    std::vector<std::pair<double,double>> samples;
     const std::vector<char> sharp = SharpTips(m);
     // Serial: deterministic, and a few ms per 10k vertices at r = 4h.
     for (size_t v = 0; v < nv; v++)
@@ -284,7 +286,7 @@ namespace ngfracture
             // half-step offset: no ray starts exactly along the x axis, where meshes
             // of straight cracks have their edges
             double th = (k + 0.5) * dtheta;
-            ok[k] = RayMinimum(m, T, int(v), cos(th), sin(th), radius[v], sharp[v], value[k]);
+            ok[k] = RayMinimum(m, T, int(v), cos(th), sin(th), radius[v], sharp[v], samples, value[k]);
             if (ok[k] && (kbest < 0 || value[k] > value[kbest])) kbest = k;
           }
         if (kbest < 0) continue;

@@ -155,24 +155,14 @@ def crack_lines(arrays):
     """The cracks of a mesh as lines: the crack faces' segments joined where they share a
     reference point (the two faces of a crack coincide there). Returns a list of point sets,
     one per connected crack."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
     seg = arrays.boundary_segments("crack")
-    keys = {}
-    ids = np.array([[keys.setdefault(tuple(arrays.points[v]), len(keys)) for v in s] for s in seg])
-    parent = list(range(len(keys)))
-
-    def root(i):
-        while parent[i] != i:
-            parent[i] = parent[parent[i]]
-            i = parent[i]
-        return i
-
-    for a, b in ids:
-        parent[root(a)] = root(b)
-    points = np.array(list(keys))
-    lines = {}
-    for k in range(len(keys)):
-        lines.setdefault(root(k), []).append(k)
-    return [points[m] for m in lines.values()]
+    points, ids = np.unique(arrays.points[seg.ravel()], axis=0, return_inverse=True)
+    ends = ids.reshape(-1, 2)
+    graph = coo_matrix((np.ones(len(ends)), (ends[:, 0], ends[:, 1])), shape=(len(points),) * 2)
+    count, label = connected_components(graph, directed=False)
+    return [points[label == k] for k in range(count)]
 
 
 @pytest.mark.slow
