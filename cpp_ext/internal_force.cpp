@@ -1,4 +1,5 @@
 #include "internal_force.hpp"
+#include <algorithm>
 #include <cmath>
 
 namespace ngfracture
@@ -59,35 +60,190 @@ namespace ngfracture
     throw ngcore::Exception("ngfracture.InternalForces: unknown material kind");
   }
 
+  // Material tangent A_ijkl = dP_ij / dH_kl (A[2 i + j][2 k + l]) of the law's P(H).
+  static void PiolaTangent (MaterialKind kind, double mu, double lam, const double H[2][2],
+                            double A[4][4])
+  {
+    auto d = [] (int a, int b) { return a == b ? 1.0 : 0.0; };
+    switch (kind)
+      {
+      case MaterialKind::Linear:
+        for (int i = 0; i < 2; i++) for (int j = 0; j < 2; j++)
+          for (int k = 0; k < 2; k++) for (int l = 0; l < 2; l++)
+            A[2 * i + j][2 * k + l] = mu * (d(i, k) * d(j, l) + d(i, l) * d(j, k)) + lam * d(i, j) * d(k, l);
+        return;
+      case MaterialKind::StVenantKirchhoff:
+        {
+          // dP_ij/dF_kl = delta_ik S_lj + mu (F_il F_kj + delta_jl (F F^T)_ik) + lam F_ij F_kl
+          double E00 = H[0][0] + 0.5 * (H[0][0] * H[0][0] + H[1][0] * H[1][0]);
+          double E11 = H[1][1] + 0.5 * (H[0][1] * H[0][1] + H[1][1] * H[1][1]);
+          double E01 = 0.5 * (H[0][1] + H[1][0] + H[0][0] * H[0][1] + H[1][0] * H[1][1]);
+          double tr = E00 + E11;
+          double S[2][2] = { { 2 * mu * E00 + lam * tr, 2 * mu * E01 }, { 2 * mu * E01, 2 * mu * E11 + lam * tr } };
+          double F[2][2] = { { 1 + H[0][0], H[0][1] }, { H[1][0], 1 + H[1][1] } };
+          double FFt[2][2];
+          for (int i = 0; i < 2; i++) for (int k = 0; k < 2; k++)
+            FFt[i][k] = F[i][0] * F[k][0] + F[i][1] * F[k][1];
+          for (int i = 0; i < 2; i++) for (int j = 0; j < 2; j++)
+            for (int k = 0; k < 2; k++) for (int l = 0; l < 2; l++)
+              A[2 * i + j][2 * k + l] = d(i, k) * S[l][j] + mu * (F[i][l] * F[k][j] + d(j, l) * FFt[i][k])
+                                        + lam * F[i][j] * F[k][l];
+          return;
+        }
+      case MaterialKind::NeoHookean:
+        {
+          // dP_ij/dF_kl = mu delta_ik delta_jl + (mu - lam ln J) G_il G_kj + lam G_ij G_kl, G = F^-T
+          double Jm1 = H[0][0] + H[1][1] + H[0][0] * H[1][1] - H[0][1] * H[1][0], J = 1 + Jm1;
+          double logJ = J > 0 ? std::log1p(Jm1) : std::nan("");
+          double G[2][2] = { { (1 + H[1][1]) / J, -H[1][0] / J }, { -H[0][1] / J, (1 + H[0][0]) / J } };
+          for (int i = 0; i < 2; i++) for (int j = 0; j < 2; j++)
+            for (int k = 0; k < 2; k++) for (int l = 0; l < 2; l++)
+              A[2 * i + j][2 * k + l] = mu * d(i, k) * d(j, l) + (mu - lam * logJ) * G[i][l] * G[k][j]
+                                        + lam * G[i][j] * G[k][l];
+          return;
+        }
+      }
+    throw ngcore::Exception("ngfracture.TangentStiffness: unknown material kind");
+  }
+
+  // Gradients of the barycentric coordinates of triangle e (g[a][j]), and twice its signed area.
+  static double BarycentricGradients (FlatMatrix<double> points, const int v[3], double g[3][2])
+  {
+    double xa = points(v[0], 0), ya = points(v[0], 1);
+    double xb = points(v[1], 0), yb = points(v[1], 1);
+    double xc = points(v[2], 0), yc = points(v[2], 1);
+    double d = (xb - xa) * (yc - ya) - (xc - xa) * (yb - ya);
+    g[0][0] = (yb - yc) / d; g[0][1] = (xc - xb) / d;
+    g[1][0] = (yc - ya) / d; g[1][1] = (xa - xc) / d;
+    g[2][0] = (ya - yb) / d; g[2][1] = (xb - xa) / d;
+    return d;
+  }
+
+  static void CheckKernelInput (const char * name, FlatMatrix<double> points, FlatMatrix<int> triangles,
+                                size_t nu, FlatVector<int> kind, FlatVector<double> mu,
+                                FlatVector<double> lam)
+  {
+    size_t nv = points.Height(), ne = triangles.Height();
+    std::string fn = std::string("ngfracture.") + name;
+    if (points.Width() != 2 || triangles.Width() != 3)
+      throw ngcore::Exception(fn + ": points must be nv x 2 and triangles ne x 3");
+    if (nu != 2 * nv)
+      throw ngcore::Exception(fn + ": u must have 2 nv = " + ngcore::ToString(2 * nv) +
+                              " entries, got " + ngcore::ToString(nu));
+    if (kind.Size() != ne || mu.Size() != ne || lam.Size() != ne)
+      throw ngcore::Exception(fn + ": kind, mu and lam need one entry per triangle");
+    for (size_t e = 0; e < ne; e++)
+      for (int k = 0; k < 3; k++)
+        if (triangles(e, k) < 0 || size_t(triangles(e, k)) >= nv)
+          throw ngcore::Exception(fn + ": triangle " + ngcore::ToString(e) +
+                                  " has a vertex number out of range");
+  }
+
+  void TangentStiffness (FlatMatrix<double> points, FlatMatrix<int> triangles, FlatVector<double> u,
+                         FlatVector<int> kind, FlatVector<double> mu, FlatVector<double> lam,
+                         Array<int> & indptr, Array<int> & indices, Array<double> & data)
+  {
+    CheckKernelInput("TangentStiffness", points, triangles, u.Size(), kind, mu, lam);
+    size_t nv = points.Height(), ne = triangles.Height();
+    // the neighbours of every vertex (itself included), sorted: row (c, v) holds the columns
+    // (0, w) then (1, w) for w in that list, so every row is sorted
+    Array<int> count(nv + 1);
+    count = 0;
+    for (size_t e = 0; e < ne; e++)
+      for (int a = 0; a < 3; a++)
+        count[triangles(e, a) + 1] += 3;
+    for (size_t v = 0; v < nv; v++)
+      count[v + 1] += count[v] + 1;
+    Array<int> fill(nv), neighbours(count[nv]);
+    for (size_t v = 0; v < nv; v++)
+      {
+        neighbours[count[v]] = v;
+        fill[v] = count[v] + 1;
+      }
+    for (size_t e = 0; e < ne; e++)
+      for (int a = 0; a < 3; a++)
+        for (int b = 0; b < 3; b++)
+          if (a != b)
+            neighbours[fill[triangles(e, a)]++] = triangles(e, b);
+    Array<int> start(nv + 1);     // compressed: sorted, duplicates removed
+    start[0] = 0;
+    size_t kept = 0;
+    for (size_t v = 0; v < nv; v++)
+      {
+        int * first = &neighbours[count[v]], * last = &neighbours[0] + fill[v];
+        std::sort(first, last);
+        last = std::unique(first, last);
+        for (int * p = first; p < last; p++)
+          neighbours[kept++] = *p;
+        start[v + 1] = kept;
+      }
+    indptr.SetSize(2 * nv + 1);
+    indptr[0] = 0;
+    for (int c = 0; c < 2; c++)
+      for (size_t v = 0; v < nv; v++)
+        {
+          size_t row = c * nv + v;
+          indptr[row + 1] = indptr[row] + 2 * (start[v + 1] - start[v]);
+        }
+    indices.SetSize(indptr[2 * nv]);
+    for (int c = 0; c < 2; c++)
+      for (size_t v = 0; v < nv; v++)
+        {
+          int deg = start[v + 1] - start[v], at = indptr[c * nv + v];
+          for (int k = 0; k < 2; k++)
+            for (int n = 0; n < deg; n++)
+              indices[at + k * deg + n] = k * nv + neighbours[start[v] + n];
+        }
+    data.SetSize(indptr[2 * nv]);
+    data = 0.0;
+    for (size_t e = 0; e < ne; e++)
+      {
+        int v[3] = { triangles(e, 0), triangles(e, 1), triangles(e, 2) };
+        double g[3][2];
+        double area = 0.5 * std::fabs(BarycentricGradients(points, v, g));
+        double H[2][2] = { { 0, 0 }, { 0, 0 } };
+        for (int a = 0; a < 3; a++)
+          for (int i = 0; i < 2; i++)
+            for (int j = 0; j < 2; j++)
+              H[i][j] += u(i * nv + v[a]) * g[a][j];
+        double A[4][4];
+        PiolaTangent(MaterialKind(kind(e)), mu(e), lam(e), H, A);
+        for (int a = 0; a < 3; a++)
+          {
+            int deg = start[v[a] + 1] - start[v[a]];
+            const int * nb = &neighbours[start[v[a]]];
+            for (int b = 0; b < 3; b++)
+              {
+                int pos = std::lower_bound(nb, nb + deg, v[b]) - nb;
+                for (int i = 0; i < 2; i++)
+                  for (int k = 0; k < 2; k++)
+                    {
+                      double s = 0;
+                      for (int j = 0; j < 2; j++)
+                        for (int l = 0; l < 2; l++)
+                          s += A[2 * i + j][2 * k + l] * g[a][j] * g[b][l];
+                      data[indptr[i * nv + v[a]] + k * deg + pos] += area * s;
+                    }
+              }
+          }
+      }
+  }
+
   void InternalForces (FlatMatrix<double> points, FlatMatrix<int> triangles, FlatVector<double> u,
                        FlatVector<int> kind, FlatVector<double> mu, FlatVector<double> lam,
                        FlatVector<double> f)
   {
+    CheckKernelInput("InternalForces", points, triangles, u.Size(), kind, mu, lam);
     size_t nv = points.Height(), ne = triangles.Height();
-    if (points.Width() != 2 || triangles.Width() != 3)
-      throw ngcore::Exception("ngfracture.InternalForces: points must be nv x 2 and triangles ne x 3");
-    if (u.Size() != 2 * nv || f.Size() != 2 * nv)
-      throw ngcore::Exception("ngfracture.InternalForces: u and f must have 2 nv = " + ngcore::ToString(2 * nv) +
-                              " entries, got " + ngcore::ToString(u.Size()) + " and " + ngcore::ToString(f.Size()));
-    if (kind.Size() != ne || mu.Size() != ne || lam.Size() != ne)
-      throw ngcore::Exception("ngfracture.InternalForces: kind, mu and lam need one entry per triangle");
-    for (size_t e = 0; e < ne; e++)
-      for (int k = 0; k < 3; k++)
-        if (triangles(e, k) < 0 || size_t(triangles(e, k)) >= nv)
-          throw ngcore::Exception("ngfracture.InternalForces: triangle " + ngcore::ToString(e) +
-                                  " has a vertex number out of range");
+    if (f.Size() != 2 * nv)
+      throw ngcore::Exception("ngfracture.InternalForces: f must have 2 nv = " + ngcore::ToString(2 * nv) +
+                              " entries, got " + ngcore::ToString(f.Size()));
     f = 0.0;
     for (size_t e = 0; e < ne; e++)
       {
         int v[3] = { triangles(e, 0), triangles(e, 1), triangles(e, 2) };
-        double xa = points(v[0], 0), ya = points(v[0], 1);
-        double xb = points(v[1], 0), yb = points(v[1], 1);
-        double xc = points(v[2], 0), yc = points(v[2], 1);
-        double d = (xb - xa) * (yc - ya) - (xc - xa) * (yb - ya);   // twice the signed area
-        // gradients of the barycentric coordinates
-        double g[3][2] = { { (yb - yc) / d, (xc - xb) / d },
-                           { (yc - ya) / d, (xa - xc) / d },
-                           { (ya - yb) / d, (xb - xa) / d } };
+        double g[3][2];
+        double area = 0.5 * std::fabs(BarycentricGradients(points, v, g));
         double H[2][2] = { { 0, 0 }, { 0, 0 } };
         for (int a = 0; a < 3; a++)
           for (int i = 0; i < 2; i++)
@@ -95,7 +251,6 @@ namespace ngfracture
               H[i][j] += u(i * nv + v[a]) * g[a][j];
         double P[2][2];
         FirstPiola(MaterialKind(kind(e)), mu(e), lam(e), H, P);
-        double area = 0.5 * std::fabs(d);
         for (int a = 0; a < 3; a++)
           for (int i = 0; i < 2; i++)
             f(i * nv + v[a]) += area * (P[i][0] * g[a][0] + P[i][1] * g[a][1]);

@@ -16,6 +16,15 @@ namespace ngfracture
                        ngbla::FlatVector<double> u, ngbla::FlatVector<int> kind,
                        ngbla::FlatVector<double> mu, ngbla::FlatVector<double> lam,
                        ngbla::FlatVector<double> f);
+
+  // Tangent stiffness df/du of the same P1 triangles and laws, as a CSR matrix (2 nv x 2 nv,
+  // component-major dofs): every pair of vertices of a triangle couples in both components,
+  // columns sorted in every row, structural zeros kept. Serial, element order: the last bit is fixed.
+  void TangentStiffness (ngbla::FlatMatrix<double> points, ngbla::FlatMatrix<int> triangles,
+                         ngbla::FlatVector<double> u, ngbla::FlatVector<int> kind,
+                         ngbla::FlatVector<double> mu, ngbla::FlatVector<double> lam,
+                         ngcore::Array<int> & indptr, ngcore::Array<int> & indices,
+                         ngcore::Array<double> & data);
 }
 
 #endif

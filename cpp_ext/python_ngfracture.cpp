@@ -63,6 +63,62 @@ numpy.ndarray
 )doc");
 }
 
+static void ExportTangentStiffness (py::module & m)
+{
+  m.def("TangentStiffness",
+        [] (py::array_t<double, py::array::c_style | py::array::forcecast> points,
+            py::array_t<int, py::array::c_style | py::array::forcecast> triangles,
+            py::array_t<double, py::array::c_style | py::array::forcecast> u,
+            py::array_t<int, py::array::c_style | py::array::forcecast> kind,
+            py::array_t<double, py::array::c_style | py::array::forcecast> mu,
+            py::array_t<double, py::array::c_style | py::array::forcecast> lam)
+        {
+          if (points.ndim() != 2 || triangles.ndim() != 2 || u.ndim() != 1 || kind.ndim() != 1 ||
+              mu.ndim() != 1 || lam.ndim() != 1)
+            throw Exception("ngfracture.TangentStiffness: points and triangles must be 2D arrays, "
+                            "u, kind, mu and lam 1D");
+          size_t nv = points.shape(0), ne = triangles.shape(0);
+          FlatMatrix<double> P(nv, points.shape(1), const_cast<double*>(points.data()));
+          FlatMatrix<int> T(ne, triangles.shape(1), const_cast<int*>(triangles.data()));
+          FlatVector<double> U(u.shape(0), const_cast<double*>(u.data()));
+          FlatVector<int> K(kind.shape(0), const_cast<int*>(kind.data()));
+          FlatVector<double> M(mu.shape(0), const_cast<double*>(mu.data()));
+          FlatVector<double> L(lam.shape(0), const_cast<double*>(lam.data()));
+          Array<int> indptr, indices;
+          Array<double> data;
+          {
+            py::gil_scoped_release release;
+            TangentStiffness(P, T, U, K, M, L, indptr, indices, data);
+          }
+          auto copy = [] (auto & a)
+            {
+              using T = std::decay_t<decltype(a[0])>;
+              py::array_t<T> out(a.Size());
+              std::copy(a.begin(), a.end(), out.mutable_data());
+              return out;
+            };
+          return py::make_tuple(copy(data), copy(indices), copy(indptr));
+        },
+        py::arg("points"), py::arg("triangles"), py::arg("u"), py::arg("kind"), py::arg("mu"), py::arg("lam"),
+        R"doc(Tangent stiffness of P1 triangles, df/du of InternalForces, as CSR arrays.
+
+K_(a i),(b k) = sum_T |T| dP_ij/dH_kl grad_j N_a grad_l N_b, H = grad u. Every pair of
+vertices of a triangle couples in both components (the sparsity of NGSolve's VectorH1
+order 1 matrix); columns are sorted in every row and structural zeros kept.
+
+Parameters
+----------
+points, triangles, u, kind, mu, lam
+    As for InternalForces.
+
+Returns
+-------
+(data, indices, indptr) : tuple of numpy.ndarray
+    The CSR arrays of the 2 nv x 2 nv matrix (component-major dofs), for
+    ``scipy.sparse.csr_matrix((data, indices, indptr))``.
+)doc");
+}
+
 static void ExportVertexAverage (py::module & m)
 {
   m.def("ElementAreas",
@@ -177,6 +233,7 @@ PYBIND11_MODULE(_ngfracture, m)
   m.doc() = "ngfracture's C++ kernels (vertex averaging, crack splitting, collision detection).";
   ExportVertexAverage(m);
   ExportInternalForces(m);
+  ExportTangentStiffness(m);
   ExportSparseTriangular(m);
   ExportCrack(m);
   ExportCollision(m);

@@ -97,9 +97,9 @@ class ContactResult:
         every Newton solve in turn.
     converged, reason, rounds, constraints, multipliers, released, max_penetration
         Initial values of the attributes of the same names (below).
-    timings, history, updates, lcp, notes, active_keys
+    timings, history, updates, lcp, notes, active_keys, tangent
         Likewise; by default zero timings for the four phases, an empty history, 0, 0, no
-        notes, no keys.
+        notes, no keys, no tangent.
 
     Attributes
     ----------
@@ -142,6 +142,9 @@ class ContactResult:
         Sorted keys of the active rows of a converged solve: ("s", lower twin, higher
         twin, kind) for seam rows, ("n", slave, a, c) for node-to-segment rows. The next
         solve can start from them (``ContactSolver.solve(warm=...)``).
+    tangent : solver.SavedTangent or None
+        The factorisation the solve ended with (the lineage of a mesh split from this
+        one, split_factor.lineage).
     """
     status: SolveStatus
     converged: bool = False
@@ -157,6 +160,7 @@ class ContactResult:
     lcp: int = 0
     notes: list = field(default_factory=list)
     active_keys: list = field(default_factory=list)
+    tangent: object = None
 
     def __bool__(self):
         return self.converged
@@ -398,7 +402,7 @@ class ContactSolver:
         return status
 
     @single_threaded_blas()
-    def solve(self, warm=()):
+    def solve(self, warm=(), lineage=None):
         """Solve for equilibrium with contact.
 
         The problem's rows labelled "contact" are replaced by the active set of each round
@@ -415,6 +419,9 @@ class ContactSolver:
             changes: the set still has to settle and pass the same tests. A warm start that
             fails is followed by the plain path from the same start (recorded in
             ``notes``). Empty: the plain predict-and-correct path.
+        lineage : split_factor.Lineage, optional
+            The problem's mesh was split from a solved one: its solves start from that
+            factorisation, bordered by the split (see solver.SavedTangent).
 
         Returns
         -------
@@ -428,29 +435,29 @@ class ContactSolver:
         uncracked = prob.fragments()[0] == 1 and "crack" not in prob.mesh.GetBoundaries()
         warm = set() if uncracked else set(warm)
         if not warm:
-            return self._solve(warm, uncracked)
+            return self._solve(warm, uncracked, lineage)
         u, load = prob.u.vec.FV().NumPy().copy(), prob.load_factor.Get()
-        result = self._solve(warm, uncracked)
+        result = self._solve(warm, uncracked, lineage)
         if result.converged:
             return result
         # rows of the pass before can hold a shattered piece in a nearly singular way
         # (measured: a plate at critical strain 1e-12); the plain path decides then
         prob.u.vec.FV().NumPy()[:] = u
         prob.load_factor.Set(load)
-        plain = self._solve(set(), uncracked)
+        plain = self._solve(set(), uncracked, lineage)
         plain.notes.append(f"the warm start from {len(warm)} contact rows failed ({result.reason}); "
                            "solved from the prediction without rows")
         for phase, seconds in result.timings.items():
             plain.timings[phase] = plain.timings.get(phase, 0.0) + seconds
         return plain
 
-    def _solve(self, warm, uncracked):
+    def _solve(self, warm, uncracked, lineage):
         """The solve of :meth:`solve` from the given warm keys (a set, maybe empty)."""
         prob = self.problem
         prob.constraints.clear_rows(LABEL)
         # the rounds are at the load of the prediction: they reuse its factorised tangent
-        tangent = SavedTangent()
-        result = ContactResult(None, notes=list(self._notes))
+        tangent = SavedTangent(lineage)
+        result = ContactResult(None, notes=list(self._notes), tangent=tangent)
         scale = None        # the first increment of the first solve
         if not warm:
             status = self._newton(result, tangent)

@@ -732,7 +732,7 @@ def transfer(u, result):
 
 
 def split_by_tensor(mesh, tensors, critical, crack_name="crack", skip_neighbours=False, first_only=False,
-                    rules=PAPER_RULES):
+                    rules=PAPER_RULES, check_mesh=True):
     """One splitting pass from a vertex tensor field supplied by the caller.
 
     Parameters
@@ -753,6 +753,9 @@ def split_by_tensor(mesh, tensors, critical, crack_name="crack", skip_neighbours
         it, which split nothing (rules 2a, none), are in the record.
     rules : SplitRules
         See :func:`split_vertices`.
+    check_mesh : bool
+        False skips meshcheck.validate_mesh, for a caller that has checked this mesh
+        (an ElasticProblem on it has).
 
     Returns
     -------
@@ -772,7 +775,8 @@ def split_by_tensor(mesh, tensors, critical, crack_name="crack", skip_neighbours
     t = np.asarray(tensors, dtype=float)
     if t.shape != (mesh.nv, 3):
         raise ValueError(f"ngfracture.crack: tensor field must have shape ({mesh.nv}, 3), got {t.shape}")
-    validate_mesh(mesh)
+    if check_mesh:
+        validate_mesh(mesh)
     return _split_pass(mesh, t, c, crack_name, skip_neighbours, first_only, rules)
 
 

@@ -71,22 +71,42 @@ class SingularSystem(RuntimeError):
 
 
 def to_scipy(mat):
-    """An NGSolve sparse matrix as a scipy CSR matrix (a copy).
+    """A sparse matrix as a scipy CSR matrix.
 
     Parameters
     ----------
-    mat : ngsolve.SparseMatrix
-        A real sparse matrix (``mat.CSR()`` gives its values, column indices and row
-        pointers).
+    mat : ngsolve.SparseMatrix or scipy.sparse matrix
+        A real sparse matrix; an NGSolve one is copied (``mat.CSR()`` gives its values,
+        column indices and row pointers), a scipy CSR one returned as it is.
 
     Returns
     -------
     scipy.sparse.csr_matrix, shape (mat.height, mat.width)
-        The same entries, including explicitly stored zeros; the arrays are copied, so
-        later changes to ``mat`` do not show in it.
+        The same entries, including explicitly stored zeros; an NGSolve matrix's arrays
+        are copied, so later changes to ``mat`` do not show in it.
     """
+    if sp.issparse(mat):
+        return sp.csr_matrix(mat)
     vals, cols, rows = mat.CSR()
     return sp.csr_matrix((np.array(vals), np.array(cols), np.array(rows)), shape=(mat.height, mat.width))
+
+
+def to_ngsolve(mat):
+    """A scipy sparse matrix as an NGSolve sparse matrix (for NGSolve's direct solvers).
+
+    Parameters
+    ----------
+    mat : scipy.sparse matrix
+        Real, square or not.
+
+    Returns
+    -------
+    ngsolve.la.SparseMatrixd
+        The same entries (duplicates summed).
+    """
+    coo = sp.coo_matrix(mat)
+    return ng.la.SparseMatrixd.CreateFromCOO(coo.row.astype(np.int64), coo.col.astype(np.int64),
+                                             coo.data, coo.shape[0], coo.shape[1])
 
 
 _blas = None     # threadpoolctl's view of the loaded BLAS libraries, made at first use
@@ -165,13 +185,120 @@ SUPERLU_MAX_DOFS = 40000
 #: KKT solve.
 SPARSE_SCHUR_MIN_DOFS = 5000
 
+#: ... and from this many general rows on: fewer rows take their columns K^+ C^T (one block
+#: solve for the rows, kept), after which a KKT solve and each refinement take one solve
+#: instead of two (the plate splitting at 31k dofs holds one free mode by one row)
+SPARSE_SCHUR_MIN_ROWS = 9
+
 #: up to this many free dofs a fresh tangent with general rows is factorised as the
 #: augmented matrix (SuperLU); above, SuperLU's fill of the augmented matrix grows fast
 #: (plate at 8210 dofs, 100 rows: 1.9 s against 0.25 s for K_ff plus 1.8 s for the columns)
 AUGMENTED_MAX_DOFS = 5000
 
 
-class EliminatedFactor:
+class FactorBase:
+    """What every K^+ shares: the rows it was made for, the corrected modes, Schur columns.
+
+    A subclass sets ``K`` (scipy CSR, all dofs), ``ndof``, ``fixed_dofs``, ``pins``, ``free``
+    (not fixed), ``factor_free`` (neither fixed nor pinned), ``_columns`` ({}) and defines
+    ``solve(B)``.
+    """
+
+    def matches(self, fixed_dofs, pins):
+        """True if this factorisation leaves out exactly these fixed dofs and pins.
+
+        Parameters
+        ----------
+        fixed_dofs, pins : numpy.ndarray of int
+            Compared element by element, in order, with those of the constructor (after its
+            conversion to int64; pins=None became an empty array there, so pass an empty
+            array, not None, for "no pins").
+
+        Returns
+        -------
+        bool
+        """
+        return np.array_equal(self.fixed_dofs, fixed_dofs) and np.array_equal(self.pins, pins)
+
+    def corrected_modes(self, R):
+        """The modes corrected for the stiffness they meet, Rt = R - K^+ K R, and A = Rt^T K Rt.
+
+        Rt equals R at the pins and K Rt vanishes at the other free dofs; A is the
+        stiffness of the modes (zero when K R = 0: then Rt = R). See the module docstring.
+        A mode whose K R is within the rounding of the product (64 eps |K| |R| entry by
+        entry: a translation, which every element matrix annihilates) is taken as it is,
+        without a solve. The result for the last R is kept (contact rounds reuse the
+        factorisation).
+
+        Parameters
+        ----------
+        R : scipy.sparse matrix, shape (ndof, k)
+            Modes, zero at fixed dofs, resolved by the pins.
+
+        Returns
+        -------
+        Rt : scipy.sparse.csr_matrix, shape (ndof, k)
+            Zero at fixed dofs.
+        A : numpy.ndarray, shape (k, k)
+            Symmetric.
+        """
+        R = sp.csr_matrix(R)
+        key = R.indptr.tobytes() + R.indices.tobytes() + R.data.tobytes()
+        cached = getattr(self, "_modes", None)
+        if cached is not None and cached[0] == key:
+            return cached[1], cached[2]
+        dense = R.toarray()
+        KR = self.K @ dense
+        KR[~self.free] = 0.0
+        rounding = 64 * np.finfo(float).eps * (abs(self.K) @ np.abs(dense))
+        stiff = np.flatnonzero(np.any(np.abs(KR) > rounding, axis=0))
+        Rt = dense.copy()
+        if len(stiff):
+            Rt[:, stiff] -= self.solve(KR[:, stiff])
+        KRt = self.K @ Rt
+        A = Rt[self.free].T @ KRt[self.free]
+        A = 0.5 * (A + A.T)
+        Rt = sp.csr_matrix(Rt)
+        self._modes = (key, Rt, A)
+        return Rt, A
+
+    def columns(self, C):
+        """Z = K^+ C^T (ndof, m); rows met in the last call are not solved again.
+
+        A row is recognised by its stored column indices and values (bitwise); the cache
+        keeps only the rows of the latest call.
+
+        Parameters
+        ----------
+        C : scipy.sparse matrix or array_like, shape (m, ndof)
+            Constraint rows.
+
+        Returns
+        -------
+        numpy.ndarray, shape (ndof, m)
+            Column i is K^+ C_i^T, zero at fixed dofs and pins.
+
+        Raises
+        ------
+        SingularSystem
+            From :meth:`solve`, if the rows not cached need a solve and it fails.
+        """
+        C = sp.csr_matrix(C)
+        keys = [C.indices[s:e].tobytes() + C.data[s:e].tobytes() for s, e in zip(C.indptr[:-1], C.indptr[1:])]
+        Z = np.zeros((self.ndof, len(keys)))
+        new = []
+        for i, key in enumerate(keys):
+            if key in self._columns:
+                Z[:, i] = self._columns[key]
+            else:
+                new.append(i)
+        if new:
+            Z[:, new] = self.solve(C[new].T.toarray())
+        self._columns = {key: Z[:, i] for i, key in enumerate(keys)}
+        return Z
+
+
+class EliminatedFactor(FactorBase):
     """K^+: the stiffness without fixed dofs and pins, factorised once, for many solves.
 
     Kept between the constrained solves of one load (contact rounds, modified Newton).
@@ -183,8 +310,9 @@ class EliminatedFactor:
 
     Parameters
     ----------
-    K : ngsolve.SparseMatrix
-        Tangent stiffness on all dofs (kept as given; do not reassemble it while in use).
+    K : scipy.sparse matrix or ngsolve.SparseMatrix
+        Tangent stiffness on all dofs (an NGSolve matrix is copied to scipy CSR; a scipy one is
+        kept as given: do not change it while in use).
     fixed_dofs, pins : array_like of int
         Dofs left out of the factorisation: those fixed by single-dof rows, and one pin per
         free rigid mode (``rigid.Support.pins``; None for none).
@@ -211,8 +339,8 @@ class EliminatedFactor:
         if linear_solver not in LINEAR_SOLVERS:
             raise ValueError(f"linear_solver must be one of {LINEAR_SOLVERS}, got {linear_solver!r}")
         t0 = time.perf_counter()
-        self.K = K
-        self.ndof = K.height
+        self.K = to_scipy(K)      # products with K: scipy's CSR product
+        self.ndof = self.K.shape[0]
         self.fixed_dofs = np.asarray(fixed_dofs, dtype=np.int64)
         self.pins = np.zeros(0, dtype=np.int64) if pins is None else np.asarray(pins, dtype=np.int64)
         self.free = np.ones(self.ndof, dtype=bool)
@@ -221,7 +349,7 @@ class EliminatedFactor:
         self.factor_free[self.pins] = False
         self.linear_solver = linear_solver
         self.gmres_tol = gmres_tol
-        self._tmp = K.CreateColVector()
+        self._tmp = ng.BaseVector(self.ndof)     # NGSolve's solvers work on its vectors
         self._columns = {}        # row key -> K^+ row^T, for the rows of the last Schur complement
         self._reach = {}          # row key -> its sparse triangular solves (schur), last rows
         self._triangles = None    # the factors' arrays for the sparse triangular solves
@@ -278,7 +406,7 @@ class EliminatedFactor:
             for d in np.flatnonzero(~self.factor_free).tolist():
                 factor_dofs.Clear(d)
             with reproducible_threads():
-                self._inv = self.K.Inverse(factor_dofs, inverse=self.inverse)
+                self._inv = to_ngsolve(self.K).Inverse(factor_dofs, inverse=self.inverse)
         self.seconds += time.perf_counter() - t0
 
     def _factorised_block(self):
@@ -343,22 +471,6 @@ class EliminatedFactor:
         self.seconds += time.perf_counter() - t0
         return lu, row_scale
 
-    def matches(self, fixed_dofs, pins):
-        """True if this factorisation leaves out exactly these fixed dofs and pins.
-
-        Parameters
-        ----------
-        fixed_dofs, pins : numpy.ndarray of int
-            Compared element by element, in order, with those of the constructor (after its
-            conversion to int64; pins=None became an empty array there, so pass an empty
-            array, not None, for "no pins").
-
-        Returns
-        -------
-        bool
-        """
-        return np.array_equal(self.fixed_dofs, fixed_dofs) and np.array_equal(self.pins, pins)
-
     def solve(self, B):
         """X = K^+ B for a full-length right-hand side (ndof,) or a block (ndof, m).
 
@@ -421,6 +533,36 @@ class EliminatedFactor:
             for j in range(B.shape[1]):
                 X[:, j] = out[j].FV().NumPy()
 
+    def solve_factorised(self, b):
+        """K_ff^-1 b on the factorised dofs only: the solve of :meth:`solve` without the
+        full-length copies, for a caller that has checked the factorisation through
+        :meth:`solve` (split_factor.BorderedFactor).
+
+        Parameters
+        ----------
+        b : numpy.ndarray, shape (n,) or (n, k)
+            Right-hand side(s) on the factorised dofs, in their order (n of them).
+
+        Returns
+        -------
+        numpy.ndarray
+            Same shape as b.
+
+        Raises
+        ------
+        SingularSystem
+            If the solution has NaN/inf.
+        """
+        if self._lu is not None:
+            x = self._lu.solve(np.asfortranarray(b))
+        else:
+            B = np.zeros((self.ndof,) + b.shape[1:])
+            B[self.factor_free] = b
+            x = self.solve(B)[self.factor_free]
+        if not np.all(np.isfinite(x)):
+            raise SingularSystem("the factorised stiffness produced NaN/inf: singular (a floating body?)")
+        return x
+
     def _check(self, B, X):
         """One residual check per factorisation: sparse Cholesky of a singular or
         indefinite matrix can return finite garbage."""
@@ -428,89 +570,11 @@ class EliminatedFactor:
         b = B[self.factor_free, j]
         if not np.any(b):
             return
-        self._tmp.FV().NumPy()[:] = X[:, j]
-        r = (self.K * self._tmp).Evaluate().FV().NumPy()[self.factor_free] - b
+        r = (self.K @ X[:, j])[self.factor_free] - b
         rel = np.linalg.norm(r) / np.linalg.norm(b)
         if not rel < 1e-6:
             raise SingularSystem(f"the factorised stiffness does not solve its system (relative residual {rel:.1e}): singular or indefinite")
         self._checked = True
-
-    def corrected_modes(self, R):
-        """The modes corrected for the stiffness they meet, Rt = R - K^+ K R, and A = Rt^T K Rt.
-
-        Rt equals R at the pins and K Rt vanishes at the other free dofs; A is the
-        stiffness of the modes (zero when K R = 0: then Rt = R). See the module docstring.
-        The result for the last R is kept (contact rounds reuse the factorisation).
-
-        Parameters
-        ----------
-        R : scipy.sparse matrix, shape (ndof, k)
-            Modes, zero at fixed dofs, resolved by the pins.
-
-        Returns
-        -------
-        Rt : scipy.sparse.csr_matrix, shape (ndof, k)
-            Zero at fixed dofs.
-        A : numpy.ndarray, shape (k, k)
-            Symmetric.
-        """
-        R = sp.csr_matrix(R)
-        key = R.indptr.tobytes() + R.indices.tobytes() + R.data.tobytes()
-        cached = getattr(self, "_modes", None)
-        if cached is not None and cached[0] == key:
-            return cached[1], cached[2]
-        k = R.shape[1]
-        KR = np.zeros((self.ndof, k))
-        dense = R.toarray()
-        for j in range(k):
-            self._tmp.FV().NumPy()[:] = dense[:, j]
-            KR[:, j] = (self.K * self._tmp).Evaluate().FV().NumPy()
-        KR[~self.free] = 0.0
-        Rt = dense - self.solve(KR) if k else dense
-        KRt = np.zeros_like(KR)
-        for j in range(k):
-            self._tmp.FV().NumPy()[:] = Rt[:, j]
-            KRt[:, j] = (self.K * self._tmp).Evaluate().FV().NumPy()
-        A = Rt[self.free].T @ KRt[self.free]
-        A = 0.5 * (A + A.T)
-        Rt = sp.csr_matrix(Rt)
-        self._modes = (key, Rt, A)
-        return Rt, A
-
-    def columns(self, C):
-        """Z = K^+ C^T (ndof, m); rows met in the last call are not solved again.
-
-        A row is recognised by its stored column indices and values (bitwise); the cache
-        keeps only the rows of the latest call.
-
-        Parameters
-        ----------
-        C : scipy.sparse matrix or array_like, shape (m, ndof)
-            Constraint rows.
-
-        Returns
-        -------
-        numpy.ndarray, shape (ndof, m)
-            Column i is K^+ C_i^T, zero at fixed dofs and pins.
-
-        Raises
-        ------
-        SingularSystem
-            From :meth:`solve`, if the rows not cached need a solve and it fails.
-        """
-        C = sp.csr_matrix(C)
-        keys = [C.indices[s:e].tobytes() + C.data[s:e].tobytes() for s, e in zip(C.indptr[:-1], C.indptr[1:])]
-        Z = np.zeros((self.ndof, len(keys)))
-        new = []
-        for i, key in enumerate(keys):
-            if key in self._columns:
-                Z[:, i] = self._columns[key]
-            else:
-                new.append(i)
-        if new:
-            Z[:, new] = self.solve(C[new].T.toarray())
-        self._columns = {key: Z[:, i] for i, key in enumerate(keys)}
-        return Z
 
     @property
     def sparse_schur(self):
@@ -613,7 +677,7 @@ class ConstrainedSolver:
 
     Parameters
     ----------
-    K : ngsolve.SparseMatrix or None
+    K : scipy.sparse matrix, ngsolve.SparseMatrix or None
         Tangent stiffness on all dofs (None allowed when ``factor`` is given).
     fixed_dofs : numpy.ndarray of int
         Dofs fixed by single-dof rows (eliminated).
@@ -669,7 +733,6 @@ class ConstrainedSolver:
             raise ValueError("the factorisation to reuse was made for other fixed dofs or pins")
         self.factor = factor
         self.K, self.ndof, self.free = factor.K, factor.ndof, factor.free
-        self._tmp = factor.K.CreateColVector()
         self.C = sp.csr_matrix(C)
         self.m = self.C.shape[0]
         # kept: every solve and its refinement use them (thousands of solves per run);
@@ -701,7 +764,7 @@ class ConstrainedSolver:
         if self.m:
             self._R, A = factor.corrected_modes(self._R)
             self._Rt = self._R.T
-            if factor.sparse_schur:
+            if factor.sparse_schur and self.m >= SPARSE_SCHUR_MIN_ROWS:
                 # no columns: the displacement correction takes one more solve per solve
                 self._Z = None
                 S = factor.schur(self.C)
@@ -817,8 +880,7 @@ class ConstrainedSolver:
         t0 = time.perf_counter()
         q = r
         if np.any(du_fixed):
-            self._tmp.FV().NumPy()[:] = du_fixed
-            q = r - (self.K * self._tmp).Evaluate().FV().NumPy()
+            q = r - self.K @ du_fixed
         lu, row_scale = self._augmented
         rhs = np.concatenate([q[self.free], row_scale * (h - self.C @ du_fixed)])
         x = lu.solve(rhs)
@@ -837,8 +899,7 @@ class ConstrainedSolver:
         values), not |C du|: rows already satisfied have C du and h near zero, and measured
         against those the rounding of the product looked like an error (measured on the
         default plate: half of all solves refined twice for nothing)."""
-        self._tmp.FV().NumPy()[:] = du
-        Kdu = (self.K * self._tmp).Evaluate().FV().NumPy()
+        Kdu = self.K @ du
         Ct_lam = self._Ct @ lam
         free = self.free
         res = np.where(free, r - Kdu - Ct_lam, 0.0)
@@ -857,8 +918,7 @@ class ConstrainedSolver:
         """The load q with the prescribed increments moved over, and du = du_fixed + K^+ q."""
         q = r
         if np.any(du_fixed):
-            self._tmp.FV().NumPy()[:] = du_fixed
-            q = r - (self.K * self._tmp).Evaluate().FV().NumPy()
+            q = r - self.K @ du_fixed
         return q, du_fixed + self.factor.solve(q)
 
     def solve_unilateral(self, r, du_fixed, h, unilateral):

@@ -120,8 +120,7 @@ def find_seams(points, segments):
     """
     X = np.ascontiguousarray(points, dtype=np.float64)
     S = np.asarray(segments, dtype=np.int64).reshape(-1, 2)
-    _, copy_id = np.unique(X, axis=0, return_inverse=True)
-    copy_id = copy_id.ravel()
+    copy_id = _point_ids(X)
     n = int(copy_id.max(initial=-1)) + 1
     a = b = np.zeros(0, dtype=np.int64)
     if len(S):
@@ -140,6 +139,19 @@ def find_seams(points, segments):
     edge_rows, diagonal = _junctions(X, S, copy_id, facets)
     return Seams(facets=facets, copy_id=copy_id, seam_edge=set(map(tuple, edges.tolist())),
                  edge_rows=edge_rows, diagonal=diagonal)
+
+
+def _point_ids(X):
+    """Number of every point among the distinct points, in lexicographic (x, y) order: the
+    inverse of ``np.unique(X, axis=0)``, by one lexsort (np.unique sorts rows as records,
+    four times slower)."""
+    order = np.lexsort((X[:, 1], X[:, 0]))
+    Xs = X[order]
+    new = np.ones(len(X), dtype=np.int64)
+    new[1:] = np.any(Xs[1:] != Xs[:-1], axis=1)
+    ids = np.empty(len(X), dtype=np.int64)
+    ids[order] = np.cumsum(new) - 1
+    return ids
 
 
 def _copy_pairs(copy_id, candidates):

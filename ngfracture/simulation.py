@@ -53,16 +53,17 @@ from typing import Callable
 
 import numpy as np
 
-from . import checkpoint
+from . import checkpoint, split_factor
 from .contact_solver import ContactSolver, fragment_overlap_area
 from .crack import (GROWTH_RULES, PAPER_RULES, StrainCriterion, element_strain, equivalent_strain,
-                    nonlocal_opening, split_by_tensor, transfer, transfer_vertex_field)
+                    nonlocal_opening, split_by_tensor, transfer_vertex_field)
 from .fragments import FragmentStatistics
 from .kkt import single_threaded_blas
 from .loadpath import load_path_cut, prescribed_increment
 from .materials import Material
 from .meshio import MeshArrays, mesh_from_arrays, mesh_to_arrays
 from .problem import ElasticProblem
+from .solver import SavedTangent
 
 #: wall time per phase; "linear" (factorisations and triangular solves) and "assembly"
 #: (NGSolve's residual and tangent assembly) are parts of "solve"
@@ -601,10 +602,12 @@ class Simulation:
             return False
         return self.scene.contact or "crack" in mesh.GetBoundaries()
 
-    def _equilibrium(self, prob, phase, substeps=1, warm=()):
-        """Solve in ``substeps`` load steps; returns the keys of the active contact rows.
+    def _equilibrium(self, prob, phase, substeps=1, warm=(), lineage=None):
+        """Solve in ``substeps`` load steps; returns (the keys of the active contact rows,
+        the solver.SavedTangent the solve ended with).
 
         ``warm``: the active contact keys of the solve before (ContactSolver.solve).
+        ``lineage``: the mesh was split from a solved one (split_factor.py).
         Raises StepFailed(reason, phase) if the solve does not converge.
         """
         c = self.control
@@ -613,7 +616,7 @@ class Simulation:
             solver = ContactSolver(prob, tol=self.scene.contact_tol,   # its tol: detection threshold
                                    fix_free_modes=self.scene.fix_free_modes)
             solver.options.update(options)                              # Newton's tol, method, maxit
-            result = solver.solve(warm=warm)
+            result = solver.solve(warm=warm, lineage=lineage)
             self.timings["solve"] += result.timings["solve"]
             self.timings["contact"] += result.timings["contact"] - result.timings.get("collision", 0.0)
             self.timings["collision"] += result.timings.get("collision", 0.0)
@@ -631,16 +634,17 @@ class Simulation:
                 else:
                     message = status.message
                 raise StepFailed(result.reason, phase, message)
-            return result.active_keys
+            return result.active_keys, result.tangent
         t0 = time.perf_counter()
-        status = prob.solve(fix_free_modes=self.scene.fix_free_modes, **options)
+        tangent = SavedTangent(lineage)
+        status = prob.solve(fix_free_modes=self.scene.fix_free_modes, tangent=tangent, **options)
         self.timings["solve"] += time.perf_counter() - t0
         for part, seconds in status.phase_seconds().items():
             self.timings[part] += seconds
         self._iterations += status.iterations
         if not status.converged:
             raise StepFailed(status.reason, phase, status.message)
-        return []
+        return [], tangent
 
     def _normalised_strain(self, prob, strength=None):
         """Vertex strain tensors divided by the vertex's critical strain (0: cannot crack).
@@ -674,23 +678,27 @@ class Simulation:
         self.timings["strain"] += time.perf_counter() - t0
         return tensors
 
-    def _crack_pass(self, prob, strength=None):
-        """One splitting pass; returns (new problem or None, number of split vertices, strength)."""
+    def _crack_pass(self, prob, strength=None, tangent=None):
+        """One splitting pass; returns (new problem or None, number of split vertices, strength,
+        the new mesh's split_factor.Lineage from ``tangent``, the last solve's, or None)."""
         tensors = self._normalised_strain(prob, strength)
         t0 = time.perf_counter()
         # cracks judged at a critical distance grow from their tips (docs/criterion.md)
         rules = PAPER_RULES if self.scene.radius is None else GROWTH_RULES
         res = split_by_tensor(prob.mesh, tensors, 1.0, skip_neighbours=self.control.split == "spread",
-                              first_only=self.control.split == "one", rules=rules)
+                              first_only=self.control.split == "one", rules=rules,
+                              check_mesh=False)          # prob's ElasticProblem has checked it
         self.timings["split"] += time.perf_counter() - t0 - sum(res.timings.get(k, 0.0) for k in ("netgen", "ngsolve_mesh"))
         self.timings["rebuild"] += res.timings.get("netgen", 0.0) + res.timings.get("ngsolve_mesh", 0.0)
         if res.nsplit == 0:
-            return None, 0, strength
+            return None, 0, strength, None
         self._split_positions.append(res.record["position"][np.diff(res.record["new_offsets"]) > 0])
-        u = transfer(prob.u, res)
+        # P1: the displacement is a vertex field (component-major), copied through the split
+        u = transfer_vertex_field(prob.u.vec.FV().NumPy().reshape(2, -1).T, res).T.reshape(-1)
         if strength is not None:
             strength = transfer_vertex_field(strength, res)    # copies inherit the vertex's strength
-        return self._problem(res.mesh, self._x_try, u.vec.FV().NumPy()), res.nsplit, strength
+        inherited = split_factor.lineage(tangent.factor, tangent.state, res.parent) if tangent is not None else None
+        return self._problem(res.mesh, self._x_try, u), res.nsplit, strength, inherited
 
     # -- one load step ----------------------------------------------------------------------------
     def _attempt(self, state, dx, substeps=1):
@@ -702,9 +710,9 @@ class Simulation:
         self._x_try = state.x + dx
         self._split_positions = []      # per pass: reference positions of the vertices split
         prob = self._problem(self._mesh, self._x_try, state.u)
-        keys = self._equilibrium(prob, "increment", substeps, warm=state.contact_keys)
+        keys, tangent = self._equilibrium(prob, "increment", substeps, warm=state.contact_keys)
         self._dwork = self._increment_work(state, prob)
-        new_prob, first, strength = self._crack_pass(prob, state.strength)
+        new_prob, first, strength, inherited = self._crack_pass(prob, state.strength, tangent)
         c = self.control
         if first > c.max_new_cracks and dx * c.cut >= c.dx_min:
             return None
@@ -714,11 +722,11 @@ class Simulation:
             if passes > c.max_relax_passes:
                 raise StepFailed("relaxation", "relaxation", f"cracks still grow after {c.max_relax_passes} passes at fixed load")
             prob = new_prob
-            keys = self._equilibrium(prob, "relaxation", warm=keys)
+            keys, tangent = self._equilibrium(prob, "relaxation", warm=keys, lineage=inherited)
             if (self.scene.stop_when_unloaded and prob.fragments()[0] > 1
                     and self._cut_through(mesh_to_arrays(prob.mesh), prob.mesh, prob.assemble_constraints())):
                 break     # the run ends with this step: no crack in the separated pieces
-            new_prob, n, strength = self._crack_pass(prob, strength)
+            new_prob, n, strength, inherited = self._crack_pass(prob, strength, tangent)
             total += n
         return prob, first, total, strength, keys
 

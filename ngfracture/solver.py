@@ -21,6 +21,7 @@ import scipy.sparse as sp
 from . import rigid
 from .constraints import ConstraintRows
 from .kkt import ConstrainedSolver, EliminatedFactor, SingularSystem, single_threaded_blas
+from .split_factor import BorderedFactor
 
 METHODS = ("modified", "full")
 #: linear solvers of the Newton step (kkt.ConstrainedSolver)
@@ -145,13 +146,6 @@ class SolveStatus:
         return self
 
 
-def _copy(K):
-    """A copy of an NGSolve sparse matrix (same sparsity)."""
-    copy = K.CreateMatrix()
-    copy.AsVector().data = K.AsVector()
-    return copy
-
-
 class SavedTangent:
     """A factorised tangent kept for further solves at the same load (contact rounds).
 
@@ -164,18 +158,62 @@ class SavedTangent:
     tangents, which are solved once). Its rigid modes and pins stay those of the
     configuration the tangent was assembled at (kkt.py corrects them for K R != 0).
 
+    A SavedTangent made with a ``lineage`` (the problem's mesh was split from a solved one,
+    split_factor.py) starts with the factorisation of the mesh before the split, bordered
+    by the split's dofs, where the fixed dofs and pins carry over.
+
+    Parameters
+    ----------
+    lineage : split_factor.Lineage, optional
+
     Attributes
     ----------
     fixed_dofs : numpy.ndarray or None
     support : rigid.Support or None
-    factor : kkt.EliminatedFactor or None
+    factor : kkt.EliminatedFactor, split_factor.BorderedFactor or None
+    state : numpy.ndarray or None
+        The displacement the EliminatedFactor's tangent was assembled at.
     residual : (numpy.ndarray, float, numpy.ndarray) or None
         (u, load factor, out-of-balance there) at the end of the last solve: the next solve
         at the same state starts from it without assembling it again.
+    lineage : split_factor.Lineage or None
     """
 
-    def __init__(self):
-        self.fixed_dofs = self.support = self.factor = self.residual = None
+    def __init__(self, lineage=None):
+        self.fixed_dofs = self.support = self.factor = self.state = self.residual = None
+        self.lineage = lineage
+
+    def carry_over(self, problem, fixed_dofs, support):
+        """Take the bordered factorisation of the lineage for this solve, if it applies.
+
+        The support's pins are replaced by the base's where these resolve the same modes
+        about as well (the pivoted QR of rigid.analyse_support chooses among equally good
+        dofs by rounding: a translation's pin wanders from split to split).
+
+        Parameters
+        ----------
+        problem : ElasticProblem
+        fixed_dofs : numpy.ndarray of int
+        support : rigid.Support
+            Of the solve on ``problem``.
+
+        Returns
+        -------
+        bool
+            True if a factorisation and the support to solve with are now saved for
+            these fixed dofs.
+        """
+        if self.factor is not None or self.lineage is None:
+            return False
+        support = _base_pins(support, self.lineage.base, problem.fes.ndof)
+        try:
+            factor = BorderedFactor.build(self.lineage, problem, fixed_dofs, support.pins)
+        except SingularSystem:
+            factor = None       # a fresh factorisation decides (and reports) instead
+        if factor is None:
+            return False
+        self.fixed_dofs, self.support, self.factor = fixed_dofs, support, factor
+        return True
 
     def holds(self, fixed_dofs):
         """True if a tangent is saved and it was factorised for exactly these fixed dofs.
@@ -191,6 +229,18 @@ class SavedTangent:
             False for an empty SavedTangent.
         """
         return self.fixed_dofs is not None and np.array_equal(self.fixed_dofs, fixed_dofs)
+
+
+def _base_pins(support, base, ndof):
+    """``support`` with the base factorisation's pins (same vertices and components) if they
+    resolve its modes within a factor 10 of its own pins' smallest singular value."""
+    nvb, nv = base.ndof // 2, ndof // 2
+    pins = base.pins // nvb * nv + base.pins % nvb
+    if len(pins) != len(support.pins) or np.array_equal(pins, support.pins) or not len(pins):
+        return support
+    own = np.linalg.svd(support.modes[support.pins].toarray(), compute_uv=False)
+    other = np.linalg.svd(support.modes[pins].toarray(), compute_uv=False)
+    return rigid.Support(support.modes, pins, support.unheld) if other.min() >= 0.1 * own.min() else support
 
 
 class _Timer:
@@ -307,6 +357,8 @@ class NewtonSolver:
             rows = prob.assemble_constraints()
             reuse = reusable and saved.holds(rows.fixed_dofs)
             support = saved.support if reuse else prob.support(rows)
+            if reusable and not reuse and saved.carry_over(prob, rows.fixed_dofs, support):
+                reuse, support = True, saved.support
             # rows that hold the free modes leave none floating: checked only without them
             floating = "" if self.fix_free_modes else prob.floating_bodies(rows, support)
             if self.fix_free_modes:
@@ -326,7 +378,7 @@ class NewtonSolver:
             factor = self._load_step(rows, support, target_fixed, target_rows, status,
                                      saved.factor if reuse else None)
             if reusable and not reuse and factor is not None:
-                saved.fixed_dofs, saved.support, saved.factor = rows.fixed_dofs, support, factor
+                saved.fixed_dofs, saved.support, saved.factor, saved.state = rows.fixed_dofs, support, factor, start
             if not status.converged:
                 u[:] = start  # the last converged state, never a failed iterate
                 prob.load_factor.Set(start_load + (step - 1) / load_steps * (1.0 - start_load))
@@ -430,8 +482,6 @@ class NewtonSolver:
                     if given is None:
                         with _Timer(timings, "assemble"):
                             K = prob.tangent()
-                            if self.tangent is not None and prob.nonlinear and self.method == "modified":
-                                K = _copy(K)   # the saved factor keeps K; the next assembly overwrites it
                         # not inside prob.threads(): the factorisation runs on one thread (kkt.py)
                         with _Timer(timings, "factorize"):
                             factor = EliminatedFactor(K, rows.fixed_dofs, support.pins, self.linear_solver,

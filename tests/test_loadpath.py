@@ -98,9 +98,9 @@ def test_plate_run_ends_as_broken_when_the_crack_separates_the_pulled_sides(monk
         joined.append(_joins_left_and_right(new.arrays))
         return new, prob, mesh, stats
 
-    def pass_spy(self, prob, strength=None):
+    def pass_spy(self, prob, strength=None, tangent=None):
         pass_on_separated.append(not _joins_left_and_right(mesh_to_arrays(prob.mesh)))
-        return crack_pass(self, prob, strength)
+        return crack_pass(self, prob, strength, tangent)
 
     monkeypatch.setattr(Simulation, "_accept", spy)
     monkeypatch.setattr(Simulation, "_crack_pass", pass_spy)

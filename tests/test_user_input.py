@@ -153,8 +153,8 @@ def test_solver_notes_reach_history_and_summary(monkeypatch, tmp_path):
     import ngfracture.simulation as simulation
 
     class Noting(ContactSolver):
-        def solve(self, warm=()):
-            result = super().solve(warm)
+        def solve(self, warm=(), lineage=None):
+            result = super().solve(warm, lineage)
             result.notes.append("a note")
             return result
     monkeypatch.setattr(simulation, "ContactSolver", Noting)

@@ -1,0 +1,374 @@
+"""K^+ of a split mesh from the factorisation of the mesh it was split from.
+
+A crack pass splits a vertex and the equilibrium at the same load is solved again on the
+new mesh: its tangent differs from the one factorised before the pass only by the border
+of the split. Let the split mesh's displacement be written as
+
+    u = E x + J d,
+
+x on the dofs of the mesh the chain of splits started from (the base: E copies every
+vertex's parent, so a new vertex moves with the vertex it was split from) and d the jump
+of every new vertex against its parent (J puts it on the new vertex). With the new mesh's
+tangent K~ taken at the base state carried over (every triangle keeps its vertices'
+displacements, so its element matrix is the base's), the system in (x, d) is
+
+    [ A    B ] [x]   [E^T b]        A = E^T K~ E = the base tangent (factorised),
+    [ B^T  D ] [d] = [J^T b],       B = E^T K~ J, D = J^T K~ J,
+
+and eliminating d needs only Z = A^-1 B (two solves per new vertex, kept from one pass
+to the next) and the small dense S_d = D - B^T Z: one base solve per solve. General
+rows C become C E and C J, and C K~^+ C^T = (C E) A^-1 (C E)^T + W S_d^-1 W^T with
+W = (C E) Z - C J: the base's sparse Schur complement plus a rank-m term.
+
+Modified Newton iterates with K~ (the tangent of the base state) as it iterates with the
+tangent of the start of its load step; the residual is the new mesh's own. A border
+larger than :func:`border_capacity` dofs, fixed dofs or pins that do not carry over (a new
+fragment, a split on a constrained boundary with a free parent) take a fresh
+factorisation instead (:func:`BorderedFactor.build` returns None).
+"""
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+
+from .kkt import EliminatedFactor, FactorBase, SingularSystem
+
+#: free dofs of the vertices created since the base factorisation beyond which a split mesh
+#: is factorised afresh: every solve costs n x m more for Z d (see docs/performance.md) ...
+MAX_BORDER = 240
+
+#: ... and Z (n x m) is kept below this many entries (64 MB): 240 columns up to 35k base dofs
+MAX_BORDER_ENTRIES = 8_000_000
+
+
+def border_capacity(n_base):
+    """The largest border kept for a base of ``n_base`` factorised dofs.
+
+    Parameters
+    ----------
+    n_base : int
+
+    Returns
+    -------
+    int
+        ``MAX_BORDER``, or fewer where Z would exceed ``MAX_BORDER_ENTRIES`` (at least 16).
+    """
+    return max(16, min(MAX_BORDER, MAX_BORDER_ENTRIES // max(n_base, 1)))
+
+
+@dataclass
+class Lineage:
+    """What a mesh split from a factorised one inherits.
+
+    Parameters
+    ----------
+    base, state, parent, columns
+        The attributes below.
+
+    Attributes
+    ----------
+    base : kkt.EliminatedFactor
+        The factorisation of the mesh the chain of splits started from.
+    state : numpy.ndarray
+        The base mesh's displacement at which that tangent was assembled.
+    parent : numpy.ndarray of int
+        For every vertex of the split mesh, the base vertex it copies (itself for base vertices).
+    columns : BorderColumns or None
+        Z of the mesh before.
+    """
+    base: EliminatedFactor
+    state: np.ndarray
+    parent: np.ndarray
+    columns: object = None
+
+
+@dataclass
+class BorderColumns:
+    """Z = A^-1 B of a chain of splits, one column per border dof in the order they came.
+
+    New vertices have higher numbers, and a border is ordered by (vertex, component): the
+    border of the next mesh starts with this one's wherever its columns of B are unchanged,
+    and its new columns are appended to the same buffer (a factor of an earlier mesh reads
+    only its own first columns).
+
+    Parameters
+    ----------
+    keys, column_keys, buffer
+        The attributes below.
+
+    Attributes
+    ----------
+    keys : list of (int, int)
+        (vertex, component) of every column.
+    column_keys : list of bytes
+        The column of B it was solved for (indices and values).
+    buffer : numpy.ndarray, shape (n, capacity)
+        Columns 0 .. len(keys) - 1 are Z.
+    """
+    keys: list
+    column_keys: list
+    buffer: np.ndarray = field(repr=False)
+
+
+def lineage(factor, state, parent):
+    """What the mesh split from one solved with ``factor`` inherits (None: nothing to carry).
+
+    Parameters
+    ----------
+    factor : kkt.EliminatedFactor, BorderedFactor or None
+        The factorisation the last solve on the mesh before the split used.
+    state : numpy.ndarray or None
+        For an EliminatedFactor, the displacement its tangent was assembled at.
+    parent : numpy.ndarray of int
+        ``crack.SplitResult.parent``: for every vertex of the split mesh, the vertex it copies.
+
+    Returns
+    -------
+    Lineage or None
+    """
+    if isinstance(factor, BorderedFactor):
+        return Lineage(factor.base, factor.base_state, factor.parent[parent], factor.z_columns)
+    if isinstance(factor, EliminatedFactor) and factor.linear_solver == "direct" and state is not None:
+        return Lineage(factor, np.asarray(state), np.asarray(parent, dtype=np.int64))
+    return None
+
+
+def _sparse_times_rows(A, Z):
+    """A @ Z for a CSR matrix A without empty rows and a dense Z in any memory order: the
+    rows of Z that A reads, weighted and summed (scipy's product copies all of Z first)."""
+    if A.shape[0] == 0:
+        return np.zeros((0, Z.shape[1]))
+    if np.any(np.diff(A.indptr) == 0):
+        return A @ np.ascontiguousarray(Z)
+    return np.add.reduceat(Z[A.indices] * A.data[:, None], A.indptr[:-1], axis=0)
+
+
+def _lifted(state, parent):
+    """The base state on the split mesh: every vertex takes its parent's displacement."""
+    return state.reshape(2, -1)[:, parent].reshape(-1)
+
+
+class BorderedFactor(FactorBase):
+    """K~^+ of a split mesh through the factorisation of its base (see the module docstring).
+
+    Made by :meth:`build`. The interface of kkt.EliminatedFactor that ConstrainedSolver
+    uses: ``solve``, ``columns``, ``schur`` (when the base has the sparse Schur path),
+    ``corrected_modes``, ``matches``.
+
+    Parameters
+    ----------
+    lineage : Lineage
+    K : scipy.sparse.csr_matrix
+        The split mesh's tangent at the base state carried over (K~).
+    fixed_dofs, pins : numpy.ndarray of int
+        Of the solve on the split mesh.
+    free, factor_free : numpy.ndarray of bool
+        Dofs not fixed; neither fixed nor pinned.
+    base_dof : numpy.ndarray of int
+        For every dof of the split mesh, the base dof it copies.
+
+    Raises
+    ------
+    SingularSystem
+        If the border's Schur complement S_d is singular.
+    """
+
+    linear_solver = "direct"
+    factorised = True
+
+    @classmethod
+    def build(cls, lineage, problem, fixed_dofs, pins):
+        """The bordered factor of ``problem``'s mesh, or None where it does not apply.
+
+        Parameters
+        ----------
+        lineage : Lineage
+        problem : ElasticProblem
+            On the split mesh (its vertices: those of the base, then the new ones).
+        fixed_dofs, pins : numpy.ndarray of int
+            Of the solve on the split mesh.
+
+        Returns
+        -------
+        BorderedFactor or None
+            None if the fixed dofs or pins do not carry over from the base, or the border
+            exceeds :func:`border_capacity` dofs.
+        """
+        base = lineage.base
+        nv, nvb = problem.fes.ndof // 2, base.ndof // 2
+        parent = lineage.parent
+        if len(parent) != nv or nv < nvb or not np.array_equal(parent[:nvb], np.arange(nvb)):
+            return None
+        fixed_dofs = np.asarray(fixed_dofs, dtype=np.int64)
+        pins = np.asarray(pins, dtype=np.int64)
+        free = np.ones(2 * nv, dtype=bool)
+        free[fixed_dofs] = False
+        factor_free = free.copy()
+        factor_free[pins] = False
+        # base vertices keep their constraints and pins; a new vertex is free only where its parent is
+        old = np.concatenate([np.arange(nvb), nv + np.arange(nvb)])
+        if (not np.array_equal(free[old], base.free) or not np.array_equal(factor_free[old], base.factor_free)):
+            return None
+        base_dof = np.repeat([0, 1], nv) * nvb + np.tile(parent, 2)
+        new_vertex = np.tile(np.arange(nv) >= nvb, 2)
+        if (np.any(factor_free & ~base.factor_free[base_dof]) or np.any(~free & base.free[base_dof])
+                or np.any(free & ~factor_free & new_vertex)):
+            return None
+        n_base = np.count_nonzero(base.factor_free)
+        if np.count_nonzero(factor_free) - n_base > border_capacity(n_base):
+            return None
+        K = problem.tangent(_lifted(lineage.state, parent))
+        return cls(lineage, K, fixed_dofs, pins, free, factor_free, base_dof)
+
+    def __init__(self, lineage, K, fixed_dofs, pins, free, factor_free, base_dof):
+        t0 = time.perf_counter()
+        base = self.base = lineage.base
+        self.base_state, self.parent = lineage.state, lineage.parent
+        self.K, self.ndof = K, K.shape[0]
+        self.fixed_dofs, self.pins, self.free, self.factor_free = fixed_dofs, pins, free, factor_free
+        self.inverse = base.inverse
+        self._columns = {}
+        self._checked = False
+        nv, nvb = self.ndof // 2, base.ndof // 2
+        n_base = np.count_nonzero(base.factor_free)
+        position = -np.ones(base.ndof, dtype=np.int64)
+        position[base.factor_free] = np.arange(n_base)
+        self._dofs = np.flatnonzero(factor_free)                 # F: the factorised dofs
+        self._x = position[base_dof[self._dofs]]                 # the base position each copies
+        # positions in F of the new vertices' dofs, ordered by (vertex, component)
+        border = np.flatnonzero(self._dofs % nv >= nvb)
+        vertex, component = self._dofs[border] % nv, self._dofs[border] // nv
+        self._border = border[np.lexsort((component, vertex))]
+        self._Et = sp.csr_matrix((np.ones(len(self._dofs)), (self._x, np.arange(len(self._dofs)))),
+                                 shape=(n_base, len(self._dofs)))                     # E^T
+        # K~ restricted to the factorised dofs, rows of the border: B^T = J^T K~ E and D
+        border_rows = K[self._dofs[self._border]][:, self._dofs]
+        self._Bt = (border_rows @ self._Et.T).tocsr()
+        D = border_rows[:, self._border].toarray()
+        keys = list(zip(self._dofs[self._border] % nv, self._dofs[self._border] // nv))
+        self.z_columns = self._border_columns(lineage.columns, keys, n_base)
+        m = len(keys)
+        self._Z = self.z_columns.buffer[:, :m]
+        if m:
+            Sd = D - _sparse_times_rows(self._Bt, self._Z)
+            self._Sd = sla.lu_factor(0.5 * (Sd + Sd.T))
+            pivots = np.abs(np.diag(self._Sd[0]))
+            if not np.all(np.isfinite(pivots)) or pivots.min() <= 1e-13 * pivots.max():
+                raise SingularSystem(f"the border of {m} split dofs is singular (pivot ratio "
+                                     f"{pivots.min() / max(pivots.max(), 1e-300):.1e}): a floating piece?")
+        self.seconds = time.perf_counter() - t0
+
+    def _border_columns(self, carried, keys, n_base):
+        """Z = A^-1 B for this border: the columns of the mesh before where the border starts
+        with its dofs and their columns of B are unchanged (vertex numbers carry over), the
+        others solved (one block solve)."""
+        Bt = self._Bt
+        column_keys = [Bt.indices[s:e].tobytes() + Bt.data[s:e].tobytes() for s, e in zip(Bt.indptr[:-1], Bt.indptr[1:])]
+        kept = 0
+        if carried is not None:
+            limit = min(len(carried.keys), len(keys))
+            while (kept < limit and carried.keys[kept] == keys[kept]
+                   and carried.column_keys[kept] == column_keys[kept]):
+                kept += 1
+        if carried is not None and kept == len(carried.keys) and carried.buffer.shape[1] >= len(keys):
+            buffer = carried.buffer        # append to the chain's buffer
+        else:
+            buffer = np.zeros((n_base, max(border_capacity(n_base), len(keys))), order="F")   # Z = its first columns, contiguous
+            if kept:
+                buffer[:, :kept] = carried.buffer[:, :kept]
+        if len(keys) > kept:
+            buffer[:, kept:len(keys)] = self.base.solve_factorised(Bt[kept:].T.toarray())
+        return BorderColumns(keys, column_keys, buffer)
+
+    @property
+    def sparse_schur(self):
+        """True if the base takes the sparse Schur complement (then so does this factor)."""
+        return self.base.sparse_schur
+
+    def factorise(self):
+        """Nothing to do: the base is factorised."""
+
+    def solve(self, B):
+        """X = K~^+ B for a full-length right-hand side (ndof,) or a block (ndof, k).
+
+        Entries of B at fixed dofs and pins are ignored; X is zero there. The first solve
+        with a nonzero right-hand side must solve its own system (relative residual below
+        1e-6), as kkt.EliminatedFactor's does.
+
+        Parameters
+        ----------
+        B : numpy.ndarray, shape (ndof,) or (ndof, k)
+
+        Returns
+        -------
+        numpy.ndarray
+            Same shape as B.
+
+        Raises
+        ------
+        SingularSystem
+            If the solution has NaN/inf or the first solve does not solve its system.
+        """
+        t0 = time.perf_counter()
+        single = B.ndim == 1
+        B = B[:, None] if single else B
+        X = np.zeros(B.shape)
+        if B.shape[1]:
+            bF = B[self._dofs]
+            x = self.base.solve_factorised(self._Et @ bF)
+            XF = x[self._x]
+            if len(self._border):
+                d = sla.lu_solve(self._Sd, bF[self._border] - self._Bt @ x)
+                XF -= (self._Z @ d)[self._x]
+                XF[self._border] += d
+            X[self._dofs] = XF
+            if not np.all(np.isfinite(X)):
+                raise SingularSystem("the bordered factorisation produced NaN/inf")
+            if not self._checked:
+                self._check(B, X)
+        self.seconds += time.perf_counter() - t0
+        return X[:, 0] if single else X
+
+    def _check(self, B, X):
+        j = int(np.argmax(np.abs(B[self._dofs]).sum(axis=0)))
+        b = B[self._dofs, j]
+        if not np.any(b):
+            return
+        rel = np.linalg.norm((self.K @ X[:, j])[self._dofs] - b) / np.linalg.norm(b)
+        if not rel < 1e-6:
+            raise SingularSystem(f"the bordered factorisation does not solve its system (relative residual {rel:.1e})")
+        self._checked = True
+
+    def schur(self, C):
+        """S = C K~^+ C^T (m, m): the base's sparse Schur complement of C E plus W S_d^-1 W^T.
+
+        Parameters
+        ----------
+        C : scipy.sparse matrix, shape (m, ndof)
+            Constraint rows of the split mesh.
+
+        Returns
+        -------
+        numpy.ndarray, shape (m, m)
+
+        Raises
+        ------
+        ValueError
+            If the base has no sparse Schur path (:attr:`sparse_schur` is False).
+        SingularSystem
+            From the base's sparse triangular solves.
+        """
+        t0 = time.perf_counter()
+        base = self.base
+        CF = sp.csr_matrix(C)[:, self._dofs]
+        Cx = (CF @ self._Et.T).tocsr()
+        base_dofs = np.flatnonzero(base.factor_free)
+        Cx_base = sp.csr_matrix((Cx.data, base_dofs[Cx.indices], Cx.indptr), shape=(Cx.shape[0], base.ndof))
+        S = base.schur(Cx_base)
+        if len(self._border):
+            W = _sparse_times_rows(Cx, self._Z) - CF[:, self._border].toarray()
+            S = S + W @ sla.lu_solve(self._Sd, W.T)
+        self.seconds += time.perf_counter() - t0
+        return S

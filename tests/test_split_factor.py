@@ -1,0 +1,182 @@
+"""The factorisation carried across vertex splits (split_factor.BorderedFactor).
+
+After a crack pass the KKT system of the split mesh is solved through the factorisation of
+the mesh before the pass, bordered by the new vertices' dofs. With the split mesh's
+tangent K~ taken at the base state carried over, the bordered solve is a direct solve of
+that system: it must equal a sparse LU of the whole KKT system
+
+    [ K~  B^T ] [du ]   [r]
+    [ B   0   ] [lam] = [h]      B = [unit rows of the fixed dofs; C]
+
+to 1e-10 on a cracked configuration in contact (rows across the crack faces), solve its
+systems to rounding along a whole simulation (pins, rows holding a free mode, chains of
+splits whose columns Z are carried over), and a run through it must end with the same
+cracks as a run that factorises every split mesh afresh.
+"""
+import numpy as np
+import pytest
+
+import ngfracture as nf
+from ngfracture import kkt as kkt_module
+from ngfracture import scenes, split_factor
+from ngfracture.contact_solver import ContactSolver
+from ngfracture.crack import split_by_tensor
+from ngfracture.kkt import ConstrainedSolver, EliminatedFactor
+from ngfracture.simulation import Simulation
+from ngfracture.solver import _base_pins
+
+from test_contact_fractured import crack_bands, plate_mesh
+from test_kkt_paths import whole_kkt_solution
+
+H = 0.1
+
+
+def pressed(mesh):
+    """Pressed from all sides: the crack faces touch (contact rows), no free rigid mode."""
+    prob = nf.ElasticProblem(mesh, nf.StVenantKirchhoff(1.0, 0.3, plane="stress"))
+    prob.add_dirichlet("left", 0.0, component="x")
+    prob.add_dirichlet("right", -1e-3, component="x")
+    prob.add_dirichlet("bottom", 0.0, component="y")
+    prob.add_dirichlet("top", -1e-3, component="y")
+    return prob
+
+
+def branch(mesh, x=0.5, top=0.8):
+    """A vertical crack branch from the horizontal crack's upper face up to y = top."""
+    pts = mesh.ngmesh.Coordinates()[:, :2]
+    t = np.zeros((mesh.nv, 3))
+    near = (np.abs(pts[:, 0] - x) < 0.45 * H) & (pts[:, 1] > 0.5 - 1e-9) & (pts[:, 1] < top)
+    t[near, 0] = 2.0 - np.abs(pts[near, 0] - x) / (0.45 * H)
+    return split_by_tensor(mesh, t, 1.0)
+
+
+@pytest.fixture(scope="module")
+def split_in_contact():
+    """A horizontal crack pressed shut (the base, factorised at its contact state), then a
+    crack branch split from its upper face (no new piece): the split mesh, with its contact
+    rows, and the lineage."""
+    base_mesh = crack_bands(plate_mesh(H), [(1, 0.5)], 0.6 * H).mesh
+    base = pressed(base_mesh)
+    assert ContactSolver(base, tol=0.1 * H).solve().converged
+    rows0 = base.assemble_constraints()
+    support0 = base.support(rows0)
+    factor = EliminatedFactor(base.tangent(), rows0.fixed_dofs, support0.pins)
+    factor.solve(np.ones(base.fes.ndof))          # factorised and checked, as after a solve
+    state = base.u.vec.FV().NumPy().copy()
+    res = branch(base_mesh)
+    assert res.nsplit == 5 and res.nfragments == 1
+    prob = pressed(res.mesh)
+    prob.u.vec.FV().NumPy()[:] = state.reshape(2, -1)[:, res.parent].reshape(-1)
+    result = ContactSolver(prob, tol=0.1 * H).solve()
+    assert result.converged and len(result.multipliers) > 0 and np.any(result.multipliers < 0)
+    return prob, split_factor.lineage(factor, state, res.parent)
+
+
+@pytest.mark.parametrize("sparse_schur", [False, True])
+def test_bordered_solve_equals_whole_kkt_solve_in_contact(split_in_contact, sparse_schur, monkeypatch):
+    """Both Schur paths: the kept columns, and the sparse Schur complement of the base plus
+    the border's rank-m term (forced on this small mesh)."""
+    monkeypatch.setattr(kkt_module, "SPARSE_SCHUR_MIN_DOFS", 0 if sparse_schur else 10 ** 9)
+    monkeypatch.setattr(kkt_module, "SPARSE_SCHUR_MIN_ROWS", 0)
+    prob, lineage = split_in_contact
+    rows = prob.assemble_constraints()
+    support = _base_pins(prob.support(rows), lineage.base, prob.fes.ndof)
+    factor = split_factor.BorderedFactor.build(lineage, prob, rows.fixed_dofs, support.pins)
+    assert factor is not None and len(factor._border) > 0
+    assert rows.C.shape[0] > 0
+    kkt = ConstrainedSolver(None, rows.fixed_dofs, rows.C, modes=support.modes, pins=support.pins,
+                            factor=factor, path="schur")
+    assert (kkt._Z is None) == sparse_schur
+    ndof = prob.fes.ndof
+    free = np.ones(ndof, dtype=bool)
+    free[rows.fixed_dofs] = False
+    rng = np.random.default_rng(3)
+    r = np.where(free, rng.standard_normal(ndof), 0.0)
+    du_fixed = np.zeros(ndof)
+    du_fixed[rows.fixed_dofs] = 1e-3 * rng.standard_normal(rows.fixed_dofs.size)
+    h = 1e-3 * rng.standard_normal(rows.C.shape[0])
+    du, lam = kkt.solve(r, du_fixed, h)
+    du_ref, lam_ref = whole_kkt_solution(factor.K, rows, r, du_fixed, h)
+    assert np.linalg.norm(du - du_ref) <= 1e-10 * np.linalg.norm(du_ref)
+    assert np.linalg.norm(lam - lam_ref) <= 1e-10 * np.linalg.norm(lam_ref)
+
+
+def test_tangent_of_the_split_mesh_at_the_carried_state_is_the_base_tangent(split_in_contact):
+    """E^T K~ E equals the base tangent (each triangle keeps its element matrix) to the
+    rounding of the sums."""
+    prob, lineage = split_in_contact
+    rows = prob.assemble_constraints()
+    support = _base_pins(prob.support(rows), lineage.base, prob.fes.ndof)
+    factor = split_factor.BorderedFactor.build(lineage, prob, rows.fixed_dofs, support.pins)
+    base = lineage.base
+    A = base.K[base.factor_free][:, base.factor_free]
+    KF = factor.K[factor._dofs][:, factor._dofs]
+    EtKE = factor._Et @ KF @ factor._Et.T
+    assert abs(EtKE - A).max() <= 1e-14 * abs(A).max()
+
+
+def test_border_beyond_capacity_or_new_fragment_takes_a_fresh_factorisation(split_in_contact, monkeypatch):
+    prob, lineage = split_in_contact
+    rows = prob.assemble_constraints()
+    support = _base_pins(prob.support(rows), lineage.base, prob.fes.ndof)
+    monkeypatch.setattr(split_factor, "border_capacity", lambda n: 2)
+    assert split_factor.BorderedFactor.build(lineage, prob, rows.fixed_dofs, support.pins) is None
+    monkeypatch.undo()
+    other_pins = np.setdiff1d(np.arange(prob.fes.ndof), rows.fixed_dofs)[:1]   # a pin the base does not have
+    assert split_factor.BorderedFactor.build(lineage, prob, rows.fixed_dofs, other_pins) is None
+
+
+def test_every_bordered_solve_of_a_plate_run_solves_its_kkt_system(monkeypatch):
+    """The default plate (critical distance) on a coarser mesh: every tenth constrained
+    solver built on a bordered factor during the run (a pin and the row holding the plate's
+    free mode, later contact rows; columns carried along chains of splits) solves a random
+    system [K~ B^T; B 0] with a backward error of rounding size (1e-12 of |K~| |du| +
+    |B^T| |lam| + |r|, row by row 1e-12 of |B| |du| + |h|). The forward error is no test
+    here: the mode the row holds meets only the geometric stiffness (K R about 1e-5 of K),
+    and random loads along it are ill-conditioned (1e-7 between two exact solvers)."""
+    checked = []
+    original = ConstrainedSolver.__init__
+
+    def checking_init(self, K, fixed_dofs, C, *args, **kwargs):
+        original(self, K, fixed_dofs, C, *args, **kwargs)
+        if not isinstance(self.factor, split_factor.BorderedFactor):
+            return
+        checked.append(len(self.factor._border))
+        if len(checked) % 10 or self.path != "schur" or getattr(self, "_coarse", None) is None:
+            return
+        rng = np.random.default_rng(len(checked))
+        K, ndof, free = self.factor.K, self.ndof, self.free
+        r = np.where(free, rng.standard_normal(ndof), 0.0)
+        du_fixed = np.zeros(ndof)
+        du_fixed[np.asarray(fixed_dofs)] = 1e-6 * rng.standard_normal(len(fixed_dofs))
+        h = 1e-6 * rng.standard_normal(self.m)
+        du, lam = self.solve(r, du_fixed, h)
+        force = (K @ du + self.C.T @ lam - r)[free]
+        force_scale = (abs(K) @ np.abs(du) + abs(self.C.T) @ np.abs(lam) + np.abs(r))[free]
+        assert np.linalg.norm(force) <= 1e-12 * np.linalg.norm(force_scale)
+        assert np.array_equal(du[~free], du_fixed[~free])
+        rows = self.C @ du - h
+        assert np.all(np.abs(rows) <= 1e-12 * (abs(self.C) @ np.abs(du) + np.abs(h)))
+
+    monkeypatch.setattr(ConstrainedSolver, "__init__", checking_init)
+    result = Simulation(scenes.plate(maxh=0.05)).run()
+    assert result.ok and result.summary["reason"] == "broken"
+    assert len(checked) >= 20 and max(checked) >= 20      # chains of splits, not single ones
+
+
+def test_a_run_through_bordered_factors_ends_as_with_fresh_factorisations(monkeypatch):
+    """The default plate on a coarser mesh, once with every split mesh factorised afresh:
+    the same steps, split vertices and fragments, and crack length and final displacement
+    equal to the tolerance of the Newton solves (1e-9 relative)."""
+    runs = {}
+    for carried in (True, False):
+        if not carried:
+            monkeypatch.setattr(split_factor.BorderedFactor, "build", classmethod(lambda cls, *args: None))
+        runs[carried] = Simulation(scenes.plate(maxh=0.05)).run()
+    a, b = runs[True], runs[False]
+    assert a.ok and b.ok and a.summary["reason"] == b.summary["reason"] == "broken"
+    for key in ("n_steps", "n_split_vertices", "n_fragments"):
+        assert a.summary[key] == b.summary[key], key
+    assert [h["split_vertices"] for h in a.summary["history"]] == [h["split_vertices"] for h in b.summary["history"]]
+    assert abs(a.summary["crack_length"] - b.summary["crack_length"]) <= 1e-9 * a.summary["crack_length"]
+    assert np.linalg.norm(a.state.u - b.state.u) <= 1e-9 * np.linalg.norm(a.state.u)
