@@ -23,6 +23,7 @@ from .crack import vertex_displacement
 from .kkt import to_scipy
 from .materials import Material
 from .meshcheck import validate_mesh
+from .meshio import mesh_to_arrays
 from .solver import NewtonSolver
 
 
@@ -128,6 +129,9 @@ class ElasticProblem:
         region of the mesh (every region needs one).
     order : int
         Polynomial order of the VectorH1 displacement space (>= 1).
+    check_mesh : bool
+        False skips meshcheck.validate_mesh, for a mesh the crack engine split from a
+        checked one (the engine keeps a valid mesh valid; the simulation's crack passes).
 
     Attributes
     ----------
@@ -150,8 +154,8 @@ class ElasticProblem:
         If the mesh has slivers (meshcheck.SLIVER_ASPECT).
     """
 
-    def __init__(self, mesh, material, order=1):
-        arrays = validate_mesh(mesh)
+    def __init__(self, mesh, material, order=1, check_mesh=True):
+        arrays = validate_mesh(mesh) if check_mesh else mesh_to_arrays(mesh)
         self.materials = region_materials(mesh, material)
         if isinstance(order, bool) or not isinstance(order, int) or order < 1:
             raise ValueError(f"order must be an integer >= 1, got {order!r}")

@@ -86,16 +86,18 @@ class Lineage:
 
 @dataclass
 class BorderColumns:
-    """Z = A^-1 B of a chain of splits, one column per border dof in the order they came.
+    """Z = A^-1 B of a chain of splits, one column per border dof.
 
-    New vertices have higher numbers, and a border is ordered by (vertex, component): the
-    border of the next mesh starts with this one's wherever its columns of B are unchanged,
-    and its new columns are appended to the same buffer (a factor of an earlier mesh reads
-    only its own first columns).
+    New vertices have higher numbers and a border is ordered by (vertex, component), so the
+    border of the next mesh starts with this one's dofs: its columns are updated in the same
+    buffer, solved again only where their column of B changed (a neighbour split since:
+    B = E^T K~ J sums the new vertex's couplings into its parent in another order), and the
+    new ones appended. A chain has one buffer; only its latest factor may solve
+    (``chain["latest"]`` is that factor's ``generation``; an earlier one refuses).
 
     Parameters
     ----------
-    keys, column_keys, buffer
+    keys, column_keys, buffer, chain, generation
         The attributes below.
 
     Attributes
@@ -104,12 +106,17 @@ class BorderColumns:
         (vertex, component) of every column.
     column_keys : list of bytes
         The column of B it was solved for (indices and values).
-    buffer : numpy.ndarray, shape (n, capacity)
+    buffer : numpy.ndarray, shape (n, capacity), Fortran order
         Columns 0 .. len(keys) - 1 are Z.
+    chain : dict
+        Shared by the chain: {"latest": generation of its latest factor}.
+    generation : int
     """
     keys: list
     column_keys: list
     buffer: np.ndarray = field(repr=False)
+    chain: dict = field(default_factory=lambda: {"latest": 0})
+    generation: int = 0
 
 
 def lineage(factor, state, parent):
@@ -247,7 +254,8 @@ class BorderedFactor(FactorBase):
         border_rows = K[self._dofs[self._border]][:, self._dofs]
         self._Bt = (border_rows @ self._Et.T).tocsr()
         D = border_rows[:, self._border].toarray()
-        keys = list(zip(self._dofs[self._border] % nv, self._dofs[self._border] // nv))
+        border_dofs = self._dofs[self._border]
+        keys = list(zip((border_dofs % nv).tolist(), (border_dofs // nv).tolist()))
         self.z_columns = self._border_columns(lineage.columns, keys, n_base)
         m = len(keys)
         self._Z = self.z_columns.buffer[:, :m]
@@ -261,26 +269,29 @@ class BorderedFactor(FactorBase):
         self.seconds = time.perf_counter() - t0
 
     def _border_columns(self, carried, keys, n_base):
-        """Z = A^-1 B for this border: the columns of the mesh before where the border starts
-        with its dofs and their columns of B are unchanged (vertex numbers carry over), the
-        others solved (one block solve)."""
+        """Z = A^-1 B for this border, from the chain's columns where B's are unchanged (see
+        BorderColumns); the others in one block solve."""
         Bt = self._Bt
         column_keys = [Bt.indices[s:e].tobytes() + Bt.data[s:e].tobytes() for s, e in zip(Bt.indptr[:-1], Bt.indptr[1:])]
-        kept = 0
-        if carried is not None:
-            limit = min(len(carried.keys), len(keys))
-            while (kept < limit and carried.keys[kept] == keys[kept]
-                   and carried.column_keys[kept] == column_keys[kept]):
-                kept += 1
-        if carried is not None and kept == len(carried.keys) and carried.buffer.shape[1] >= len(keys):
-            buffer = carried.buffer        # append to the chain's buffer
+        m = len(keys)
+        old = len(carried.keys) if carried is not None else 0
+        if old and carried.keys == keys[:old] and carried.buffer.shape[1] >= m:
+            columns = BorderColumns(keys, column_keys, carried.buffer, carried.chain, carried.generation + 1)
+            solve = [i for i in range(old) if carried.column_keys[i] != column_keys[i]] + list(range(old, m))
         else:
-            buffer = np.zeros((n_base, max(border_capacity(n_base), len(keys))), order="F")   # Z = its first columns, contiguous
-            if kept:
-                buffer[:, :kept] = carried.buffer[:, :kept]
-        if len(keys) > kept:
-            buffer[:, kept:len(keys)] = self.base.solve_factorised(Bt[kept:].T.toarray())
-        return BorderColumns(keys, column_keys, buffer)
+            buffer = np.zeros((n_base, max(border_capacity(n_base), m)), order="F")   # Z: its first columns
+            columns = BorderColumns(keys, column_keys, buffer)
+            known = dict(zip(zip(carried.keys, carried.column_keys), range(old))) if old else {}
+            solve = []
+            for i, key in enumerate(zip(keys, column_keys)):
+                if key in known:
+                    buffer[:, i] = carried.buffer[:, known[key]]
+                else:
+                    solve.append(i)
+        columns.chain["latest"] = columns.generation
+        if solve:
+            columns.buffer[:, solve] = self.base.solve_factorised(Bt[solve].T.toarray())
+        return columns
 
     @property
     def sparse_schur(self):
@@ -310,8 +321,11 @@ class BorderedFactor(FactorBase):
         ------
         SingularSystem
             If the solution has NaN/inf or the first solve does not solve its system.
+        RuntimeError
+            If a later mesh of the chain has been factorised (the columns are its own now).
         """
         t0 = time.perf_counter()
+        self._check_latest()
         single = B.ndim == 1
         B = B[:, None] if single else B
         X = np.zeros(B.shape)
@@ -330,6 +344,11 @@ class BorderedFactor(FactorBase):
                 self._check(B, X)
         self.seconds += time.perf_counter() - t0
         return X[:, 0] if single else X
+
+    def _check_latest(self):
+        if self.z_columns.chain["latest"] != self.z_columns.generation:
+            raise RuntimeError("a bordered factor of an earlier mesh of a chain of splits: its columns "
+                               "were overwritten by a later mesh's")
 
     def _check(self, B, X):
         j = int(np.argmax(np.abs(B[self._dofs]).sum(axis=0)))
@@ -359,8 +378,11 @@ class BorderedFactor(FactorBase):
             If the base has no sparse Schur path (:attr:`sparse_schur` is False).
         SingularSystem
             From the base's sparse triangular solves.
+        RuntimeError
+            If a later mesh of the chain has been factorised (as :meth:`solve`).
         """
         t0 = time.perf_counter()
+        self._check_latest()
         base = self.base
         CF = sp.csr_matrix(C)[:, self._dofs]
         Cx = (CF @ self._Et.T).tocsr()
