@@ -75,7 +75,7 @@ import scipy.sparse as sp
 from . import contact
 from .collision import detect_collisions
 from .crack import vertex_displacement
-from .meshio import boundary_only, mesh_to_arrays
+from .meshio import boundary_only
 from .seams import KINK_ANGLE, find_seams, seam_constraints
 from .kkt import SingularSystem, single_threaded_blas
 from .qp import QPError
@@ -287,7 +287,7 @@ class ContactSolver:
         None of it changes while the problem is solved on one mesh: computed once per solve.
         """
         prob = self.problem
-        arrays = boundary_only(mesh_to_arrays(prob.mesh))   # no bonded-interface segments
+        arrays = boundary_only(prob.arrays)   # no bonded-interface segments
         _, comp = prob.fragments()
         fragment = comp[arrays.triangles[:, 0]]
         nv, n = prob.mesh.nv, prob.fes.ndof // 2
@@ -749,7 +749,7 @@ def fragment_overlap_area(problem):
     float
         Area, in the square of the mesh's length unit.
     """
-    arrays = boundary_only(mesh_to_arrays(problem.mesh))
+    arrays = boundary_only(problem.arrays)
     U = vertex_displacement(problem.u)
     _, comp = problem.fragments()
     fragment = comp[arrays.triangles[:, 0]]

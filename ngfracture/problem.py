@@ -141,6 +141,9 @@ class ElasticProblem:
     constraints : ConstraintSet
     load_factor : ngsolve.Parameter
         Scales body forces and tractions (0 before the first solve, 1 after).
+    arrays : meshio.MeshArrays
+        The mesh's arrays (points, triangles, segments, regions), made once: read them,
+        do not change them.
 
     Raises
     ------
@@ -171,6 +174,7 @@ class ElasticProblem:
         self.load_factor = ng.Parameter(0.0)
         self._loads = []      # (kind, CF, region)
         self._form = None
+        self.arrays = arrays
         self._elements = arrays.triangles
         self._points = arrays.points
         self._regions = arrays.regions, arrays.region_names
@@ -431,7 +435,8 @@ class ElasticProblem:
             Modes at the current configuration.
         """
         x = self._points + vertex_displacement(self.u)
-        return rigid.analyse_support(x, self._elements, self.fes.ndof // 2, self.fes.ndof, rows.fixed_dofs)
+        return rigid.analyse_support(x, self._elements, self.fes.ndof // 2, self.fes.ndof, rows.fixed_dofs,
+                                     self.fragments())
 
     def floating_bodies(self, rows, support=None):
         """A message naming the pieces whose rigid-body modes no constraint fixes ('' if none).

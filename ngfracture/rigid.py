@@ -123,7 +123,7 @@ class Support:
     unheld: list
 
 
-def analyse_support(x, elements, n, ndof, fixed_dofs):
+def analyse_support(x, elements, n, ndof, fixed_dofs, components=None):
     """Find the rigid modes left free by the single-dof rows, piece by piece.
 
     Parameters
@@ -138,6 +138,8 @@ def analyse_support(x, elements, n, ndof, fixed_dofs):
         Number of dofs of the space.
     fixed_dofs : numpy.ndarray
         Dofs fixed by single-dof rows.
+    components : (int, numpy.ndarray), optional
+        :func:`pieces` of the mesh, if the caller has them.
 
     Returns
     -------
@@ -145,7 +147,7 @@ def analyse_support(x, elements, n, ndof, fixed_dofs):
         The free modes of all pieces, their pins and the pieces they belong to.
     """
     nv = x.shape[0]
-    ncomp, comp = pieces(elements, nv)
+    ncomp, comp = components if components is not None else pieces(elements, nv)
     fixed = np.zeros(ndof, dtype=bool)
     fixed[fixed_dofs] = True
     order = np.argsort(comp, kind="stable")

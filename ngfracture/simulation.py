@@ -653,7 +653,7 @@ class Simulation:
         """
         t0 = time.perf_counter()
         mesh = prob.mesh
-        arrays = mesh_to_arrays(mesh)
+        arrays = prob.arrays
         names = arrays.region_names
         inv = np.array([0.0] + [1.0 / self.critical[n] if self.critical.get(n) is not None else 0.0
                                 for n in names])
@@ -725,7 +725,7 @@ class Simulation:
             prob = new_prob
             keys, tangent = self._equilibrium(prob, "relaxation", warm=keys, lineage=inherited)
             if (self.scene.stop_when_unloaded and prob.fragments()[0] > 1
-                    and self._cut_through(mesh_to_arrays(prob.mesh), prob.mesh, prob.assemble_constraints())):
+                    and self._cut_through(prob.arrays, prob.mesh, prob.assemble_constraints())):
                 break     # the run ends with this step: no crack in the separated pieces
             new_prob, n, strength, inherited = self._crack_pass(prob, strength, tangent)
             total += n
