@@ -24,7 +24,8 @@ Modified Newton iterates with K~ (the tangent of the base state) as it iterates 
 tangent of the start of its load step; the residual is the new mesh's own. A border
 larger than :func:`border_capacity` dofs, fixed dofs or pins that do not carry over (a new
 fragment, a split on a constrained boundary with a free parent) take a fresh
-factorisation instead (:func:`BorderedFactor.build` returns None).
+factorisation instead (:func:`BorderedFactor.build` returns None), as does a small mesh
+(``MIN_BASE_DOFS``), where a factorisation is cheaper than the bookkeeping.
 """
 import time
 from dataclasses import dataclass, field
@@ -34,6 +35,12 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 
 from .kkt import EliminatedFactor, FactorBase, SingularSystem
+
+#: below this many factorised dofs a split mesh is factorised afresh: a factorisation costs
+#: less than the bordered solves' bookkeeping (measured: the default plate, 2.9k dofs, 3.2 s
+#: fresh against 3.5 s bordered; the paper's disintegrating disk, 1.1k dofs, 47 against 53 s;
+#: the 4x plate, 8.4k dofs, 9.9 against 7.2 s)
+MIN_BASE_DOFS = 5000
 
 #: free dofs of the vertices created since the base factorisation beyond which a split mesh
 #: is factorised afresh: every solve costs n x m more for Z d (see docs/performance.md) ...
@@ -143,8 +150,9 @@ def lineage(factor, state, parent):
 
 
 def _sparse_times_rows(A, Z):
-    """A @ Z for a CSR matrix A without empty rows and a dense Z in any memory order: the
-    rows of Z that A reads, weighted and summed (scipy's product copies all of Z first)."""
+    """A @ Z for a CSR matrix A and a dense Z in any memory order: the rows of Z that A
+    reads, weighted and summed (scipy's product copies all of Z first); a matrix with an
+    empty row takes scipy's product."""
     if A.shape[0] == 0:
         return np.zeros((0, Z.shape[1]))
     if np.any(np.diff(A.indptr) == 0):
@@ -200,10 +208,13 @@ class BorderedFactor(FactorBase):
         Returns
         -------
         BorderedFactor or None
-            None if the fixed dofs or pins do not carry over from the base, or the border
-            exceeds :func:`border_capacity` dofs.
+            None if the base has fewer than ``MIN_BASE_DOFS`` factorised dofs, the fixed
+            dofs or pins do not carry over from the base, or the border exceeds
+            :func:`border_capacity` dofs.
         """
         base = lineage.base
+        if np.count_nonzero(base.factor_free) < MIN_BASE_DOFS:
+            return None
         nv, nvb = problem.fes.ndof // 2, base.ndof // 2
         parent = lineage.parent
         if len(parent) != nv or nv < nvb or not np.array_equal(parent[:nvb], np.arange(nvb)):

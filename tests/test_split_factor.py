@@ -31,6 +31,13 @@ from test_kkt_paths import whole_kkt_solution
 H = 0.1
 
 
+@pytest.fixture(autouse=True)
+def small_meshes_carry_their_factorisation(monkeypatch):
+    """The meshes here are small: below split_factor.MIN_BASE_DOFS a split mesh is
+    factorised afresh, so the threshold is lowered to test the bordered path on them."""
+    monkeypatch.setattr(split_factor, "MIN_BASE_DOFS", 0)
+
+
 def pressed(mesh):
     """Pressed from all sides: the crack faces touch (contact rows), no free rigid mode."""
     prob = nf.ElasticProblem(mesh, nf.StVenantKirchhoff(1.0, 0.3, plane="stress"))
@@ -115,13 +122,18 @@ def test_tangent_of_the_split_mesh_at_the_carried_state_is_the_base_tangent(spli
     assert abs(EtKE - A).max() <= 1e-14 * abs(A).max()
 
 
-def test_border_beyond_capacity_or_new_fragment_takes_a_fresh_factorisation(split_in_contact, monkeypatch):
+def test_small_mesh_border_beyond_capacity_or_new_fragment_takes_a_fresh_factorisation(split_in_contact,
+                                                                                      monkeypatch):
     prob, lineage = split_in_contact
     rows = prob.assemble_constraints()
     support = _base_pins(prob.support(rows), lineage.base, prob.fes.ndof)
+    assert split_factor.BorderedFactor.build(lineage, prob, rows.fixed_dofs, support.pins) is not None
+    monkeypatch.setattr(split_factor, "MIN_BASE_DOFS", np.count_nonzero(lineage.base.factor_free) + 1)
+    assert split_factor.BorderedFactor.build(lineage, prob, rows.fixed_dofs, support.pins) is None
+    monkeypatch.setattr(split_factor, "MIN_BASE_DOFS", 0)
     monkeypatch.setattr(split_factor, "border_capacity", lambda n: 2)
     assert split_factor.BorderedFactor.build(lineage, prob, rows.fixed_dofs, support.pins) is None
-    monkeypatch.undo()
+    monkeypatch.setattr(split_factor, "border_capacity", lambda n: 240)
     other_pins = np.setdiff1d(np.arange(prob.fes.ndof), rows.fixed_dofs)[:1]   # a pin the base does not have
     assert split_factor.BorderedFactor.build(lineage, prob, rows.fixed_dofs, other_pins) is None
 
