@@ -37,10 +37,12 @@ import scipy.sparse as sp
 from .kkt import EliminatedFactor, FactorBase, SingularSystem
 
 #: below this many factorised dofs a split mesh is factorised afresh: a factorisation costs
-#: less than the bordered solves' bookkeeping (measured: the default plate, 2.9k dofs, 3.2 s
-#: fresh against 3.5 s bordered; the paper's disintegrating disk, 1.1k dofs, 47 against 53 s;
-#: the 4x plate, 8.4k dofs, 9.9 against 7.2 s)
-MIN_BASE_DOFS = 5000
+#: about as much as the bordered solves' bookkeeping, and a fresh tangent saves Newton
+#: iterations where contact moves pieces far (measured one run after the other: the
+#: paper's disk, 2k dofs, 51 s fresh against 57 s bordered; its disintegrating disk, 1.1k
+#: dofs, 48 against 47 s; the default plate, 2.9k dofs, linear algebra 1.2 to 1.4 s
+#: fresh against 0.66 to 0.73 s bordered)
+MIN_BASE_DOFS = 2500
 
 #: free dofs of the vertices created since the base factorisation beyond which a split mesh
 #: is factorised afresh: every solve costs n x m more for Z d (see docs/performance.md) ...
