@@ -6,6 +6,19 @@ namespace ngfracture
 {
   using namespace ngbla;
 
+  // St Venant-Kirchhoff: S = 2 mu E + lam tr(E) I with E = (H + H^T + H^T H) / 2, written in
+  // H so that nothing cancels at small strain.
+  static void SecondPiolaSvk (double mu, double lam, const double H[2][2], double S[2][2])
+  {
+    double E00 = H[0][0] + 0.5 * (H[0][0] * H[0][0] + H[1][0] * H[1][0]);
+    double E11 = H[1][1] + 0.5 * (H[0][1] * H[0][1] + H[1][1] * H[1][1]);
+    double E01 = 0.5 * (H[0][1] + H[1][0] + H[0][0] * H[0][1] + H[1][0] * H[1][1]);
+    double tr = E00 + E11;
+    S[0][0] = 2 * mu * E00 + lam * tr;
+    S[1][1] = 2 * mu * E11 + lam * tr;
+    S[0][1] = S[1][0] = 2 * mu * E01;
+  }
+
   // First Piola-Kirchhoff stress P(H) of one element, H = grad u (2x2, row i = component).
   static void FirstPiola (MaterialKind kind, double mu, double lam, const double H[2][2],
                           double P[2][2])
@@ -23,12 +36,10 @@ namespace ngfracture
         }
       case MaterialKind::StVenantKirchhoff:
         {
-          // E = (H + H^T + H^T H) / 2, S = 2 mu E + lam tr(E) I, P = (I + H) S
-          double E00 = H[0][0] + 0.5 * (H[0][0] * H[0][0] + H[1][0] * H[1][0]);
-          double E11 = H[1][1] + 0.5 * (H[0][1] * H[0][1] + H[1][1] * H[1][1]);
-          double E01 = 0.5 * (H[0][1] + H[1][0] + H[0][0] * H[0][1] + H[1][0] * H[1][1]);
-          double tr = E00 + E11;
-          double S00 = 2 * mu * E00 + lam * tr, S11 = 2 * mu * E11 + lam * tr, S01 = 2 * mu * E01;
+          // P = (I + H) S
+          double S[2][2];
+          SecondPiolaSvk(mu, lam, H, S);
+          double S00 = S[0][0], S11 = S[1][1], S01 = S[0][1];
           double F00 = 1 + H[0][0], F01 = H[0][1], F10 = H[1][0], F11 = 1 + H[1][1];
           P[0][0] = F00 * S00 + F01 * S01;
           P[0][1] = F00 * S01 + F01 * S11;
@@ -75,11 +86,8 @@ namespace ngfracture
       case MaterialKind::StVenantKirchhoff:
         {
           // dP_ij/dF_kl = delta_ik S_lj + mu (F_il F_kj + delta_jl (F F^T)_ik) + lam F_ij F_kl
-          double E00 = H[0][0] + 0.5 * (H[0][0] * H[0][0] + H[1][0] * H[1][0]);
-          double E11 = H[1][1] + 0.5 * (H[0][1] * H[0][1] + H[1][1] * H[1][1]);
-          double E01 = 0.5 * (H[0][1] + H[1][0] + H[0][0] * H[0][1] + H[1][0] * H[1][1]);
-          double tr = E00 + E11;
-          double S[2][2] = { { 2 * mu * E00 + lam * tr, 2 * mu * E01 }, { 2 * mu * E01, 2 * mu * E11 + lam * tr } };
+          double S[2][2];
+          SecondPiolaSvk(mu, lam, H, S);
           double F[2][2] = { { 1 + H[0][0], H[0][1] }, { H[1][0], 1 + H[1][1] } };
           double FFt[2][2];
           for (int i = 0; i < 2; i++) for (int k = 0; k < 2; k++)
@@ -117,6 +125,25 @@ namespace ngfracture
     g[1][0] = (yc - ya) / d; g[1][1] = (xa - xc) / d;
     g[2][0] = (ya - yb) / d; g[2][1] = (xb - xa) / d;
     return d;
+  }
+
+  // Vertices v, barycentric gradients g and displacement gradient H = grad u of triangle e;
+  // returns its area.
+  static double ElementState (FlatMatrix<double> points, FlatMatrix<int> triangles, FlatVector<double> u,
+                              size_t e, int v[3], double g[3][2], double H[2][2])
+  {
+    size_t nv = points.Height();
+    for (int a = 0; a < 3; a++)
+      v[a] = triangles(e, a);
+    double area = 0.5 * std::fabs(BarycentricGradients(points, v, g));
+    for (int i = 0; i < 2; i++)
+      for (int j = 0; j < 2; j++)
+        H[i][j] = 0.0;
+    for (int a = 0; a < 3; a++)
+      for (int i = 0; i < 2; i++)
+        for (int j = 0; j < 2; j++)
+          H[i][j] += u(i * nv + v[a]) * g[a][j];
+    return area;
   }
 
   static void CheckKernelInput (const char * name, FlatMatrix<double> points, FlatMatrix<int> triangles,
@@ -198,14 +225,9 @@ namespace ngfracture
     data = 0.0;
     for (size_t e = 0; e < ne; e++)
       {
-        int v[3] = { triangles(e, 0), triangles(e, 1), triangles(e, 2) };
-        double g[3][2];
-        double area = 0.5 * std::fabs(BarycentricGradients(points, v, g));
-        double H[2][2] = { { 0, 0 }, { 0, 0 } };
-        for (int a = 0; a < 3; a++)
-          for (int i = 0; i < 2; i++)
-            for (int j = 0; j < 2; j++)
-              H[i][j] += u(i * nv + v[a]) * g[a][j];
+        int v[3];
+        double g[3][2], H[2][2];
+        double area = ElementState(points, triangles, u, e, v, g, H);
         double A[4][4];
         PiolaTangent(MaterialKind(kind(e)), mu(e), lam(e), H, A);
         for (int a = 0; a < 3; a++)
@@ -241,14 +263,9 @@ namespace ngfracture
     f = 0.0;
     for (size_t e = 0; e < ne; e++)
       {
-        int v[3] = { triangles(e, 0), triangles(e, 1), triangles(e, 2) };
-        double g[3][2];
-        double area = 0.5 * std::fabs(BarycentricGradients(points, v, g));
-        double H[2][2] = { { 0, 0 }, { 0, 0 } };
-        for (int a = 0; a < 3; a++)
-          for (int i = 0; i < 2; i++)
-            for (int j = 0; j < 2; j++)
-              H[i][j] += u(i * nv + v[a]) * g[a][j];
+        int v[3];
+        double g[3][2], H[2][2];
+        double area = ElementState(points, triangles, u, e, v, g, H);
         double P[2][2];
         FirstPiola(MaterialKind(kind(e)), mu(e), lam(e), H, P);
         for (int a = 0; a < 3; a++)

@@ -10,32 +10,41 @@ using namespace ngfracture;
 void ExportCrack (py::module & m);   // python_crack.cpp
 void ExportCollision (py::module & m);  // python_collision.cpp
 
+using Doubles = py::array_t<double, py::array::c_style | py::array::forcecast>;
+using Ints = py::array_t<int, py::array::c_style | py::array::forcecast>;
+
+// The arrays of the element kernels (mesh, displacement, law per triangle) as ngbla views;
+// the numpy arrays must outlive it.
+struct KernelInput
+{
+  FlatMatrix<double> points;
+  FlatMatrix<int> triangles;
+  FlatVector<double> u, mu, lam;
+  FlatVector<int> kind;
+
+  KernelInput (const char * name, Doubles & p, Ints & t, Doubles & uu, Ints & k, Doubles & m, Doubles & l)
+    : points(p.ndim() == 2 ? p.shape(0) : 0, p.ndim() == 2 ? p.shape(1) : 0, const_cast<double*>(p.data())),
+      triangles(t.ndim() == 2 ? t.shape(0) : 0, t.ndim() == 2 ? t.shape(1) : 0, const_cast<int*>(t.data())),
+      u(uu.shape(0), const_cast<double*>(uu.data())), mu(m.shape(0), const_cast<double*>(m.data())),
+      lam(l.shape(0), const_cast<double*>(l.data())), kind(k.shape(0), const_cast<int*>(k.data()))
+  {
+    if (p.ndim() != 2 || t.ndim() != 2 || uu.ndim() != 1 || k.ndim() != 1 || m.ndim() != 1 || l.ndim() != 1)
+      throw Exception(std::string("ngfracture.") + name + ": points and triangles must be 2D arrays, "
+                      "u, kind, mu and lam 1D");
+  }
+};
+
 static void ExportInternalForces (py::module & m)
 {
   m.def("InternalForces",
-        [] (py::array_t<double, py::array::c_style | py::array::forcecast> points,
-            py::array_t<int, py::array::c_style | py::array::forcecast> triangles,
-            py::array_t<double, py::array::c_style | py::array::forcecast> u,
-            py::array_t<int, py::array::c_style | py::array::forcecast> kind,
-            py::array_t<double, py::array::c_style | py::array::forcecast> mu,
-            py::array_t<double, py::array::c_style | py::array::forcecast> lam)
+        [] (Doubles points, Ints triangles, Doubles u, Ints kind, Doubles mu, Doubles lam)
         {
-          if (points.ndim() != 2 || triangles.ndim() != 2 || u.ndim() != 1 || kind.ndim() != 1 ||
-              mu.ndim() != 1 || lam.ndim() != 1)
-            throw Exception("ngfracture.InternalForces: points and triangles must be 2D arrays, "
-                            "u, kind, mu and lam 1D");
-          size_t nv = points.shape(0), ne = triangles.shape(0);
+          KernelInput in("InternalForces", points, triangles, u, kind, mu, lam);
           py::array_t<double> out(u.shape(0));
-          FlatMatrix<double> P(nv, points.shape(1), const_cast<double*>(points.data()));
-          FlatMatrix<int> T(ne, triangles.shape(1), const_cast<int*>(triangles.data()));
-          FlatVector<double> U(u.shape(0), const_cast<double*>(u.data()));
-          FlatVector<int> K(kind.shape(0), const_cast<int*>(kind.data()));
-          FlatVector<double> M(mu.shape(0), const_cast<double*>(mu.data()));
-          FlatVector<double> L(lam.shape(0), const_cast<double*>(lam.data()));
           FlatVector<double> F(out.shape(0), out.mutable_data());
           {
             py::gil_scoped_release release;
-            InternalForces(P, T, U, K, M, L, F);
+            InternalForces(in.points, in.triangles, in.u, in.kind, in.mu, in.lam, F);
           }
           return out;
         },
@@ -66,29 +75,14 @@ numpy.ndarray
 static void ExportTangentStiffness (py::module & m)
 {
   m.def("TangentStiffness",
-        [] (py::array_t<double, py::array::c_style | py::array::forcecast> points,
-            py::array_t<int, py::array::c_style | py::array::forcecast> triangles,
-            py::array_t<double, py::array::c_style | py::array::forcecast> u,
-            py::array_t<int, py::array::c_style | py::array::forcecast> kind,
-            py::array_t<double, py::array::c_style | py::array::forcecast> mu,
-            py::array_t<double, py::array::c_style | py::array::forcecast> lam)
+        [] (Doubles points, Ints triangles, Doubles u, Ints kind, Doubles mu, Doubles lam)
         {
-          if (points.ndim() != 2 || triangles.ndim() != 2 || u.ndim() != 1 || kind.ndim() != 1 ||
-              mu.ndim() != 1 || lam.ndim() != 1)
-            throw Exception("ngfracture.TangentStiffness: points and triangles must be 2D arrays, "
-                            "u, kind, mu and lam 1D");
-          size_t nv = points.shape(0), ne = triangles.shape(0);
-          FlatMatrix<double> P(nv, points.shape(1), const_cast<double*>(points.data()));
-          FlatMatrix<int> T(ne, triangles.shape(1), const_cast<int*>(triangles.data()));
-          FlatVector<double> U(u.shape(0), const_cast<double*>(u.data()));
-          FlatVector<int> K(kind.shape(0), const_cast<int*>(kind.data()));
-          FlatVector<double> M(mu.shape(0), const_cast<double*>(mu.data()));
-          FlatVector<double> L(lam.shape(0), const_cast<double*>(lam.data()));
+          KernelInput in("TangentStiffness", points, triangles, u, kind, mu, lam);
           Array<int> indptr, indices;
           Array<double> data;
           {
             py::gil_scoped_release release;
-            TangentStiffness(P, T, U, K, M, L, indptr, indices, data);
+            TangentStiffness(in.points, in.triangles, in.u, in.kind, in.mu, in.lam, indptr, indices, data);
           }
           auto copy = [] (auto & a)
             {

@@ -687,7 +687,7 @@ class Simulation:
         rules = PAPER_RULES if self.scene.radius is None else GROWTH_RULES
         res = split_by_tensor(prob.mesh, tensors, 1.0, skip_neighbours=self.control.split == "spread",
                               first_only=self.control.split == "one", rules=rules,
-                              check_mesh=False)          # prob's ElasticProblem has checked it
+                              check_mesh=False)   # checked when made, or split from a checked mesh
         self.timings["split"] += time.perf_counter() - t0 - sum(res.timings.get(k, 0.0) for k in ("netgen", "ngsolve_mesh"))
         self.timings["rebuild"] += res.timings.get("netgen", 0.0) + res.timings.get("ngsolve_mesh", 0.0)
         if res.nsplit == 0:
