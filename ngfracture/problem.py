@@ -284,7 +284,7 @@ class ElasticProblem:
 
         P1 spaces with the package's laws take it from the C++ kernel (the derivative of the
         internal forces of ``out_of_balance``, entry for entry NGSolve's linearisation of the
-        energy to rounding, tests/test_internal_forces.py, at a tenth of its cost); others
+        energy to rounding, tests/test_internal_forces.py, 14 times cheaper); others
         from NGSolve's ``AssembleLinearization`` of the energy form. The linear model's
         stiffness does not depend on u: it is assembled once and kept.
 
