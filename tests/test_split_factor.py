@@ -79,13 +79,19 @@ def split_in_contact():
     return prob, split_factor.lineage(factor, state, res.parent)
 
 
-@pytest.mark.parametrize("sparse_schur", [False, True])
-def test_bordered_solve_equals_whole_kkt_solve_in_contact(split_in_contact, sparse_schur, monkeypatch):
-    """Both Schur paths: the kept columns, and the sparse Schur complement of the base plus
-    the border's rank-m term (forced on this small mesh)."""
+@pytest.mark.parametrize("sparse_schur, inverse", [(False, "superlu"), (True, "superlu"), (False, "sparsecholesky")])
+def test_bordered_solve_equals_whole_kkt_solve_in_contact(split_in_contact, sparse_schur, inverse, monkeypatch):
+    """Both Schur paths on a SuperLU base: the kept columns, and the sparse Schur complement
+    of the base plus the border's rank-m term (forced on this small mesh); and a base
+    factorised by NGSolve's sparse Cholesky (the large meshes' solver)."""
     monkeypatch.setattr(kkt_module, "SPARSE_SCHUR_MIN_DOFS", 0 if sparse_schur else 10 ** 9)
     monkeypatch.setattr(kkt_module, "SPARSE_SCHUR_MIN_ROWS", 0)
     prob, lineage = split_in_contact
+    if inverse != "superlu":
+        base = lineage.base
+        other = EliminatedFactor(base.K, base.fixed_dofs, base.pins, inverse=inverse)
+        other.solve(np.ones(base.ndof))
+        lineage = split_factor.Lineage(other, lineage.state, lineage.parent)
     rows = prob.assemble_constraints()
     support = _base_pins(prob.support(rows), lineage.base, prob.fes.ndof)
     factor = split_factor.BorderedFactor.build(lineage, prob, rows.fixed_dofs, support.pins)
