@@ -197,12 +197,26 @@ AUGMENTED_MAX_DOFS = 5000
 
 
 class FactorBase:
-    """What every K^+ shares: the rows it was made for, the corrected modes, Schur columns.
+    """What every K^+ shares: the rows it was made for, the corrected modes, Schur columns,
+    the residual check of its first solve.
 
     A subclass sets ``K`` (scipy CSR, all dofs), ``ndof``, ``fixed_dofs``, ``pins``, ``free``
-    (not fixed), ``factor_free`` (neither fixed nor pinned), ``_columns`` ({}) and defines
-    ``solve(B)``.
+    (not fixed), ``factor_free`` (neither fixed nor pinned), ``_columns`` ({}),
+    ``_checked`` (False) and defines ``solve(B)``.
     """
+
+    def _check(self, B, X):
+        """One residual check per factorisation: sparse Cholesky of a singular or
+        indefinite matrix can return finite garbage."""
+        j = int(np.argmax(np.abs(B[self.factor_free]).sum(axis=0)))
+        b = B[self.factor_free, j]
+        if not np.any(b):
+            return
+        r = (self.K @ X[:, j])[self.factor_free] - b
+        rel = np.linalg.norm(r) / np.linalg.norm(b)
+        if not rel < 1e-6:
+            raise SingularSystem(f"the factorised stiffness does not solve its system (relative residual {rel:.1e}): singular or indefinite")
+        self._checked = True
 
     def matches(self, fixed_dofs, pins):
         """True if this factorisation leaves out exactly these fixed dofs and pins.
@@ -562,19 +576,6 @@ class EliminatedFactor(FactorBase):
         if not np.all(np.isfinite(x)):
             raise SingularSystem("the factorised stiffness produced NaN/inf: singular (a floating body?)")
         return x
-
-    def _check(self, B, X):
-        """One residual check per factorisation: sparse Cholesky of a singular or
-        indefinite matrix can return finite garbage."""
-        j = int(np.argmax(np.abs(B[self.factor_free]).sum(axis=0)))
-        b = B[self.factor_free, j]
-        if not np.any(b):
-            return
-        r = (self.K @ X[:, j])[self.factor_free] - b
-        rel = np.linalg.norm(r) / np.linalg.norm(b)
-        if not rel < 1e-6:
-            raise SingularSystem(f"the factorised stiffness does not solve its system (relative residual {rel:.1e}): singular or indefinite")
-        self._checked = True
 
     @property
     def sparse_schur(self):

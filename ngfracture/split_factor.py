@@ -215,7 +215,8 @@ class BorderedFactor(FactorBase):
             :func:`border_capacity` dofs.
         """
         base = lineage.base
-        if np.count_nonzero(base.factor_free) < MIN_BASE_DOFS:
+        n_base = np.count_nonzero(base.factor_free)
+        if n_base < MIN_BASE_DOFS:
             return None
         nv, nvb = problem.fes.ndof // 2, base.ndof // 2
         parent = lineage.parent
@@ -236,7 +237,6 @@ class BorderedFactor(FactorBase):
         if (np.any(factor_free & ~base.factor_free[base_dof]) or np.any(~free & base.free[base_dof])
                 or np.any(free & ~factor_free & new_vertex)):
             return None
-        n_base = np.count_nonzero(base.factor_free)
         if np.count_nonzero(factor_free) - n_base > border_capacity(n_base):
             return None
         K = problem.tangent(_lifted(lineage.state, parent))
@@ -261,13 +261,13 @@ class BorderedFactor(FactorBase):
         border = np.flatnonzero(self._dofs % nv >= nvb)
         vertex, component = self._dofs[border] % nv, self._dofs[border] // nv
         self._border = border[np.lexsort((component, vertex))]
+        border_dofs = self._dofs[self._border]
         self._Et = sp.csr_matrix((np.ones(len(self._dofs)), (self._x, np.arange(len(self._dofs)))),
                                  shape=(n_base, len(self._dofs)))                     # E^T
         # K~ restricted to the factorised dofs, rows of the border: B^T = J^T K~ E and D
-        border_rows = K[self._dofs[self._border]][:, self._dofs]
+        border_rows = K[border_dofs][:, self._dofs]
         self._Bt = (border_rows @ self._Et.T).tocsr()
         D = border_rows[:, self._border].toarray()
-        border_dofs = self._dofs[self._border]
         keys = list(zip((border_dofs % nv).tolist(), (border_dofs // nv).tolist()))
         self.z_columns = self._border_columns(lineage.columns, keys, n_base)
         m = len(keys)
@@ -362,16 +362,6 @@ class BorderedFactor(FactorBase):
         if self.z_columns.chain["latest"] != self.z_columns.generation:
             raise RuntimeError("a bordered factor of an earlier mesh of a chain of splits: its columns "
                                "were overwritten by a later mesh's")
-
-    def _check(self, B, X):
-        j = int(np.argmax(np.abs(B[self._dofs]).sum(axis=0)))
-        b = B[self._dofs, j]
-        if not np.any(b):
-            return
-        rel = np.linalg.norm((self.K @ X[:, j])[self._dofs] - b) / np.linalg.norm(b)
-        if not rel < 1e-6:
-            raise SingularSystem(f"the bordered factorisation does not solve its system (relative residual {rel:.1e})")
-        self._checked = True
 
     def schur(self, C):
         """S = C K~^+ C^T (m, m): the base's sparse Schur complement of C E plus W S_d^-1 W^T.

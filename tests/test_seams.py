@@ -7,7 +7,7 @@ adjacent wedges share a facet.
 import numpy as np
 import pytest
 
-from ngfracture.seams import DIAGONAL_RIGHT, find_seams, seam_constraints
+from ngfracture.seams import DIAGONAL_RIGHT, _point_ids, find_seams, seam_constraints
 
 
 def junction(angles_deg):
@@ -149,3 +149,14 @@ def test_junction_rows_turn_with_the_pieces(turn):
     assert np.array_equal(keys0, keys1)
     np.testing.assert_allclose(rows1.normal, rows0.normal @ Q.T, atol=1e-14)
     np.testing.assert_allclose(rows1.dist, 0.0, atol=1e-15)
+
+
+def test_point_ids_are_the_inverse_of_numpy_unique_rows():
+    """Copies share an id, ids in lexicographic (x, y) order as np.unique(axis=0) numbers
+    them (-0.0 and 0.0 are one point), for no, one and many points."""
+    rng = np.random.default_rng(0)
+    X = rng.integers(0, 30, (5000, 2)).astype(float) * 0.1
+    X[::7] *= -1.0                     # -0.0 where the coordinate was 0
+    for Y in (X, X[:1], np.zeros((0, 2))):
+        _, reference = np.unique(Y, axis=0, return_inverse=True)
+        assert np.array_equal(_point_ids(Y), reference.ravel())
