@@ -10,7 +10,10 @@ Reported per case:
                rebuild, collision, contact, output) and wall
   t_unit       one factorisation plus one solve of the uncracked configuration's tangent
                (the scene's mesh and constraints at the first increment, NGSolve's sparse
-               Cholesky, one thread; the best of three), measured in the same process
+               Cholesky, one thread), measured in the same process: the mean of the best of
+               three before the run (t_unit_before) and the best of three after it
+               (t_unit_after), so that a shared machine's change of speed during the run
+               moves the unit with it
   solve_equivalents      wall / t_unit: the run in units of one linear solve of its own
                size, a figure that does not depend on the machine's speed
   seconds_per_step, solve_equivalents_per_step
@@ -89,10 +92,12 @@ def run_case(name, factor, steps=None, one_ring=False):
     criterion = {"radius": None} if one_ring else {}
     base = scenes.SCENES[name](**criterion)
     scene = scenes.SCENES[name](maxh=base.parameters["maxh"] / math.sqrt(factor), **criterion)
-    t_unit = unit_solve(scene)
+    t_unit_before = unit_solve(scene)
     control = StepControl(**{**scene.control, "max_steps": steps}) if steps else None
     with tempfile.TemporaryDirectory() as out:
         result = Simulation(scene, control, out=out, pictures="none").run()
+    t_unit_after = unit_solve(scene)
+    t_unit = 0.5 * (t_unit_before + t_unit_after)
     s = result.summary
     wall = s["timings"]["wall"]
     linear = s["timings"].get("linear", float("nan"))
@@ -102,7 +107,8 @@ def run_case(name, factor, steps=None, one_ring=False):
             "reason": result.reason, "max_steps": steps,
             "nsteps": s["n_steps"], "n_split_vertices": s["n_split_vertices"],
             "n_fragments": s["n_fragments"], "phases": s["timings"], "linear": linear,
-            "assembly": assembly, "t_unit": t_unit, "solve_equivalents": wall / t_unit,
+            "assembly": assembly, "t_unit": t_unit, "t_unit_before": t_unit_before,
+            "t_unit_after": t_unit_after, "solve_equivalents": wall / t_unit,
             "seconds_per_step": wall / nsteps, "solve_equivalents_per_step": wall / t_unit / nsteps,
             "outside_solve_share": 1.0 - s["timings"]["solve"] / wall,
             "outside_fe_share": 1.0 - (linear + assembly) / wall,

@@ -67,6 +67,7 @@ import ngsolve
 
 from . import _ngfracture as _C
 from .meshcheck import validate_mesh
+from .meshio import ngsolve_mesh
 
 __all__ = [
     "RULE_1", "RULE_1A", "RULE_1B", "RULE_2", "RULE_2A", "RULE_2B", "RULE_2C", "RULE_TIP", "RULE_TIP1",
@@ -644,7 +645,7 @@ def split_vertices(mesh, vertices, directions, crack_name="crack", skip_neighbou
                       bool(rules.single_edge_tips))
     t0 = time.perf_counter()
     # nothing split: keep the very same mesh, so callers keep their spaces and factorisations
-    newmesh = mesh if len(r["parent"]) == mesh.nv else ngsolve.Mesh(r["ngmesh"])
+    newmesh = mesh if len(r["parent"]) == mesh.nv else ngsolve_mesh(r["ngmesh"], mesh.ne)
     t_mesh = time.perf_counter() - t0
     rec = dict(r["record"])
     coords = mesh.ngmesh.Coordinates()

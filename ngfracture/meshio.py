@@ -22,6 +22,31 @@ import ngsolve as ng
 import numpy as np
 
 
+#: from this many triangles on a netgen mesh's topology is built in NGSolve's task manager:
+#: the same numbering, in 10.6 ms instead of 25 ms at 31k triangles (two threads); below it
+#: starting the task manager costs more than it saves
+PARALLEL_MIN_TRIANGLES = 10000
+
+
+def ngsolve_mesh(ngmesh, ntriangles):
+    """``ngsolve.Mesh(ngmesh)``, built in NGSolve's task manager for a big mesh.
+
+    Parameters
+    ----------
+    ngmesh : netgen.meshing.Mesh
+    ntriangles : int
+        Its number of triangles (or an estimate): decides the task manager.
+
+    Returns
+    -------
+    ngsolve.Mesh
+    """
+    if ntriangles < PARALLEL_MIN_TRIANGLES:
+        return ng.Mesh(ngmesh)
+    with ng.TaskManager():
+        return ng.Mesh(ngmesh)
+
+
 @dataclass
 class MeshArrays:
     """A 2D triangle mesh as plain arrays (see the module docstring).
@@ -196,7 +221,7 @@ def mesh_from_arrays(arrays):
         m.AddElements(dim=1, index=int(seg_bc[s]), data=np.ascontiguousarray(segs[s:e].astype(np.int32)), base=0)
     for b, name in enumerate(a.bc_names, start=1):
         m.SetBCName(b - 1, name)
-    return ng.Mesh(m)
+    return ngsolve_mesh(m, len(tris))
 
 
 def merge_meshes(*meshes):

@@ -206,10 +206,7 @@ class SavedTangent:
         if self.factor is not None or self.lineage is None:
             return False
         support = _base_pins(support, self.lineage.base, problem.fes.ndof)
-        try:
-            factor = BorderedFactor.build(self.lineage, problem, fixed_dofs, support.pins)
-        except SingularSystem:
-            factor = None       # a fresh factorisation decides (and reports) instead
+        factor = BorderedFactor.build(self.lineage, problem, fixed_dofs, support.pins)
         if factor is None:
             return False
         self.fixed_dofs, self.support, self.factor = fixed_dofs, support, factor

@@ -15,8 +15,9 @@ displacements, so its element matrix is the base's), the system in (x, d) is
     [ A    B ] [x]   [E^T b]        A = E^T K~ E = the base tangent (factorised),
     [ B^T  D ] [d] = [J^T b],       B = E^T K~ J, D = J^T K~ J,
 
-and eliminating d needs only Z = A^-1 B (two solves per new vertex, kept from one pass
-to the next) and the small dense S_d = D - B^T Z: one base solve per solve. General
+and eliminating d needs only Z = A^-1 B (two columns per new vertex, kept from one pass
+to the next) and the small dense S_d = D - B^T Z: one base solve per solve. The columns a
+pass adds are solved in one block with the first right-hand side it meets. General
 rows C become C E and C J, and C K~^+ C^T = (C E) A^-1 (C E)^T + W S_d^-1 W^T with
 W = (C E) Z - C J: the base's sparse Schur complement plus a rank-m term.
 
@@ -99,14 +100,15 @@ class BorderColumns:
 
     New vertices have higher numbers and a border is ordered by (vertex, component), so the
     border of the next mesh starts with this one's dofs: its columns are updated in the same
-    buffer, solved again only where their column of B changed (a neighbour split since:
-    B = E^T K~ J sums the new vertex's couplings into its parent in another order), and the
-    new ones appended. A chain has one buffer; only its latest factor may solve
+    buffer, solved again only where their column of B changed, and the new ones appended.
+    A neighbour's split leaves a column as it was: E^T sums the new vertex's couplings with
+    both copies of the neighbour into the same base dofs, and each triangle keeps its element
+    matrix. A chain has one buffer; only its latest factor may solve
     (``chain["latest"]`` is that factor's ``generation``; an earlier one refuses).
 
     Parameters
     ----------
-    keys, column_keys, buffer, chain, generation
+    keys, column_keys, buffer, chain, generation, unsolved
         The attributes below.
 
     Attributes
@@ -120,12 +122,16 @@ class BorderColumns:
     chain : dict
         Shared by the chain: {"latest": generation of its latest factor}.
     generation : int
+    unsolved : list of int
+        Columns whose Z is not in the buffer yet (BorderedFactor solves them with its first
+        right-hand side).
     """
     keys: list
     column_keys: list
     buffer: np.ndarray = field(repr=False)
     chain: dict = field(default_factory=lambda: {"latest": 0})
     generation: int = 0
+    unsolved: list = field(default_factory=list)
 
 
 def lineage(factor, state, parent):
@@ -186,10 +192,6 @@ class BorderedFactor(FactorBase):
     base_dof : numpy.ndarray of int
         For every dof of the split mesh, the base dof it copies.
 
-    Raises
-    ------
-    SingularSystem
-        If the border's Schur complement S_d is singular.
     """
 
     linear_solver = "direct"
@@ -266,45 +268,68 @@ class BorderedFactor(FactorBase):
                                  shape=(n_base, len(self._dofs)))                     # E^T
         # K~ restricted to the factorised dofs, rows of the border: B^T = J^T K~ E and D
         border_rows = K[border_dofs][:, self._dofs]
+        # sorted: a column is recognised by its indices and values, and a sparse product's
+        # rows come in any order
         self._Bt = (border_rows @ self._Et.T).tocsr()
+        self._Bt.sort_indices()
         D = border_rows[:, self._border].toarray()
         keys = list(zip((border_dofs % nv).tolist(), (border_dofs // nv).tolist()))
         self.z_columns = self._border_columns(lineage.columns, keys, n_base)
-        m = len(keys)
-        self._Z = self.z_columns.buffer[:, :m]
-        if m:
-            Sd = D - _sparse_times_rows(self._Bt, self._Z)
-            self._Sd = sla.lu_factor(0.5 * (Sd + Sd.T))
-            pivots = np.abs(np.diag(self._Sd[0]))
-            if not np.all(np.isfinite(pivots)) or pivots.min() <= 1e-13 * pivots.max():
-                raise SingularSystem(f"the border of {m} split dofs is singular (pivot ratio "
-                                     f"{pivots.min() / max(pivots.max(), 1e-300):.1e}): a floating piece?")
+        self._Z = self.z_columns.buffer[:, :len(keys)]
+        self._D = D
+        self._Sd = None           # factorised S_d, made with the columns of Z (_base_solve)
         self.seconds = time.perf_counter() - t0
 
     def _border_columns(self, carried, keys, n_base):
-        """Z = A^-1 B for this border, from the chain's columns where B's are unchanged (see
-        BorderColumns); the others in one block solve."""
+        """Z = A^-1 B for this border: the chain's columns where B's are unchanged (see
+        BorderColumns), the others marked unsolved."""
         Bt = self._Bt
         column_keys = [Bt.indices[s:e].tobytes() + Bt.data[s:e].tobytes() for s, e in zip(Bt.indptr[:-1], Bt.indptr[1:])]
         m = len(keys)
         old = len(carried.keys) if carried is not None else 0
         if old and carried.keys == keys[:old] and carried.buffer.shape[1] >= m:
             columns = BorderColumns(keys, column_keys, carried.buffer, carried.chain, carried.generation + 1)
-            solve = [i for i in range(old) if carried.column_keys[i] != column_keys[i]] + list(range(old, m))
+            unsolved = set(carried.unsolved)
+            solve = [i for i in range(old) if i in unsolved or carried.column_keys[i] != column_keys[i]]
+            solve += list(range(old, m))
         else:
             buffer = np.zeros((n_base, max(border_capacity(n_base), m)), order="F")   # Z: its first columns
             columns = BorderColumns(keys, column_keys, buffer)
             known = dict(zip(zip(carried.keys, carried.column_keys), range(old))) if old else {}
             solve = []
             for i, key in enumerate(zip(keys, column_keys)):
-                if key in known:
+                if key in known and known[key] not in carried.unsolved:
                     buffer[:, i] = carried.buffer[:, known[key]]
                 else:
                     solve.append(i)
         columns.chain["latest"] = columns.generation
-        if solve:
-            columns.buffer[:, solve] = self.base.solve_factorised(Bt[solve].T.toarray())
+        columns.unsolved = solve
         return columns
+
+    def _base_solve(self, rhs):
+        """A^-1 rhs (n_base, k); the first call solves the unsolved columns of Z in the same
+        block and factorises S_d.
+
+        Raises
+        ------
+        SingularSystem
+            If S_d is singular (a floating piece), or from the base's solve.
+        """
+        if self._Sd is not None or not len(self._border):
+            return self.base.solve_factorised(rhs)
+        unsolved = self.z_columns.unsolved
+        X = self.base.solve_factorised(np.hstack([self._Bt[unsolved].T.toarray(), rhs]))
+        self._Z[:, unsolved] = X[:, :len(unsolved)]
+        self.z_columns.unsolved = []
+        m = len(self._border)
+        Sd = self._D - _sparse_times_rows(self._Bt, self._Z)
+        Sd = sla.lu_factor(0.5 * (Sd + Sd.T))
+        pivots = np.abs(np.diag(Sd[0]))
+        if not np.all(np.isfinite(pivots)) or pivots.min() <= 1e-13 * pivots.max():
+            raise SingularSystem(f"the border of {m} split dofs is singular (pivot ratio "
+                                 f"{pivots.min() / max(pivots.max(), 1e-300):.1e}): a floating piece?")
+        self._Sd = Sd
+        return X[:, len(unsolved):]
 
     @property
     def sparse_schur(self):
@@ -333,7 +358,8 @@ class BorderedFactor(FactorBase):
         Raises
         ------
         SingularSystem
-            If the solution has NaN/inf or the first solve does not solve its system.
+            If the solution has NaN/inf, the first solve does not solve its system or the
+            border is singular.
         RuntimeError
             If a later mesh of the chain has been factorised (the columns are its own now).
         """
@@ -344,7 +370,7 @@ class BorderedFactor(FactorBase):
         X = np.zeros(B.shape)
         if B.shape[1]:
             bF = B[self._dofs]
-            x = self.base.solve_factorised(self._Et @ bF)
+            x = self._base_solve(self._Et @ bF)
             XF = x[self._x]
             if len(self._border):
                 d = sla.lu_solve(self._Sd, bF[self._border] - self._Bt @ x)
@@ -380,7 +406,7 @@ class BorderedFactor(FactorBase):
         ValueError
             If the base has no sparse Schur path (:attr:`sparse_schur` is False).
         SingularSystem
-            From the base's sparse triangular solves.
+            From the base's sparse triangular solves, or if the border is singular.
         RuntimeError
             If a later mesh of the chain has been factorised (as :meth:`solve`).
         """
@@ -393,6 +419,7 @@ class BorderedFactor(FactorBase):
         Cx_base = sp.csr_matrix((Cx.data, base_dofs[Cx.indices], Cx.indptr), shape=(Cx.shape[0], base.ndof))
         S = base.schur(Cx_base)
         if len(self._border):
+            self._base_solve(np.zeros((self._Et.shape[0], 0)))     # Z and S_d, if not yet made
             W = _sparse_times_rows(Cx, self._Z) - CF[:, self._border].toarray()
             S = S + W @ sla.lu_solve(self._Sd, W.T)
         self.seconds += time.perf_counter() - t0

@@ -198,3 +198,45 @@ def test_a_run_through_bordered_factors_ends_as_with_fresh_factorisations(monkey
     assert [h["split_vertices"] for h in a.summary["history"]] == [h["split_vertices"] for h in b.summary["history"]]
     assert abs(a.summary["crack_length"] - b.summary["crack_length"]) <= 1e-9 * a.summary["crack_length"]
     assert np.linalg.norm(a.state.u - b.state.u) <= 1e-9 * np.linalg.norm(a.state.u)
+
+
+def test_a_chain_solves_each_column_of_z_once_and_every_column_is_that_of_its_border(monkeypatch):
+    """Along the default plate on a coarser mesh: within a chain of splits every border dof's
+    column of Z = A^-1 B is solved once (a neighbour's split leaves its column of B as it
+    was, bit for bit, so the carried column is kept), and in every bordered factor, once it
+    has solved, A Z = B holds to rounding (1e-12 of |A| |Z|) for all its columns, the carried
+    ones included."""
+    solved = {}          # chain -> border dofs whose column was solved, in order
+    factors = []
+    original = split_factor.BorderedFactor._base_solve
+
+    def recording(self, rhs):
+        unsolved = [self.z_columns.keys[i] for i in self.z_columns.unsolved] if self._Sd is None else []
+        x = original(self, rhs)
+        solved.setdefault(id(self.z_columns.chain), []).extend(unsolved)
+        if unsolved:
+            factors.append(self)
+        return x
+
+    monkeypatch.setattr(split_factor.BorderedFactor, "_base_solve", recording)
+    original_init = ConstrainedSolver.__init__
+    checked = []
+
+    def checking_init(self, *args, **kwargs):
+        original_init(self, *args, **kwargs)
+        factor = self.factor
+        if not isinstance(factor, split_factor.BorderedFactor) or factor._Sd is None or len(factors) % 3:
+            return
+        base = factor.base
+        A = base.K[base.factor_free][:, base.factor_free]
+        Z, B = factor._Z, factor._Bt.T.toarray()
+        assert np.linalg.norm(A @ Z - B) <= 1e-12 * np.linalg.norm(abs(A) @ np.abs(Z))
+        checked.append(Z.shape[1])
+
+    monkeypatch.setattr(ConstrainedSolver, "__init__", checking_init)
+    result = Simulation(scenes.plate(maxh=0.05)).run()
+    assert result.ok and result.summary["reason"] == "broken"
+    assert len(checked) >= 5 and max(checked) >= 20
+    for keys in solved.values():
+        assert len(keys) == len(set(keys))
+    assert max(len(keys) for keys in solved.values()) >= 20
