@@ -28,27 +28,28 @@ def _components(component):
         raise ValueError(f"component must be None (both), 0/'x' or 1/'y', got {component!r}") from None
 
 
-def _as_vector_cf(value, comps):
-    """A 2-vector CoefficientFunction from a number, a pair or a CF (gliding: one component)."""
+def _dirichlet_value(value, comps):
+    """A Dirichlet value, checked: a 2-vector CoefficientFunction (a CF given; gliding: a
+    scalar CF in one component), or a constant pair (a number or a pair; gliding: the other
+    entry 0)."""
     if isinstance(value, ng.CoefficientFunction):
-        cf = value
-        if cf.dim == 1:
+        if value.dim == 1:
             if len(comps) != 1:
                 raise ValueError("a scalar value needs component=0 or 1 (gliding); give a pair for both")
-            return ng.CF((cf, 0)) if comps == (0,) else ng.CF((0, cf))
-        if cf.dim != 2:
-            raise ValueError(f"a Dirichlet value must have 1 or 2 components, this CoefficientFunction has {cf.dim}")
-        return cf
+            return ng.CF((value, 0)) if comps == (0,) else ng.CF((0, value))
+        if value.dim != 2:
+            raise ValueError(f"a Dirichlet value must have 1 or 2 components, this CoefficientFunction has {value.dim}")
+        return value
     arr = np.asarray(value, dtype=float)
     if not np.all(np.isfinite(arr)):
         raise ValueError(f"a Dirichlet value must be finite, got {value!r}")
     if arr.ndim == 0:
         if len(comps) != 1:
-            return ng.CF((float(arr), float(arr)))
-        return ng.CF((float(arr), 0.0)) if comps == (0,) else ng.CF((0.0, float(arr)))
+            return np.array([float(arr), float(arr)])
+        return np.array([float(arr), 0.0]) if comps == (0,) else np.array([0.0, float(arr)])
     if arr.shape != (2,):
         raise ValueError(f"a Dirichlet value must be a number or a pair, got {value!r}")
-    return ng.CF((float(arr[0]), float(arr[1])))
+    return arr.copy()
 
 
 @dataclass
@@ -59,8 +60,9 @@ class Dirichlet:
     ----------
     boundaries : tuple of str
         Boundary names of the mesh.
-    value : ngsolve.CoefficientFunction
-        The prescribed displacement as a 2-vector CoefficientFunction.
+    value : ngsolve.CoefficientFunction or numpy.ndarray
+        The prescribed displacement: a 2-vector CoefficientFunction, or a constant pair
+        (shape (2,)).
     component : None, 0/'x' or 1/'y'
         None prescribes both components, otherwise only that one.
     """
@@ -123,11 +125,15 @@ class ConstraintSet:
     ----------
     fes : ngsolve.VectorH1
         The displacement space.
+    arrays : meshio.MeshArrays, optional
+        The mesh's arrays: a first-order space then reads the dofs of a boundary from its
+        segments instead of NGSolve's boundary elements.
     """
 
-    def __init__(self, fes):
+    def __init__(self, fes, arrays=None):
         self.fes = fes
         self.mesh = fes.mesh
+        self._arrays = arrays
         self.dirichlet = []
         self.points = []
         self.rows = []  # (C, g, label)
@@ -159,8 +165,7 @@ class ConstraintSet:
             if not isinstance(name, str) or name not in known:
                 raise ValueError(f"boundary {name!r} does not exist in the mesh; its boundaries are {sorted(known)}")
         comps = _components(component)
-        cf = _as_vector_cf(value, comps)
-        self.dirichlet.append(Dirichlet(names, cf, component))
+        self.dirichlet.append(Dirichlet(names, _dirichlet_value(value, comps), component))
 
     def add_point(self, vertex, value=(0.0, 0.0), component=None):
         """Prescribe the displacement of a single vertex.
@@ -237,15 +242,24 @@ class ConstraintSet:
         """
         n = self.fes.ndof // 2
         pieces = []   # (dofs, values, source), merged below
-        work = ng.GridFunction(self.fes)
+        work = None
         for cond in self.dirichlet:
+            scalar_dofs = self._boundary_dofs(cond.boundaries, n)
+            source = f"Dirichlet on {', '.join(cond.boundaries)}"
+            if isinstance(cond.value, np.ndarray):
+                # a constant: its value at the vertex dofs, zero at the higher-order ones (what
+                # Set() gives, without the projection's rounding)
+                vertex = scalar_dofs < self.mesh.nv
+                for c in _components(cond.component):
+                    pieces.append((c * n + scalar_dofs, np.where(vertex, cond.value[c], 0.0), source))
+                continue
+            if work is None:
+                work = ng.GridFunction(self.fes)
             region = self.mesh.Boundaries("|".join(cond.boundaries))
             work.vec[:] = 0.0
             # NGSolve's Set() on the boundary: nodal at vertices, projection for edge dofs
             work.Set(cond.value, ng.BND, definedon=region)
             data = work.vec.FV().NumPy()
-            scalar_dofs = self._boundary_dofs(cond.boundaries, n)
-            source = f"Dirichlet on {', '.join(cond.boundaries)}"
             for c in _components(cond.component):
                 dofs = c * n + scalar_dofs
                 if not np.all(np.isfinite(data[dofs])):
@@ -283,9 +297,15 @@ class ConstraintSet:
         """
         key = tuple(sorted(set(names)))
         if key not in self._dofs_on:
-            names = set(key)
-            dofs = [d for el in self.fes.Elements(ng.BND) if el.mat in names for d in el.dofs if 0 <= d < n]
-            self._dofs_on[key] = np.unique(np.array(dofs, dtype=np.int64))
+            a = self._arrays
+            if a is not None and self.fes.globalorder == 1:
+                # first order: the dofs are the vertices of the boundary's segments
+                bc = np.isin(np.asarray(a.bc_names, dtype=object)[a.seg_bc - 1], key) if len(a.seg_bc) else []
+                self._dofs_on[key] = np.unique(a.segments[bc].astype(np.int64))
+            else:
+                names = set(key)
+                dofs = [d for el in self.fes.Elements(ng.BND) if el.mat in names for d in el.dofs if 0 <= d < n]
+                self._dofs_on[key] = np.unique(np.array(dofs, dtype=np.int64))
         return self._dofs_on[key]
 
     @staticmethod

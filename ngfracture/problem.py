@@ -170,7 +170,7 @@ class ElasticProblem:
         with ng.TaskManager() if big else contextlib.nullcontext():
             self.fes = ng.VectorH1(mesh, order=order)
             self.u = ng.GridFunction(self.fes, name="displacement")
-            self.constraints = ConstraintSet(self.fes)
+            self.constraints = ConstraintSet(self.fes, arrays)
         self.load_factor = ng.Parameter(0.0)
         self._loads = []      # (kind, CF, region)
         self._form = None
