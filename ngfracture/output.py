@@ -38,7 +38,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import crack
+from . import crack, vtkxml
 from .meshio import mesh_to_arrays
 from .problem import check_mesh
 
@@ -176,8 +176,20 @@ def to_pyvista(mesh, u=None, fragment=None, strain="green", point_data=None, cel
 
 
 def _vtk_mesh(mesh, u=None, fragment=None, strain="green", point_data=None, cell_data=None, arrays=None):
-    """The vtkUnstructuredGrid of :func:`to_pyvista` (plain VTK: the time series writes it
-    without importing pyvista, a fifth of a small run's output time)."""
+    """The vtkUnstructuredGrid of :func:`to_pyvista` (plain VTK, without pyvista)."""
+    a, points, cells = _mesh_fields(mesh, u, fragment, strain, point_data, cell_data, arrays)
+    from vtkmodules.vtkCommonDataModel import vtkUnstructuredGrid
+    grid = vtkUnstructuredGrid()
+    _fill_vtk(grid, a.points, a.triangles, points, cells, _region_names(a))
+    return grid
+
+
+def _region_names(a):
+    return a.region_names if a.region_names else [""]
+
+
+def _mesh_fields(mesh, u=None, fragment=None, strain="green", point_data=None, cell_data=None, arrays=None):
+    """The mesh arrays and the point and cell arrays of :func:`to_pyvista`, checked."""
     a = arrays if arrays is not None else vertex_arrays(mesh)
     ne, nv = len(a.triangles), len(a.points)
     cells, points = {}, {}
@@ -204,10 +216,7 @@ def _vtk_mesh(mesh, u=None, fragment=None, strain="green", point_data=None, cell
             points["nodal_principal_direction"] = _pad3(d)
     _add_user_data(points, point_data, nv, "point_data")
     _add_user_data(cells, cell_data, ne, "cell_data")
-    from vtkmodules.vtkCommonDataModel import vtkUnstructuredGrid
-    grid = vtkUnstructuredGrid()
-    _fill_vtk(grid, a.points, a.triangles, points, cells, a.region_names if a.region_names else [""])
-    return grid
+    return a, points, cells
 
 
 def _fill_vtk(data, points, cells, point_data, cell_data, region_names=None):
@@ -283,17 +292,24 @@ def cracks_to_pyvista(mesh, u=None, boundary="crack", arrays=None):
 def _vtk_cracks(mesh, u=None, boundary="crack", arrays=None):
     """The vtkPolyData of :func:`cracks_to_pyvista` (plain VTK, see :func:`_vtk_mesh`)."""
     from vtkmodules.vtkCommonDataModel import vtkPolyData
+    poly = vtkPolyData()
+    points, lines, point_data = _crack_fields(mesh, u, boundary, arrays)
+    if len(lines):
+        _fill_vtk(poly, points, lines, point_data, {})
+    return poly
+
+
+def _crack_fields(mesh, u=None, boundary="crack", arrays=None):
+    """The crack faces' points, their segments in the points' numbering, and point data."""
     a = arrays if arrays is not None else vertex_arrays(mesh)
     seg = a.boundary_segments(boundary)
-    poly = vtkPolyData()
     if len(seg) == 0:
-        return poly
+        return np.zeros((0, 2)), np.zeros((0, 2), dtype=np.int64), {}
     used, local = np.unique(seg, return_inverse=True)
     points = {"vertex": used}
     if u is not None:
         points["displacement"] = _pad3(_displacement(mesh, u)[used])
-    _fill_vtk(poly, a.points[used], local.reshape(seg.shape), points, {})
-    return poly
+    return a.points[used], local.reshape(seg.shape), points
 
 
 # -- atomic files ---------------------------------------------------------------------------
@@ -335,9 +351,23 @@ def _publish(tmp, path, force):
     _fsync_dir(Path(path).parent)
 
 
-#: compression of the binary VTK arrays -> the VTK writer's setter
-_COMPRESSIONS = {"lz4": "SetCompressorTypeToLZ4", "zlib": "SetCompressorTypeToZLib",
-                 "lzma": "SetCompressorTypeToLZMA", None: "SetCompressorTypeToNone"}
+#: compressions of the binary VTK arrays: lz4 through VTK's writer (its setter), the others
+#: written by :mod:`ngfracture.vtkxml` (no VTK import)
+_COMPRESSIONS = {"lz4": "SetCompressorTypeToLZ4", "zlib": None, "lzma": None, None: None}
+
+
+def _replace_bytes(path, data):
+    """Write bytes through a temp file in the same folder, then rename over path."""
+    path = Path(path)
+    fd, tmp = tempfile.mkstemp(prefix=".tmp_ngf_", suffix=path.suffix, dir=path.parent)
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
 
 
 def _save_vtk(obj, path, compression):
@@ -380,11 +410,10 @@ class TimeSeriesWriter:
         delete this writer's files of later steps, continue the collections.
     last_step : int, optional
         With ``resume``: the last step to keep (e.g. the step of the checkpoint resumed from).
-    compression : {'lz4', 'zlib', 'lzma', None}
-        Compression of the binary VTK arrays (lossless). lz4 by default: at 100k triangles
-        it wrote a step about 2.5 times faster than zlib for random-valued fields (1.2 to
-        1.8 times for smooth ones) for 1.5 to 3 times the size (ParaView >= 5.5 reads it);
-        zlib for the smallest files.
+    compression : {'zlib', 'lzma', 'lz4', None}
+        Compression of the binary VTK arrays (lossless). zlib (level 1) by default, written
+        by :mod:`ngfracture.vtkxml` without importing VTK; lzma for the smallest files; lz4
+        goes through VTK's writer (ParaView >= 5.5 reads it); None writes the raw bytes.
 
     Attributes
     ----------
@@ -408,7 +437,7 @@ class TimeSeriesWriter:
     _OWN = re.compile(r"^(step_\d{6}\.vtu|cracks_\d{6}\.vtp|results\.pvd|cracks\.pvd|\.tmp_ngf_.*)$")
     _STEP = re.compile(r"^(?:step_(\d{6})\.vtu|cracks_(\d{6})\.vtp)$")
 
-    def __init__(self, folder, force=False, resume=False, last_step=None, compression="lz4"):
+    def __init__(self, folder, force=False, resume=False, last_step=None, compression="zlib"):
         if force and resume:
             raise ValueError("TimeSeriesWriter: force=True deletes results, resume=True keeps them; choose one")
         if last_step is not None and not resume:
@@ -527,9 +556,15 @@ class TimeSeriesWriter:
         for p in (vtu, vtp):
             if p.exists():   # a file the collection does not list: never overwrite it silently
                 raise FileExistsError(f"TimeSeriesWriter.write: {p} exists but is not in the collection")
-        _save_vtk(_vtk_mesh(mesh, u, fragment, strain, point_data, cell_data, arrays=a), vtu,
-                  self.compression)
-        _save_vtk(_vtk_cracks(mesh, u, crack_boundary, arrays=a), vtp, self.compression)
+        if self.compression == "lz4":
+            _save_vtk(_vtk_mesh(mesh, u, fragment, strain, point_data, cell_data, arrays=a), vtu,
+                      self.compression)
+            _save_vtk(_vtk_cracks(mesh, u, crack_boundary, arrays=a), vtp, self.compression)
+        else:
+            _, points, cells = _mesh_fields(mesh, u, fragment, strain, point_data, cell_data, arrays=a)
+            _replace_bytes(vtu, vtkxml.unstructured_grid(a.points, a.triangles, points, cells,
+                                                         {"region_names": _region_names(a)}, self.compression))
+            _replace_bytes(vtp, vtkxml.poly_lines(*_crack_fields(mesh, u, crack_boundary, a), self.compression))
         self.steps.append((step, time))
         self._write_collections()
         return vtu, vtp
