@@ -132,6 +132,9 @@ class ElasticProblem:
     check_mesh : bool
         False skips meshcheck.validate_mesh, for a mesh the crack engine split from a
         checked one (the engine keeps a valid mesh valid; the simulation's crack passes).
+    triangle_piece : numpy.ndarray of int, optional
+        The connected component of every triangle, if known (a split mesh: the crack
+        engine's fragments): :meth:`fragments` then needs no graph search.
 
     Attributes
     ----------
@@ -157,7 +160,7 @@ class ElasticProblem:
         If the mesh has slivers (meshcheck.SLIVER_ASPECT).
     """
 
-    def __init__(self, mesh, material, order=1, check_mesh=True):
+    def __init__(self, mesh, material, order=1, check_mesh=True, triangle_piece=None):
         arrays = validate_mesh(mesh) if check_mesh else mesh_to_arrays(mesh)
         self.materials = region_materials(mesh, material)
         if isinstance(order, bool) or not isinstance(order, int) or order < 1:
@@ -180,7 +183,9 @@ class ElasticProblem:
         self._regions = arrays.regions, arrays.region_names
         self._internal = None     # the C++ kernel's per-element data, made at first need
         self._reference_areas = None
-        self._pieces = None       # the mesh's connected components: the mesh never changes
+        # the mesh's connected components (the mesh never changes)
+        self._pieces = (None if triangle_piece is None
+                        else rigid.pieces_of_triangles(self._elements, mesh.nv, triangle_piece))
 
     # -- set-up ---------------------------------------------------------------------
     def add_dirichlet(self, boundaries, value=(0.0, 0.0), component=None):

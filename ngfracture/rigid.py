@@ -74,6 +74,38 @@ def pieces(elements, nv):
     return connected_components(graph, directed=False)
 
 
+def pieces_of_triangles(elements, nv, triangle_piece):
+    """:func:`pieces` from a known piece number of every triangle (any numbering).
+
+    The same count and numbering as :func:`pieces` (pieces numbered in the order of their
+    smallest vertex, as scipy's connected_components does) without building the graph: a
+    split mesh's fragments come from the crack engine.
+
+    Parameters
+    ----------
+    elements : numpy.ndarray of int, shape (ne, 3)
+    nv : int
+    triangle_piece : numpy.ndarray of int, shape (ne,)
+        The connected component of every triangle.
+
+    Returns
+    -------
+    (int, numpy.ndarray) or None
+        As :func:`pieces`; None if a vertex is in no triangle (a piece of its own there).
+    """
+    piece = np.full(nv, -1, dtype=np.int64)
+    piece[np.asarray(elements).ravel()] = np.repeat(np.asarray(triangle_piece, dtype=np.int64), 3)
+    if nv and piece.min() < 0:
+        return None
+    # the piece of vertex 0 first, then that of the first vertex not in it, ...
+    labels, first = np.unique(piece, return_index=True)
+    rank = np.empty(len(labels), dtype=np.int64)
+    rank[np.argsort(first, kind="stable")] = np.arange(len(labels))
+    renumber = np.zeros(labels.max(initial=-1) + 1, dtype=np.int64)
+    renumber[labels] = rank
+    return len(labels), renumber[piece].astype(np.int32)
+
+
 def piece_modes(x, verts, n):
     """The three rigid modes of one piece as dense columns over its vertex dofs.
 

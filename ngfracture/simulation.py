@@ -588,9 +588,10 @@ class Simulation:
         self.writer = TimeSeriesWriter(self.out)
 
     # -- the physics of one configuration ------------------------------------------------------
-    def _problem(self, mesh, x, u=None, check_mesh=True):
+    def _problem(self, mesh, x, u=None, check_mesh=True, triangle_piece=None):
         t0 = time.perf_counter()
-        prob = ElasticProblem(mesh, self.scene.material, order=1, check_mesh=check_mesh)
+        prob = ElasticProblem(mesh, self.scene.material, order=1, check_mesh=check_mesh,
+                              triangle_piece=triangle_piece)
         self.scene.apply_load(prob, x)
         if u is not None:
             prob.u.vec.FV().NumPy()[:] = u
@@ -699,7 +700,8 @@ class Simulation:
             strength = transfer_vertex_field(strength, res)    # copies inherit the vertex's strength
         inherited = split_factor.lineage(tangent.factor, tangent.state, res.parent) if tangent is not None else None
         # the engine split a checked mesh and keeps it valid
-        return self._problem(res.mesh, self._x_try, u, check_mesh=False), res.nsplit, strength, inherited
+        return (self._problem(res.mesh, self._x_try, u, check_mesh=False, triangle_piece=res.fragment),
+                res.nsplit, strength, inherited)
 
     # -- one load step ----------------------------------------------------------------------------
     def _attempt(self, state, dx, substeps=1):

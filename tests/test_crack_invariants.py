@@ -151,3 +151,25 @@ def test_thousands_of_random_splits_10k_triangles():
 if __name__ == "__main__":
     import pytest as _pytest
     raise SystemExit(_pytest.main([__file__, "-q"]))
+
+
+def test_pieces_from_the_engines_fragments_equal_the_graph_search():
+    """rigid.pieces_of_triangles on the crack engine's fragments gives the very count and
+    numbering of rigid.pieces (connected components of the vertex graph) on shattered meshes,
+    and refuses (None) a vertex in no triangle."""
+    from ngfracture import rigid
+    rng = np.random.default_rng(7)
+    mesh = netgen_square(0.08)
+    checked = 0
+    for d in [[1, 0], [0, 1], [1, -1], [1, 1]]:
+        order = rng.permutation(mesh.nv)[: mesh.nv // 2]
+        res = crack.split_vertices(mesh, order, np.tile(d, (len(order), 1)) * 1.0)
+        mesh = res.mesh
+        T = mesh.ngmesh.Elements2D().NumPy()["nodes"][:, :3].astype(np.int64) - 1
+        count, piece = rigid.pieces(T, mesh.nv)
+        fast = rigid.pieces_of_triangles(T, mesh.nv, res.fragment)
+        assert fast[0] == count == res.nfragments
+        assert np.array_equal(fast[1], piece) and fast[1].dtype == piece.dtype
+        checked += count > 1
+    assert checked >= 3
+    assert rigid.pieces_of_triangles(T, mesh.nv + 1, res.fragment) is None
