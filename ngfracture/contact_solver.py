@@ -396,6 +396,7 @@ class ContactSolver:
         t0 = time.perf_counter()
         status = self.problem.solve(tangent=tangent, increment_scale=increment_scale, **self.options)
         result.status = status
+        result.notes.extend(n for n in status.notes if n not in result.notes)
         result.timings["solve"] += time.perf_counter() - t0
         for part, seconds in status.phase_seconds().items():
             result.timings[part] += seconds

@@ -351,8 +351,8 @@ def _publish(tmp, path, force):
     _fsync_dir(Path(path).parent)
 
 
-#: compressions of the binary VTK arrays: lz4 through VTK's writer (its setter), the others
-#: written by :mod:`ngfracture.vtkxml` (no VTK import)
+#: compressions of the binary VTK arrays: lz4 through VTK's writer (its setter, used by
+#: _save_vtk), the others written by :mod:`ngfracture.vtkxml` (no VTK import, no setter)
 _COMPRESSIONS = {"lz4": "SetCompressorTypeToLZ4", "zlib": None, "lzma": None, None: None}
 
 

@@ -23,7 +23,7 @@ from .crack import vertex_displacement
 from .kkt import to_scipy
 from .materials import Material
 from .meshcheck import validate_mesh
-from .meshio import PARALLEL_MIN_TRIANGLES, mesh_to_arrays
+from .meshio import mesh_to_arrays
 from .solver import NewtonSolver
 
 
@@ -169,7 +169,7 @@ class ElasticProblem:
         #: False only when every region is linear: then the stiffness is constant
         self.nonlinear = any(m.geometrically_nonlinear for m in self.materials.values())
         # building the spaces is parallel inside the task manager (0.3 s at 360k dofs)
-        big = mesh.ne * order * order >= PARALLEL_MIN_TRIANGLES
+        big = mesh.ne * order * order >= self.PARALLEL_MIN_DOFS // 2
         with ng.TaskManager() if big else contextlib.nullcontext():
             self.fes = ng.VectorH1(mesh, order=order)
             self.u = ng.GridFunction(self.fes, name="displacement")

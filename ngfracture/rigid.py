@@ -92,9 +92,21 @@ def pieces_of_triangles(elements, nv, triangle_piece):
     -------
     (int, numpy.ndarray) or None
         As :func:`pieces`; None if a vertex is in no triangle (a piece of its own there).
+
+    Raises
+    ------
+    ValueError
+        If ``triangle_piece`` does not have one entry per triangle, or gives two triangles
+        that share a vertex different pieces.
     """
+    elements = np.asarray(elements)
+    tp = np.asarray(triangle_piece, dtype=np.int64)
+    if tp.shape != (len(elements),):
+        raise ValueError(f"triangle_piece must have one entry per triangle ({len(elements)}), got shape {tp.shape}")
     piece = np.full(nv, -1, dtype=np.int64)
-    piece[np.asarray(elements).ravel()] = np.repeat(np.asarray(triangle_piece, dtype=np.int64), 3)
+    piece[elements.ravel()] = np.repeat(tp, 3)
+    if np.any(piece[elements] != tp[:, None]):
+        raise ValueError("triangle_piece gives triangles that share a vertex different pieces")
     if nv and piece.min() < 0:
         return None
     # the piece of vertex 0 first, then that of the first vertex not in it, ...

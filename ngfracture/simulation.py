@@ -643,6 +643,7 @@ class Simulation:
         for part, seconds in status.phase_seconds().items():
             self.timings[part] += seconds
         self._iterations += status.iterations
+        self._notes.extend(n for n in status.notes if n not in self._notes)
         if not status.converged:
             raise StepFailed(status.reason, phase, status.message)
         return [], tangent

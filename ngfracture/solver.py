@@ -99,6 +99,8 @@ class SolveStatus:
         they exert on the dofs); empty without general rows.
     first_increment : float
         Euclidean norm of the first increment du^(0) (0 before any iteration).
+    notes : list of str
+        Fallbacks the solve took (a carried factorisation given up for a fresh one).
     """
     converged: bool = False
     reason: str = "max_iterations"
@@ -111,6 +113,7 @@ class SolveStatus:
         ("assemble", "factorize", "solve", "residual", "checks"), 0.0))
     multipliers: np.ndarray = field(default_factory=lambda: np.zeros(0))
     first_increment: float = 0.0
+    notes: list = field(default_factory=list)
 
     def __bool__(self):
         return self.converged
@@ -182,6 +185,10 @@ class SavedTangent:
     def __init__(self, lineage=None):
         self.fixed_dofs = self.support = self.factor = self.state = self.residual = None
         self.lineage = lineage
+
+    def forget(self):
+        """Empty it, lineage included: the next solve factorises its own tangent."""
+        self.__init__()
 
     def carry_over(self, problem, fixed_dofs, support):
         """Take the bordered factorisation of the lineage for this solve, if it applies.
@@ -334,7 +341,10 @@ class NewtonSolver:
         SolveStatus
             Failures (floating body, singular system, NaN, divergence, inverted element,
             no convergence) are reported here, not raised; on failure the displacement and
-            the load factor are those of the last converged load step.
+            the load factor are those of the last converged load step. A solve through a
+            factorisation carried across a crack pass (split_factor.BorderedFactor) that
+            finds it singular is made again with the split mesh's own factorisation,
+            recorded in ``notes``.
 
         Raises
         ------
@@ -342,6 +352,21 @@ class NewtonSolver:
             If ``load_steps`` is not a positive integer, or if the constructor's
             ``linear_solver`` is unknown (raised at the first factorisation).
         """
+        status = self._solve(load_steps)
+        saved = self.tangent
+        if status.reason == "singular" and saved is not None and isinstance(saved.factor, BorderedFactor):
+            failed = status
+            saved.forget()
+            status = self._solve(load_steps)
+            status.iterations += failed.iterations
+            for phase, seconds in failed.timings.items():
+                status.timings[phase] += seconds
+            status.notes.append("a factorisation carried across a crack pass was singular; the split "
+                                "mesh was solved with its own factorisation")
+        return status
+
+    def _solve(self, load_steps):
+        """The solve of :meth:`solve` with the tangent it is given."""
         if isinstance(load_steps, bool) or not isinstance(load_steps, int) or load_steps < 1:
             raise ValueError(f"load_steps must be a positive integer, got {load_steps!r}")
         prob = self.problem

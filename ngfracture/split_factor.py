@@ -26,7 +26,10 @@ tangent of the start of its load step; the residual is the new mesh's own. A bor
 larger than :func:`border_capacity` dofs, fixed dofs or pins that do not carry over (a new
 fragment, a split on a constrained boundary with a free parent) take a fresh
 factorisation instead (:func:`BorderedFactor.build` returns None), as does a small mesh
-(``MIN_BASE_DOFS``), where a factorisation is cheaper than the bookkeeping.
+(``MIN_BASE_DOFS``), where a factorisation is cheaper than the bookkeeping. A border that
+its first solve finds singular (S_d; no case is known where build accepts one) makes the
+solve start again with the split mesh's own factorisation (solver.NewtonSolver.solve,
+recorded in its notes).
 """
 import time
 from dataclasses import dataclass, field
@@ -104,7 +107,10 @@ class BorderColumns:
     A neighbour's split leaves a column as it was: E^T sums the new vertex's couplings with
     both copies of the neighbour into the same base dofs, and each triangle keeps its element
     matrix. A chain has one buffer; only its latest factor may solve
-    (``chain["latest"]`` is that factor's ``generation``; an earlier one refuses).
+    (``chain["latest"]`` is that factor's ``generation``; an earlier one refuses), and only
+    the latest factor's columns are carried on (a factor built twice from one lineage, a
+    contact solve's second start, leaves its parent's columns stale: the next one starts a
+    buffer of its own).
 
     Parameters
     ----------
@@ -120,7 +126,8 @@ class BorderColumns:
     buffer : numpy.ndarray, shape (n, capacity), Fortran order
         Columns 0 .. len(keys) - 1 are Z.
     chain : dict
-        Shared by the chain: {"latest": generation of its latest factor}.
+        Shared by the chain: {"latest": generation of its latest factor, "made": number of
+        factors made}.
     generation : int
     unsolved : list of int
         Columns whose Z is not in the buffer yet (BorderedFactor solves them with its first
@@ -129,7 +136,7 @@ class BorderColumns:
     keys: list
     column_keys: list
     buffer: np.ndarray = field(repr=False)
-    chain: dict = field(default_factory=lambda: {"latest": 0})
+    chain: dict = field(default_factory=lambda: {"latest": 0, "made": 1})
     generation: int = 0
     unsolved: list = field(default_factory=list)
 
@@ -191,7 +198,6 @@ class BorderedFactor(FactorBase):
         Dofs not fixed; neither fixed nor pinned.
     base_dof : numpy.ndarray of int
         For every dof of the split mesh, the base dof it copies.
-
     """
 
     linear_solver = "direct"
@@ -286,9 +292,11 @@ class BorderedFactor(FactorBase):
         Bt = self._Bt
         column_keys = [Bt.indices[s:e].tobytes() + Bt.data[s:e].tobytes() for s, e in zip(Bt.indptr[:-1], Bt.indptr[1:])]
         m = len(keys)
-        old = len(carried.keys) if carried is not None else 0
+        current = carried is not None and carried.chain["latest"] == carried.generation
+        old = len(carried.keys) if current else 0
         if old and carried.keys == keys[:old] and carried.buffer.shape[1] >= m:
-            columns = BorderColumns(keys, column_keys, carried.buffer, carried.chain, carried.generation + 1)
+            columns = BorderColumns(keys, column_keys, carried.buffer, carried.chain, carried.chain["made"])
+            carried.chain["made"] += 1
             unsolved = set(carried.unsolved)
             solve = [i for i in range(old) if i in unsolved or carried.column_keys[i] != column_keys[i]]
             solve += list(range(old, m))

@@ -90,13 +90,20 @@ class _Appended:
 
 
 def _escape(text):
-    return str(text).replace("&", "&amp;").replace('"', "&quot;").replace("<", "&lt;").replace(">", "&gt;")
+    text = str(text)
+    if any(ord(c) < 32 for c in text):
+        raise ValueError(f"ngfracture.vtkxml: the name {text!r} has control characters")
+    return text.replace("&", "&amp;").replace('"', "&quot;").replace("<", "&lt;").replace(">", "&gt;")
 
 
-def _attributes(tag, arrays, appended, indent):
-    """PointData / CellData: the first array is the active scalars (ParaView colours by it)."""
+def _attributes(tag, arrays, appended, indent, rows):
+    """PointData / CellData (``rows`` entries each): the first array is the active scalars
+    (ParaView colours by it)."""
     if not arrays:
         return [f"{indent}<{tag}/>"]
+    for name, values in arrays.items():
+        if len(values) != rows:
+            raise ValueError(f"ngfracture.vtkxml: {tag} array {name!r} has {len(values)} rows, expected {rows}")
     first = next(iter(arrays))
     lines = [f'{indent}<{tag} Scalars="{_escape(first)}">']
     lines += [appended.data_array(name, values, indent + "  ") for name, values in arrays.items()]
@@ -162,14 +169,15 @@ def unstructured_grid(points, triangles, point_data=None, cell_data=None, field_
     Raises
     ------
     ValueError
-        Unknown compression, or points / triangles of the wrong shape.
+        Unknown compression, points / triangles of the wrong shape, an array without one
+        row per point / triangle, a name with control characters.
     TypeError
         An array of a dtype VTK has no type for.
     """
     p, t = _check(compression, points, triangles, 3)
     appended = _Appended(compression)
-    body = (_attributes("PointData", point_data, appended, "      ")
-            + _attributes("CellData", cell_data, appended, "      ")
+    body = (_attributes("PointData", point_data, appended, "      ", len(p))
+            + _attributes("CellData", cell_data, appended, "      ", len(t))
             + ["      <Points>", appended.data_array("Points", p, "        "), "      </Points>",
                "      <Cells>"] + _cell_arrays(appended, t, "        ")
             + [appended.data_array("types", np.full(len(t), VTK_TRIANGLE, dtype=np.uint8), "        "),
@@ -201,8 +209,8 @@ def poly_lines(points, lines, point_data=None, compression="zlib"):
     """
     p, s = _check(compression, points, lines, 2)
     appended = _Appended(compression)
-    body = (_attributes("PointData", point_data, appended, "      ")
-            + _attributes("CellData", {}, appended, "      ")
+    body = (_attributes("PointData", point_data, appended, "      ", len(p))
+            + _attributes("CellData", {}, appended, "      ", len(s))
             + ["      <Points>", appended.data_array("Points", p, "        "), "      </Points>",
                "      <Lines>"] + _cell_arrays(appended, s, "        ") + ["      </Lines>"])
     piece = (f'NumberOfPoints="{len(p)}" NumberOfVerts="0" NumberOfLines="{len(s)}" '

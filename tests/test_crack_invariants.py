@@ -156,7 +156,8 @@ if __name__ == "__main__":
 def test_pieces_from_the_engines_fragments_equal_the_graph_search():
     """rigid.pieces_of_triangles on the crack engine's fragments gives the very count and
     numbering of rigid.pieces (connected components of the vertex graph) on shattered meshes,
-    and refuses (None) a vertex in no triangle."""
+    returns None for a vertex in no triangle and refuses labels that are not per triangle
+    or split a piece."""
     from ngfracture import rigid
     rng = np.random.default_rng(7)
     mesh = netgen_square(0.08)
@@ -173,3 +174,7 @@ def test_pieces_from_the_engines_fragments_equal_the_graph_search():
         checked += count > 1
     assert checked >= 3
     assert rigid.pieces_of_triangles(T, mesh.nv + 1, res.fragment) is None
+    with pytest.raises(ValueError, match="one entry per triangle"):
+        rigid.pieces_of_triangles(T, mesh.nv, res.fragment[1:])
+    with pytest.raises(ValueError, match="share a vertex different pieces"):
+        rigid.pieces_of_triangles(T, mesh.nv, np.arange(len(T)))

@@ -68,5 +68,9 @@ def test_bad_input_is_refused():
         vtkxml.unstructured_grid(points, tris[:, :2])
     with pytest.raises(ValueError, match=r"points must have shape"):
         vtkxml.poly_lines(np.zeros(4), np.zeros((0, 2), dtype=int))
+    with pytest.raises(ValueError, match="CellData array 'f' has 3 rows, expected 8"):
+        vtkxml.unstructured_grid(points, tris, cell_data={"f": np.zeros(3)})
+    with pytest.raises(ValueError, match="control characters"):
+        vtkxml.unstructured_grid(points, tris, {"a\nb": np.zeros(len(points))})
     with pytest.raises(TypeError, match="complex128 have no VTK type"):
         vtkxml.unstructured_grid(points, tris, {"z": np.zeros(len(points), dtype=complex)})
