@@ -72,8 +72,9 @@ class SolveStatus:
     ----------
     converged, reason, message, iterations, steps, increment_history, residual_history
         Initial values of the attributes of the same names (below).
-    timings, multipliers, first_increment
-        Likewise; by default a dict of zeros for the five phases, an empty array and 0.
+    timings, multipliers, first_increment, notes
+        Likewise; by default a dict of zeros for the five phases, an empty array, 0 and an
+        empty list.
 
     Attributes
     ----------
