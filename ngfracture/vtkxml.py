@@ -139,6 +139,13 @@ def _check(compression, points, cells, corners):
     return p3, c.reshape(-1, corners).astype(np.int64)
 
 
+def _data_and_points(appended, point_data, cell_data, points, ncells):
+    """The lines of a piece before its cells: point data, cell data, points."""
+    return (_attributes("PointData", point_data, appended, "      ", len(points))
+            + _attributes("CellData", cell_data, appended, "      ", ncells)
+            + ["      <Points>", appended.data_array("Points", points, "        "), "      </Points>"])
+
+
 def _cell_arrays(appended, cells, indent):
     corners = cells.shape[1]
     offsets = np.arange(corners, corners * len(cells) + 1, corners, dtype=np.int64)
@@ -176,10 +183,8 @@ def unstructured_grid(points, triangles, point_data=None, cell_data=None, field_
     """
     p, t = _check(compression, points, triangles, 3)
     appended = _Appended(compression)
-    body = (_attributes("PointData", point_data, appended, "      ", len(p))
-            + _attributes("CellData", cell_data, appended, "      ", len(t))
-            + ["      <Points>", appended.data_array("Points", p, "        "), "      </Points>",
-               "      <Cells>"] + _cell_arrays(appended, t, "        ")
+    body = (_data_and_points(appended, point_data, cell_data, p, len(t))
+            + ["      <Cells>"] + _cell_arrays(appended, t, "        ")
             + [appended.data_array("types", np.full(len(t), VTK_TRIANGLE, dtype=np.uint8), "        "),
                "      </Cells>"])
     return _file("UnstructuredGrid", f'NumberOfPoints="{len(p)}" NumberOfCells="{len(t)}"', body,
@@ -209,10 +214,8 @@ def poly_lines(points, lines, point_data=None, compression="zlib"):
     """
     p, s = _check(compression, points, lines, 2)
     appended = _Appended(compression)
-    body = (_attributes("PointData", point_data, appended, "      ", len(p))
-            + _attributes("CellData", {}, appended, "      ", len(s))
-            + ["      <Points>", appended.data_array("Points", p, "        "), "      </Points>",
-               "      <Lines>"] + _cell_arrays(appended, s, "        ") + ["      </Lines>"])
+    body = (_data_and_points(appended, point_data, {}, p, len(s))
+            + ["      <Lines>"] + _cell_arrays(appended, s, "        ") + ["      </Lines>"])
     piece = (f'NumberOfPoints="{len(p)}" NumberOfVerts="0" NumberOfLines="{len(s)}" '
              f'NumberOfStrips="0" NumberOfPolys="0"')
     return _file("PolyData", piece, body, None, appended)
