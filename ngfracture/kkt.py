@@ -264,15 +264,23 @@ class FactorBase:
         dense = R.toarray()
         KR = self.K @ dense
         KR[~self.free] = 0.0
-        rounding = 64 * np.finfo(float).eps * (abs(self.K) @ np.abs(dense))
+        K = sp.csr_matrix(self.K)
+        K_abs = sp.csr_matrix((np.abs(K.data), K.indices, K.indptr), shape=K.shape)   # |K|, no index copies
+        rounding = 64 * np.finfo(float).eps * (K_abs @ np.abs(dense))
         stiff = np.flatnonzero(np.any(np.abs(KR) > rounding, axis=0))
-        Rt = dense.copy()
         if len(stiff):
+            Rt = dense.copy()
             Rt[:, stiff] -= self.solve(KR[:, stiff])
-        KRt = self.K @ Rt
+            KRt = self.K @ Rt
+        else:
+            Rt, KRt = dense, KR          # every mode as it is: K Rt is K R (only free rows count)
         A = Rt[self.free].T @ KRt[self.free]
         A = 0.5 * (A + A.T)
-        Rt = sp.csr_matrix(Rt)
+        if len(stiff):
+            Rt = sp.csr_matrix(Rt)
+        else:
+            Rt = R.copy()
+            Rt.eliminate_zeros()         # as the conversion from the dense array would
         self._modes = (key, Rt, A)
         return Rt, A
 
