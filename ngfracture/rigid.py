@@ -222,11 +222,35 @@ def analyse_support(x, elements, n, ndof, fixed_dofs, components=None):
             cols.append((dofs, np.full(dofs.size, len(cols), dtype=np.int64), N[:, j]))
         unheld.append((p, N.shape[1]))
     if cols:
-        row, col, data = (np.concatenate(part) for part in zip(*cols))
-        modes = sp.csc_matrix((data, (row, col)), shape=(ndof, len(cols)))
+        # column j holds its piece's dofs in increasing order: the CSC arrays directly
+        row, _, data = (np.concatenate(part) for part in zip(*cols))
+        indptr = np.concatenate([[0], np.cumsum([len(dofs) for dofs, _, _ in cols])])
+        modes = sp.csc_matrix((data, row, indptr), shape=(ndof, len(cols)))
     else:
         modes = sp.csc_matrix((ndof, 0))
     return Support(modes, np.array(pins, dtype=np.int64), unheld)
+
+
+def _groups(link):
+    """Connected components of a symmetric boolean adjacency (k, k), numbered like scipy's
+    connected_components (by smallest member); a search over the dense rows for a few
+    dozen nodes, where scipy's call costs a millisecond."""
+    k = link.shape[0]
+    if k > 64:
+        return connected_components(sp.csr_matrix(link) + sp.identity(k), directed=False)
+    group = np.full(k, -1, dtype=np.int32)
+    count = 0
+    for start in range(k):
+        if group[start] >= 0:
+            continue
+        group[start] = count
+        frontier = [start]
+        while frontier:
+            reached = np.flatnonzero(link[frontier].any(axis=0) & (group < 0))
+            group[reached] = count
+            frontier = reached.tolist()
+        count += 1
+    return count, group
 
 
 def unheld_mode_rows(C, modes, rtol=RANK_RTOL):
@@ -255,8 +279,7 @@ def unheld_mode_rows(C, modes, rtol=RANK_RTOL):
     # group is much cheaper than slicing a sparse matrix
     G = (sp.csr_matrix(C) @ modes).toarray() if C.shape[0] else np.zeros((0, k))
     # modes coupled through rows form groups; each group is a small dense problem
-    link = sp.csr_matrix(np.abs(G).T @ np.abs(G))
-    ngroups, group = connected_components(link + sp.identity(k), directed=False)
+    ngroups, group = _groups(np.abs(G).T @ np.abs(G) != 0.0)
     rows = []
     for gidx in range(ngroups):
         cols = np.flatnonzero(group == gidx)

@@ -165,3 +165,20 @@ def test_refinement_repairs_an_inaccurate_solve(pinned, monkeypatch):
 
     assert min(relative_residuals(0)) > 1e-8
     assert max(relative_residuals(refinements)) <= 1e-11
+
+
+def test_mode_groups_are_numbered_as_scipys_connected_components():
+    """rigid._groups (a dense search for few modes) gives scipy's count and numbering on
+    random symmetric couplings of 1 to 100 modes (above 64 it is scipy's call)."""
+    import scipy.sparse as sp
+    from scipy.sparse.csgraph import connected_components
+    from ngfracture import rigid
+    rng = np.random.default_rng(0)
+    for k in [1, 2, 3, 5, 10, 30, 64, 65, 100]:
+        for _ in range(10):
+            G = rng.standard_normal((int(rng.integers(0, 6)), k)) * (rng.random(k) < 0.5)
+            G[rng.random(G.shape) < 0.7] = 0.0
+            link = np.abs(G).T @ np.abs(G)
+            count, group = connected_components(sp.csr_matrix(link) + sp.identity(k), directed=False)
+            mine = rigid._groups(link != 0.0)
+            assert mine[0] == count and np.array_equal(mine[1], group) and mine[1].dtype == group.dtype
