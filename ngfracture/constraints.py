@@ -301,8 +301,8 @@ class ConstraintSet:
             a = self._arrays
             if a is not None and self.fes.globalorder == 1:
                 # first order: the dofs are the vertices of the boundary's segments
-                ids = [i for i, name in enumerate(a.bc_names, start=1) if name in key]
-                self._dofs_on[key] = np.unique(a.segments[np.isin(a.seg_bc, ids)].astype(np.int64))
+                segments = np.concatenate([a.boundary_segments(name) for name in key])
+                self._dofs_on[key] = np.unique(segments.astype(np.int64))
             else:
                 names = set(key)
                 dofs = [d for el in self.fes.Elements(ng.BND) if el.mat in names for d in el.dofs if 0 <= d < n]

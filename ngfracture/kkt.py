@@ -272,17 +272,15 @@ class FactorBase:
             Rt = dense.copy()
             Rt[:, stiff] -= self.solve(KR[:, stiff])
             KRt = self.K @ Rt
+            Rt_sparse = sp.csr_matrix(Rt)
         else:
             Rt, KRt = dense, KR          # every mode as it is: K Rt is K R (only free rows count)
+            Rt_sparse = R.copy()
+            Rt_sparse.eliminate_zeros()  # as the conversion from the dense array would
         A = Rt[self.free].T @ KRt[self.free]
         A = 0.5 * (A + A.T)
-        if len(stiff):
-            Rt = sp.csr_matrix(Rt)
-        else:
-            Rt = R.copy()
-            Rt.eliminate_zeros()         # as the conversion from the dense array would
-        self._modes = (key, Rt, A)
-        return Rt, A
+        self._modes = (key, Rt_sparse, A)
+        return Rt_sparse, A
 
     def columns(self, C):
         """Z = K^+ C^T (ndof, m); rows met in the last call are not solved again.

@@ -23,8 +23,9 @@ import numpy as np
 
 
 #: from this many triangles on a netgen mesh's topology is built in NGSolve's task manager
-#: (as ElasticProblem builds its space from PARALLEL_MIN_DOFS // 2): the same numbering, in 17 ms instead of 28 ms at 31k triangles (two threads); below it
-#: starting the task manager costs more than it saves
+#: (as ElasticProblem builds its space from PARALLEL_MIN_DOFS // 2): the same numbering,
+#: in 17 ms instead of 28 ms at 31k triangles (two threads); below it starting the task
+#: manager costs more than it saves
 PARALLEL_MIN_TRIANGLES = 10000
 
 

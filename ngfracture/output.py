@@ -322,23 +322,26 @@ def _fsync_dir(folder):
         os.close(fd)
 
 
-def _atomic_bytes(path, data, force):
-    """Write bytes to path through a synced temp file; refuse an existing path unless force."""
+def _atomic_bytes(path, data, force, sync=True):
+    """Write bytes to path through a temp file in its folder; refuse an existing path unless
+    force. ``sync``: the file and the folder are synced (False for a time series' step
+    files: the collection written after them syncs the folder)."""
     path = Path(path)
     fd, tmp = tempfile.mkstemp(prefix=".tmp_ngf_", suffix=path.suffix, dir=path.parent)
     try:
         with os.fdopen(fd, "wb") as fh:
             fh.write(data)
-            fh.flush()
-            os.fsync(fh.fileno())
-        _publish(tmp, path, force)
+            if sync:
+                fh.flush()
+                os.fsync(fh.fileno())
+        _publish(tmp, path, force, sync)
     except BaseException:
         if os.path.exists(tmp):
             os.unlink(tmp)
         raise
 
 
-def _publish(tmp, path, force):
+def _publish(tmp, path, force, sync=True):
     """Rename tmp to path; without force, a link that fails if path exists (no race)."""
     if force:
         os.replace(tmp, path)
@@ -348,26 +351,13 @@ def _publish(tmp, path, force):
         except FileExistsError:
             raise FileExistsError(f"ngfracture.output: {path} exists; pass force=True to overwrite it") from None
         os.unlink(tmp)
-    _fsync_dir(Path(path).parent)
+    if sync:
+        _fsync_dir(Path(path).parent)
 
 
 #: compressions of the binary VTK arrays: lz4 through VTK's writer (its setter, used by
 #: _save_vtk), the others written by :mod:`ngfracture.vtkxml` (no VTK import, no setter)
 _COMPRESSIONS = {"lz4": "SetCompressorTypeToLZ4", "zlib": None, "lzma": None, None: None}
-
-
-def _replace_bytes(path, data):
-    """Write bytes through a temp file in the same folder, then rename over path."""
-    path = Path(path)
-    fd, tmp = tempfile.mkstemp(prefix=".tmp_ngf_", suffix=path.suffix, dir=path.parent)
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
 
 
 def _save_vtk(obj, path, compression):
@@ -562,9 +552,11 @@ class TimeSeriesWriter:
             _save_vtk(_vtk_cracks(mesh, u, crack_boundary, arrays=a), vtp, self.compression)
         else:
             _, points, cells = _mesh_fields(mesh, u, fragment, strain, point_data, cell_data, arrays=a)
-            _replace_bytes(vtu, vtkxml.unstructured_grid(a.points, a.triangles, points, cells,
-                                                         {"region_names": _region_names(a)}, self.compression))
-            _replace_bytes(vtp, vtkxml.poly_lines(*_crack_fields(mesh, u, crack_boundary, a), self.compression))
+            grid = vtkxml.unstructured_grid(a.points, a.triangles, points, cells,
+                                            {"region_names": _region_names(a)}, self.compression)
+            _atomic_bytes(vtu, grid, force=True, sync=False)
+            lines = vtkxml.poly_lines(*_crack_fields(mesh, u, crack_boundary, a), self.compression)
+            _atomic_bytes(vtp, lines, force=True, sync=False)
         self.steps.append((step, time))
         self._write_collections()
         return vtu, vtp

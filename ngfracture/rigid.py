@@ -216,15 +216,15 @@ def analyse_support(x, elements, n, ndof, fixed_dofs, components=None):
         # pin the dofs that best resolve these modes (column-pivoted QR)
         _, _, piv = sla.qr(N.T, pivoting=True, mode="economic")
         pins.extend(dofs[piv[:N.shape[1]]].tolist())
-        # one triplet block per mode: a sparse matrix per column cost 50 ms per call
-        # with 20 pieces (scipy's construction overhead)
+        # one column per mode, built at the end: a sparse matrix per column cost 50 ms per
+        # call with 20 pieces (scipy's construction overhead)
         for j in range(N.shape[1]):
-            cols.append((dofs, np.full(dofs.size, len(cols), dtype=np.int64), N[:, j]))
+            cols.append((dofs, N[:, j]))
         unheld.append((p, N.shape[1]))
     if cols:
         # column j holds its piece's dofs in increasing order: the CSC arrays directly
-        row, _, data = (np.concatenate(part) for part in zip(*cols))
-        indptr = np.concatenate([[0], np.cumsum([len(dofs) for dofs, _, _ in cols])])
+        row, data = (np.concatenate(part) for part in zip(*cols))
+        indptr = np.concatenate([[0], np.cumsum([len(dofs) for dofs, _ in cols])])
         modes = sp.csc_matrix((data, row, indptr), shape=(ndof, len(cols)))
     else:
         modes = sp.csc_matrix((ndof, 0))
