@@ -87,7 +87,7 @@ def _positive_float(text):
 CONTROL_OPTIONS = [
     ("max_new_cracks", "int0", "split vertices allowed in the first crack pass after an increment "
                                "before dx is cut (the scene's default, else 2)"),
-    ("method", ("modified", "full"), "Newton variant: modified (tangent once per load step, the paper's) "
+    ("method", ("modified", "full"), "Newton variant: modified (tangent at most once per load step, the paper's) "
                                      "or full"),
     ("tol", "float", "Newton tolerance (relative increment, paper eq. 7; default 1e-10)"),
     ("maxit", "int1", "Newton iterations per solve (default 60)"),

@@ -403,7 +403,7 @@ class ContactSolver:
         return status
 
     @single_threaded_blas()
-    def solve(self, warm=(), lineage=None):
+    def solve(self, warm=(), lineage=None, start=None):
         """Solve for equilibrium with contact.
 
         The problem's rows labelled "contact" are replaced by the active set of each round
@@ -423,6 +423,9 @@ class ContactSolver:
         lineage : split_factor.Lineage, optional
             The problem's mesh was split from a solved one: its solves start from that
             factorisation, bordered by the split (see solver.SavedTangent).
+        start : solver.SavedTangent, optional
+            A factorised tangent of this mesh to start from (the solve before at another
+            load, simulation.py); each start takes it afresh (``SavedTangent.kept``).
 
         Returns
         -------
@@ -436,28 +439,28 @@ class ContactSolver:
         uncracked = prob.fragments()[0] == 1 and "crack" not in prob.mesh.GetBoundaries()
         warm = set() if uncracked else set(warm)
         if not warm:
-            return self._solve(warm, uncracked, lineage)
+            return self._solve(warm, uncracked, lineage, start)
         u, load = prob.u.vec.FV().NumPy().copy(), prob.load_factor.Get()
-        result = self._solve(warm, uncracked, lineage)
+        result = self._solve(warm, uncracked, lineage, start)
         if result.converged:
             return result
         # rows of the pass before can hold a shattered piece in a nearly singular way
         # (measured: a plate at critical strain 1e-12); the plain path decides then
         prob.u.vec.FV().NumPy()[:] = u
         prob.load_factor.Set(load)
-        plain = self._solve(set(), uncracked, lineage)
+        plain = self._solve(set(), uncracked, lineage, start)
         plain.notes.append(f"the warm start from {len(warm)} contact rows failed ({result.reason}); "
                            "solved from the prediction without rows")
         for phase, seconds in result.timings.items():
             plain.timings[phase] = plain.timings.get(phase, 0.0) + seconds
         return plain
 
-    def _solve(self, warm, uncracked, lineage):
+    def _solve(self, warm, uncracked, lineage, start):
         """The solve of :meth:`solve` from the given warm keys (a set, maybe empty)."""
         prob = self.problem
         prob.constraints.clear_rows(LABEL)
         # the rounds are at the load of the prediction: they reuse its factorised tangent
-        tangent = SavedTangent(lineage)
+        tangent = start.kept() if start is not None else SavedTangent(lineage)
         result = ContactResult(None, notes=list(self._notes), tangent=tangent)
         scale = None        # the first increment of the first solve
         if not warm:

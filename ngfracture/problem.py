@@ -426,20 +426,25 @@ class ElasticProblem:
         count, piece = self._pieces
         return count, piece.copy()
 
-    def support(self, rows):
+    def support(self, rows, u=None):
         """The rigid modes that single-dof rows leave free, with pins to factorise around them.
 
         Parameters
         ----------
         rows : ConstraintRows
             The assembled constraints (only ``fixed_dofs`` is used).
+        u : numpy.ndarray, optional
+            A displacement (ndof,) to take the configuration from instead of the current one.
 
         Returns
         -------
         rigid.Support
-            Modes at the current configuration.
+            Modes at the current configuration (or at ``u``).
         """
-        x = self._points + vertex_displacement(self.u)
+        if u is None:
+            x = self._points + vertex_displacement(self.u)
+        else:    # component-blocked dofs, vertices first (as vertex_displacement reads them)
+            x = self._points + np.asarray(u, dtype=float).reshape(2, -1)[:, :self.mesh.nv].T
         return rigid.analyse_support(x, self._elements, self.fes.ndof // 2, self.fes.ndof, rows.fixed_dofs,
                                      self.fragments())
 

@@ -13,8 +13,9 @@ One load step, from an accepted state (mesh, displacement, load parameter x)::
        row without a crack, dx = min(dx * grow, dx_max).
 
 A failed solve (diverged, NaN, singular, inverted element, contact set that does not
-settle) sends the step back to the saved state: with modified Newton, the first retry
-solves the same attempt with full Newton (the tangent factorised at the start of a solve
+settle) sends the step back to the saved state: an increment solve that started from
+the tangent kept from the step before is made again with a tangent of its own; with
+modified Newton, the next retry solves the same attempt with full Newton (the tangent factorised at the start of a solve
 can be too far from the state that new contact rows impose: measured on the disk, Newton
 diverged with the saved tangent and converged with fresh ones); then a failure of the
 increment solve is retried with the same target in twice as many Newton load steps (the
@@ -39,6 +40,12 @@ Where the paper is vague, we chose:
 * Every accepted state goes through the checkpoint's mesh representation (arrays and
   back) whether or not it is written, so a resumed run continues from bitwise the
   same mesh and displacement as the uninterrupted one.
+* The factorised tangent of a step's last solve starts the next step's increment solve
+  (modified Newton, same mesh, at least ``KEEP_MIN_DOFS`` factorised dofs) while that
+  solve contracted by ``KEEP_MAX_CONTRACTION`` or better: the paper's modified Newton
+  factorises at every load step, and a tangent from a few load steps back converges as
+  fast on glass strains (docs/performance.md). The displacement it was assembled at is
+  in the checkpoint, so a resumed run factorises the same tangent again.
 * External work is the trapezoidal sum of reaction forces times the increments of
   the prescribed displacements; relaxation at fixed load does no work, so
   work - elastic energy is the energy released by cracking.
@@ -63,11 +70,21 @@ from .loadpath import load_path_cut, prescribed_increment
 from .materials import Material
 from .meshio import MeshArrays, mesh_from_arrays, mesh_to_arrays
 from .problem import ElasticProblem
+from .kkt import EliminatedFactor
 from .solver import SavedTangent
 
 #: wall time per phase; "linear" (factorisations and triangular solves) and "assembly"
 #: (NGSolve's residual and tangent assembly) are parts of "solve"
 PHASES = ("solve", "linear", "assembly", "strain", "split", "rebuild", "collision", "contact", "output")
+
+#: a step's factorised tangent starts the next step's solve from this many factorised dofs
+#: on; below, a factorisation costs a few solves (the bordered factors' threshold) ...
+KEEP_MIN_DOFS = split_factor.MIN_BASE_DOFS
+
+#: ... and while its last solve contracted by this ratio or better (its increments fell by
+#: 1e3 or more per iteration): at most one iteration more than a fresh tangent at tol
+#: 1e-10, where a factorisation costs 15 to 30 solves (the plate at 2.9k and 31k dofs)
+KEEP_MAX_CONTRACTION = 1e-3
 
 
 @dataclass
@@ -218,7 +235,8 @@ class StepControl:
     max_relax_passes : int
         Crack passes at fixed load at most (a bound, not a tuning knob).
     method : {"modified", "full"}
-        Newton variant (paper: modified, tangent factorised once per load step). A step
+        Newton variant (paper: modified, tangent factorised once per load step; kept for
+        the next step while it contracts as well, see the module docstring). A step
         whose modified Newton solve fails is retried with full Newton first.
     tol : float
         Newton tolerance of eq. 7.
@@ -401,6 +419,12 @@ class State:
     contact_keys : list of tuple
         Keys of the active contact rows at this state: the first contact solve of the next
         step starts from them (ContactSolver.solve, ``warm``).
+    tangent_state : numpy.ndarray or None
+        The displacement the factorised tangent kept for the next step was assembled at
+        (None: the next step factorises its own).
+    tangent : solver.SavedTangent or None
+        That factorisation, if this process made it (not in checkpoints: a resumed run
+        makes it again from ``tangent_state``).
     """
     arrays: MeshArrays
     u: np.ndarray            # P1 displacement vector, VectorH1 layout
@@ -416,6 +440,8 @@ class State:
     history: list            # one dict per accepted step
     strength: np.ndarray = None
     contact_keys: list = field(default_factory=list)
+    tangent_state: np.ndarray = None
+    tangent: object = field(default=None, repr=False, compare=False)
 
 
 def round_trip(mesh):
@@ -603,12 +629,13 @@ class Simulation:
             return False
         return self.scene.contact or "crack" in mesh.GetBoundaries()
 
-    def _equilibrium(self, prob, phase, substeps=1, warm=(), lineage=None):
+    def _equilibrium(self, prob, phase, substeps=1, warm=(), lineage=None, start=None):
         """Solve in ``substeps`` load steps; returns (the keys of the active contact rows,
         the solver.SavedTangent the solve ended with).
 
         ``warm``: the active contact keys of the solve before (ContactSolver.solve).
         ``lineage``: the mesh was split from a solved one (split_factor.py).
+        ``start``: a factorised tangent of this mesh to start from (State.tangent).
         Raises StepFailed(reason, phase) if the solve does not converge.
         """
         c = self.control
@@ -617,7 +644,7 @@ class Simulation:
             solver = ContactSolver(prob, tol=self.scene.contact_tol,   # its tol: detection threshold
                                    fix_free_modes=self.scene.fix_free_modes)
             solver.options.update(options)                              # Newton's tol, method, maxit
-            result = solver.solve(warm=warm, lineage=lineage)
+            result = solver.solve(warm=warm, lineage=lineage, start=start)
             self.timings["solve"] += result.timings["solve"]
             self.timings["contact"] += result.timings["contact"] - result.timings.get("collision", 0.0)
             self.timings["collision"] += result.timings.get("collision", 0.0)
@@ -637,7 +664,7 @@ class Simulation:
                 raise StepFailed(result.reason, phase, message)
             return result.active_keys, result.tangent
         t0 = time.perf_counter()
-        tangent = SavedTangent(lineage)
+        tangent = start.kept() if start is not None else SavedTangent(lineage)
         status = prob.solve(fix_free_modes=self.scene.fix_free_modes, tangent=tangent, **options)
         self.timings["solve"] += time.perf_counter() - t0
         for part, seconds in status.phase_seconds().items():
@@ -705,16 +732,18 @@ class Simulation:
                 res.nsplit, strength, inherited)
 
     # -- one load step ----------------------------------------------------------------------------
-    def _attempt(self, state, dx, substeps=1):
+    def _attempt(self, state, dx, substeps=1, keep=True):
         """Try the step x + dx from an accepted state; returns (problem, first-pass cracks, total cracks,
-        vertex strength, active contact keys).
+        vertex strength, active contact keys, the solver.SavedTangent of the last solve).
 
+        ``keep``: start from the tangent the state keeps (if any, modified Newton).
         Raises StepFailed on a failed solve and returns None for too many cracks.
         """
         self._x_try = state.x + dx
         self._split_positions = []      # per pass: reference positions of the vertices split
         prob = self._problem(self._mesh, self._x_try, state.u)
-        keys, tangent = self._equilibrium(prob, "increment", substeps, warm=state.contact_keys)
+        start = self._kept_tangent(state, prob) if keep and self._method == "modified" else None
+        keys, tangent = self._equilibrium(prob, "increment", substeps, warm=state.contact_keys, start=start)
         self._dwork = self._increment_work(state, prob)
         new_prob, first, strength, inherited = self._crack_pass(prob, state.strength, tangent)
         c = self.control
@@ -732,7 +761,32 @@ class Simulation:
                 break     # the run ends with this step: no crack in the separated pieces
             new_prob, n, strength, inherited = self._crack_pass(prob, strength, tangent)
             total += n
-        return prob, first, total, strength, keys
+        return prob, first, total, strength, keys, tangent
+
+    def _kept_tangent(self, state, prob):
+        """The factorised tangent the state keeps for ``prob`` (its mesh), or None.
+
+        A resumed run factorises it again at the displacement it was assembled at.
+        """
+        if state.tangent_state is None:
+            return None
+        if state.tangent is not None:
+            return state.tangent
+        t0 = time.perf_counter()
+        tangent = SavedTangent.assembled_at(prob, state.tangent_state)
+        for phase in ("solve", "linear"):
+            self.timings[phase] += time.perf_counter() - t0
+        return tangent
+
+    def _tangent_to_keep(self, tangent):
+        """What the accepted state keeps of the last solve's tangent (see the module docstring)."""
+        factor = tangent.factor if tangent is not None else None
+        if (self._method != "modified" or not isinstance(factor, EliminatedFactor) or factor.linear_solver != "direct"
+                or tangent.state is None or tangent.contraction is None
+                or tangent.contraction > KEEP_MAX_CONTRACTION
+                or np.count_nonzero(factor.factor_free) < KEEP_MIN_DOFS):
+            return None
+        return tangent.kept()
 
     @staticmethod
     def _increment_work(state, prob):
@@ -749,7 +803,7 @@ class Simulation:
         dg = rows.fixed_values[pos[same]] - state.fixed_values[same]
         return float(0.5 * np.dot(state.reactions[same] + r_new, dg))
 
-    def _accept(self, state, dx, prob, first, total, strength, contact_keys):
+    def _accept(self, state, dx, prob, first, total, strength, contact_keys, tangent):
         arrays, mesh = round_trip(prob.mesh)
         u = prob.u.vec.FV().NumPy().copy()
         # the solve ended at u (kept by the problem, no assembly); the round trip keeps the dof numbers
@@ -780,6 +834,9 @@ class Simulation:
                     work=state.work + dwork, reactions=reactions, fixed_values=rows.fixed_values.copy(),
                     fixed_dofs=rows.fixed_dofs.copy(), peak_energy=max(state.peak_energy, energy),
                     history=state.history + [record], strength=strength, contact_keys=contact_keys)
+        kept = self._tangent_to_keep(tangent)
+        if kept is not None:
+            new.tangent_state, new.tangent = kept.state, kept
         return new, prob, mesh, stats
 
     # -- the run ----------------------------------------------------------------------------------
@@ -796,8 +853,10 @@ class Simulation:
     def _step(self, state, dx):
         """Attempts of one step until one is accepted: (attempt, dx, None) or (None, dx, last failure).
 
-        Too many cracks: dx * cut. A failed solve with modified Newton: the same attempt with
-        full Newton (from then on for this step). A failed solve of the increment: the same target in twice
+        Too many cracks: dx * cut. A failed increment solve that started from the tangent the
+        state keeps: the same attempt with a tangent of its own (recorded in the notes). A
+        failed solve with modified Newton: the same attempt with full Newton (from then on
+        for this step). A failed solve of the increment: the same target in twice
         as many substeps (load steps of the Newton solver, no crack pass between them), so
         a passing trouble does not change the load path. A failed solve at fixed load
         (relaxation on a split mesh): dx * cut, substeps reset. Every attempt starts from
@@ -806,16 +865,22 @@ class Simulation:
         c = self.control
         self._retries, self._failures, substeps = 0, [], 1
         self._method = c.method
+        keep = True
+        notes = []
         while True:
-            self._iterations, self._notes = 0, []
+            self._iterations, self._notes = 0, list(notes)
             try:
-                attempt = self._attempt(state, dx, substeps)
+                attempt = self._attempt(state, dx, substeps, keep)
             except StepFailed as err:
                 self._retries += 1
                 self._failures.append(err.reason)
                 if self._retries > c.max_retries:
                     return None, dx, err
-                if self._method == "modified":
+                if keep and err.phase == "increment" and self._method == "modified" and state.tangent_state is not None:
+                    keep = False                    # the same attempt with its own tangent
+                    notes.append(f"the tangent kept from the step before failed ({err.reason}); "
+                                 "the step factorised its own")
+                elif self._method == "modified":
                     self._method = "full"           # the same attempt with fresh tangents
                 elif err.phase == "increment":
                     substeps *= 2
@@ -957,6 +1022,8 @@ class Simulation:
                   "fixed_values": state.fixed_values, "fixed_dofs": state.fixed_dofs}
         if state.strength is not None:
             arrays["strength"] = state.strength
+        if state.tangent_state is not None:
+            arrays["tangent_state"] = state.tangent_state
         meta = {"scene": self.scene.name, "parameters": self.scene.parameters,
                 "x": state.x, "dx": state.dx, "step": state.step, "quiet": state.quiet, "work": state.work,
                 "peak_energy": state.peak_energy, "history": state.history,
@@ -987,7 +1054,8 @@ class Simulation:
                      step=meta["step"], quiet=meta["quiet"], work=meta["work"], reactions=arrays["reactions"],
                      fixed_values=arrays["fixed_values"], fixed_dofs=arrays["fixed_dofs"],
                      peak_energy=meta["peak_energy"], history=meta["history"], strength=arrays.get("strength"),
-                     contact_keys=[tuple(k) for k in meta.get("contact_keys", [])])
+                     contact_keys=[tuple(k) for k in meta.get("contact_keys", [])],
+                     tangent_state=arrays.get("tangent_state"))
 
     def _path_options(self):
         """The options that decide the load path: a resumed run must have the same ones.

@@ -164,7 +164,9 @@ class SavedTangent:
 
     A SavedTangent made with a ``lineage`` (the problem's mesh was split from a solved one,
     split_factor.py) starts with the factorisation of the mesh before the split, bordered
-    by the split's dofs, where the fixed dofs and pins carry over.
+    by the split's dofs, where the fixed dofs and pins carry over. One made by
+    :meth:`kept` or :meth:`assembled_at` starts with a factorisation of the same mesh from
+    an earlier state (a load step before, simulation.py).
 
     Parameters
     ----------
@@ -180,16 +182,63 @@ class SavedTangent:
     residual : (numpy.ndarray, float, numpy.ndarray) or None
         (u, load factor, out-of-balance there) at the end of the last solve: the next solve
         at the same state starts from it without assembling it again.
+    contraction : float or None
+        How fast the last converged modified-Newton solve with this tangent contracted:
+        the ratio of its last two increments (0.0 when it needed fewer than three
+        iterations; None before any solve or after full Newton).
     lineage : split_factor.Lineage or None
     """
 
     def __init__(self, lineage=None):
         self.fixed_dofs = self.support = self.factor = self.state = self.residual = None
+        self.contraction = None
         self.lineage = lineage
 
     def forget(self):
         """Empty it, lineage included: the next solve factorises its own tangent."""
         self.__init__()
+
+    def kept(self):
+        """A new SavedTangent with this one's factorisation, for solves at another load.
+
+        Returns
+        -------
+        SavedTangent
+            The same fixed dofs, support, factorisation and state; no residual, no
+            contraction, no lineage.
+        """
+        other = SavedTangent()
+        other.fixed_dofs, other.support, other.factor, other.state = self.fixed_dofs, self.support, self.factor, self.state
+        return other
+
+    @classmethod
+    def assembled_at(cls, problem, state):
+        """The factorised tangent of ``problem`` at the displacement ``state``, as a solve
+        that started there would have made it (its support taken at ``state``, the default
+        direct solver): the same factorisation bit for bit.
+
+        Parameters
+        ----------
+        problem : ElasticProblem
+        state : numpy.ndarray
+            A displacement of the problem's space.
+
+        Returns
+        -------
+        SavedTangent
+
+        Raises
+        ------
+        SingularSystem
+            If the factorisation fails.
+        """
+        rows = problem.assemble_constraints()
+        support = problem.support(rows, state)
+        saved = cls()
+        saved.fixed_dofs, saved.support, saved.state = rows.fixed_dofs, support, np.array(state, dtype=float)
+        saved.factor = EliminatedFactor(problem.tangent(state), rows.fixed_dofs, support.pins)
+        saved.factor.factorise()
+        return saved
 
     def carry_over(self, problem, fixed_dofs, support):
         """Take the bordered factorisation of the lineage for this solve, if it applies.
@@ -573,6 +622,7 @@ class NewtonSolver:
                 status.message = f"stalled at relative increment {ratio:.1e}" if stalled and ratio >= self.tol else ""
                 if self.tangent is not None:
                     self.tangent.residual = (u.copy(), prob.load_factor.Get(), r)
+                    self.tangent.contraction = None if self.method == "full" else (rho if k >= 2 else 0.0)
                 return factor
             if not np.isfinite(ratio) or ratio > self.divergence_factor:
                 status.fail("diverged", f"increment grew to {ratio:.2e} times the first one")

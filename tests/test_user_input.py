@@ -153,8 +153,8 @@ def test_solver_notes_reach_history_and_summary(monkeypatch, tmp_path):
     import ngfracture.simulation as simulation
 
     class Noting(ContactSolver):
-        def solve(self, warm=(), lineage=None):
-            result = super().solve(warm, lineage)
+        def solve(self, warm=(), lineage=None, start=None):
+            result = super().solve(warm, lineage, start)
             result.notes.append("a note")
             return result
     monkeypatch.setattr(simulation, "ContactSolver", Noting)

@@ -1,0 +1,107 @@
+"""The factorised tangent a load step keeps for the next one (simulation.KEEP_MIN_DOFS).
+
+A step's increment solve starts from the factorisation of the step before when that one
+contracted well: the same cracks as fresh factorisations to the Newton tolerance, one
+factorisation less per step that starts from it, the same result after a resume, and a
+kept tangent that fails is replaced by a fresh one and recorded.
+"""
+import json
+
+import numpy as np
+import pyvista as pv
+
+from ngfracture import checkpoint, kkt, scenes, simulation
+from ngfracture.kkt import EliminatedFactor
+from ngfracture.simulation import Simulation, StepControl
+
+
+def counted_run(monkeypatch, scene, keep, **options):
+    """Run ``scene``; returns (result, factorisations, steps started from a kept tangent)."""
+    monkeypatch.setattr(simulation, "KEEP_MIN_DOFS", simulation.KEEP_MIN_DOFS if keep else 10**12)
+    count = {"factorisations": 0, "kept": 0}
+    factorise, kept_tangent = EliminatedFactor.factorise, Simulation._kept_tangent
+
+    def counting_factorise(self):
+        count["factorisations"] += not self.factorised
+        factorise(self)
+
+    def counting_kept(self, state, prob):
+        tangent = kept_tangent(self, state, prob)
+        count["kept"] += tangent is not None
+        return tangent
+
+    monkeypatch.setattr(kkt.EliminatedFactor, "factorise", counting_factorise)
+    monkeypatch.setattr(Simulation, "_kept_tangent", counting_kept)
+    result = Simulation(scene, pictures="none", **options).run()
+    monkeypatch.undo()
+    return result, count["factorisations"], count["kept"]
+
+
+def final_displacement(result):
+    return result.problem.u.vec.FV().NumPy().copy()
+
+
+def test_kept_tangent_gives_the_cracks_of_fresh_ones_with_one_factorisation_less_per_step(monkeypatch):
+    kept, n_kept_factor, n_started_kept = counted_run(monkeypatch, scenes.plate(), keep=True)
+    fresh, n_fresh_factor, n_fresh_started = counted_run(monkeypatch, scenes.plate(), keep=False)
+    a, b = kept.summary, fresh.summary
+    assert kept.ok and fresh.ok and n_fresh_started == 0
+    assert n_started_kept >= 1                       # the default plate has 2.9k factorised dofs
+    assert n_kept_factor == n_fresh_factor - n_started_kept
+    for key in ("n_steps", "n_split_vertices", "n_fragments", "reason"):
+        assert a[key] == b[key], key
+    # the results of the same Newton tolerance (1e-10 of the first increment)
+    assert abs(a["crack_length"] - b["crack_length"]) <= 1e-9 * b["crack_length"]
+    u, u_ref = final_displacement(kept), final_displacement(fresh)
+    assert np.linalg.norm(u - u_ref) <= 1e-9 * np.linalg.norm(u_ref)
+    # KEEP_MAX_CONTRACTION: at most one iteration more per step started from a kept tangent
+    assert sum(a["newton_iterations"]) <= sum(b["newton_iterations"]) + n_started_kept
+    assert not a["notes"]
+
+
+def test_resume_factorises_the_kept_tangent_again_and_equals_the_uninterrupted_run(monkeypatch, tmp_path):
+    monkeypatch.setattr(simulation, "KEEP_MIN_DOFS", 0)
+    scene = lambda: scenes.plate(maxh=0.06, radius=None)
+    full, part = tmp_path / "full", tmp_path / "part"
+    Simulation(scene(), out=full, pictures="none").run()
+    first = Simulation(scene(), StepControl(max_steps=3), out=part, pictures="none").run()
+    assert first.reason == "max_steps"
+    arrays, _ = checkpoint.latest(part)
+    assert "tangent_state" in arrays                 # the resumed run starts from a kept tangent
+    Simulation(scene(), out=part, resume=True, pictures="none").run()
+    a, b = (json.loads((d / "summary.json").read_text()) for d in (part, full))
+    for key in b:
+        if key not in ("timings", "control"):
+            assert a[key] == b[key], key
+    for n in range(b["n_steps"] + 1):
+        ga, gb = pv.read(part / f"step_{n:06d}.vtu"), pv.read(full / f"step_{n:06d}.vtu")
+        for name in gb.point_data:
+            assert np.array_equal(ga.point_data[name], gb.point_data[name]), (n, name)
+
+
+def test_a_kept_tangent_that_fails_is_replaced_by_a_fresh_one_and_recorded(monkeypatch):
+    scene = lambda: scenes.plate(maxh=0.06, radius=None)
+    fresh, _, _ = counted_run(monkeypatch, scene(), keep=False)
+    monkeypatch.setattr(simulation, "KEEP_MIN_DOFS", 0)
+    kept_tangent = Simulation._kept_tangent
+
+    def halved(self, state, prob):
+        """The kept tangent with half its stiffness: modified Newton oscillates and fails."""
+        tangent = kept_tangent(self, state, prob)
+        if tangent is None:
+            return None
+        bad = tangent.kept()
+        bad.factor = EliminatedFactor(0.5 * tangent.factor.K, tangent.fixed_dofs, tangent.support.pins)
+        return bad
+
+    monkeypatch.setattr(Simulation, "_kept_tangent", halved)
+    result = Simulation(scene(), pictures="none").run()
+    assert result.ok
+    noted = [n for n in result.summary["notes"] if "the tangent kept from the step before failed" in n["note"]]
+    assert noted
+    for record in result.summary["history"]:
+        assert (record["retries"] > 0) == any(n["step"] == record["step"] for n in noted)
+    # every step solved with its own tangent in the end: the fresh run's result, bit for bit
+    for key in ("n_steps", "n_split_vertices", "n_fragments", "crack_length", "fragment_areas"):
+        assert result.summary[key] == fresh.summary[key], key
+    assert np.array_equal(final_displacement(result), final_displacement(fresh))
