@@ -303,6 +303,29 @@ class FactorBase:
         SingularSystem
             From :meth:`solve`, if the rows not cached need a solve and it fails.
         """
+        return self.columns_and_solve(C, np.zeros((self.ndof, 0)))[0]
+
+    def columns_and_solve(self, C, B):
+        """:meth:`columns` of C and K^+ B, solved in one block: a block of right-hand sides
+        costs much less than as many single solves (memory-bound triangular solves).
+
+        Parameters
+        ----------
+        C : scipy.sparse matrix or array_like, shape (m, ndof)
+            Constraint rows.
+        B : numpy.ndarray, shape (ndof, k)
+            Right-hand sides, as for ``solve``.
+
+        Returns
+        -------
+        Z : numpy.ndarray, shape (ndof, m)
+        X : numpy.ndarray, shape (ndof, k)
+
+        Raises
+        ------
+        SingularSystem
+            From :meth:`solve`.
+        """
         C = sp.csr_matrix(C)
         keys = [C.indices[s:e].tobytes() + C.data[s:e].tobytes() for s, e in zip(C.indptr[:-1], C.indptr[1:])]
         Z = np.zeros((self.ndof, len(keys)))
@@ -312,10 +335,12 @@ class FactorBase:
                 Z[:, i] = self._columns[key]
             else:
                 new.append(i)
-        if new:
-            Z[:, new] = self.solve(C[new].T.toarray())
+        X = B
+        if new or B.shape[1]:
+            solved = self.solve(np.hstack([C[new].T.toarray(), B]))
+            Z[:, new], X = solved[:, :len(new)], solved[:, len(new):]
         self._columns = {key: Z[:, i] for i, key in enumerate(keys)}
-        return Z
+        return Z, X
 
 
 class EliminatedFactor(FactorBase):
@@ -713,6 +738,9 @@ class ConstrainedSolver:
         complement with pins and corrected modes. "auto" (default): "augmented" where K_ff
         is factorised by SuperLU with at most ``AUGMENTED_MAX_DOFS`` free dofs, with general rows and
         without ``dependent_rows``, else "schur".
+    first : (numpy.ndarray, numpy.ndarray), optional
+        (r, du_fixed) of the first :meth:`solve`, if the caller knows them: where the Schur
+        columns K^+ C^T are solved here, that solve's K^+ q is solved in the same block.
 
     Attributes
     ----------
@@ -732,7 +760,7 @@ class ConstrainedSolver:
     """
 
     def __init__(self, K, fixed_dofs, C, linear_solver="direct", inverse="auto", gmres_tol=1e-12,
-                 modes=None, pins=None, factor=None, dependent_rows=False, path="auto"):
+                 modes=None, pins=None, factor=None, dependent_rows=False, path="auto", first=None):
         if factor is None:
             factor = EliminatedFactor(K, fixed_dofs, pins, linear_solver, inverse, gmres_tol)
         elif not factor.matches(np.asarray(fixed_dofs, dtype=np.int64),
@@ -764,6 +792,7 @@ class ConstrainedSolver:
             raise ValueError("the augmented path needs independent general rows and a direct solver")
         self.path = path
         self._checked = False     # the augmented path checks the residual of its first solve
+        self._first = None        # (q, K^+ q) of the first solve, solved with the columns
         if path == "augmented":
             self._augmented = factor.augmented(self.C)
             return
@@ -775,6 +804,11 @@ class ConstrainedSolver:
                 # no columns: the displacement correction takes one more solve per solve
                 self._Z = None
                 S = factor.schur(self.C)
+            elif first is not None:
+                q = self._load(*first)
+                self._Z, X = factor.columns_and_solve(self.C, q[:, None])
+                self._first = (q.copy(), X[:, 0])
+                S = self.C @ self._Z
             else:
                 self._Z = factor.columns(self.C)
                 S = self.C @ self._Z
@@ -885,9 +919,7 @@ class ConstrainedSolver:
     def _solve_augmented(self, r, du_fixed, h):
         """One solve with the factorised augmented matrix (see EliminatedFactor.augmented)."""
         t0 = time.perf_counter()
-        q = r
-        if np.any(du_fixed):
-            q = r - self.K @ du_fixed
+        q = self._load(r, du_fixed)
         lu, row_scale = self._augmented
         rhs = np.concatenate([q[self.free], row_scale * (h - self.C @ du_fixed)])
         x = lu.solve(rhs)
@@ -921,11 +953,16 @@ class ConstrainedSolver:
         """K^+ C^T lam: from the kept columns, or by a solve where none are kept."""
         return self._Z @ lam if self._Z is not None else self.factor.solve(self._Ct @ lam)
 
+    def _load(self, r, du_fixed):
+        """The load q = r - K du_fixed: the prescribed increments moved over."""
+        return r - self.K @ du_fixed if np.any(du_fixed) else r
+
     def _unconstrained(self, r, du_fixed):
         """The load q with the prescribed increments moved over, and du = du_fixed + K^+ q."""
-        q = r
-        if np.any(du_fixed):
-            q = r - self.K @ du_fixed
+        q = self._load(r, du_fixed)
+        first, self._first = self._first, None
+        if first is not None and np.array_equal(q, first[0]):
+            return q, du_fixed + first[1]         # solved with the columns
         return q, du_fixed + self.factor.solve(q)
 
     def solve_unilateral(self, r, du_fixed, h, unilateral):

@@ -549,6 +549,12 @@ class NewtonSolver:
             r = self._out_of_balance()
         given = factor
         for k in range(self.maxit):
+            if not np.all(np.isfinite(r)):
+                status.fail("nan", f"the residual is NaN/inf at iteration {k}")
+                return None
+            du_fixed[:] = 0.0
+            du_fixed[rows.fixed_dofs] = target_fixed - u[rows.fixed_dofs]   # eq. 6
+            h = target_rows - rows.C @ u
             if kkt is None or (self.method == "full" and given is None):
                 try:
                     if given is None:
@@ -564,16 +570,11 @@ class NewtonSolver:
                     path = "auto" if self.method == "full" and given is None else "schur"
                     with _Timer(timings, "factorize"):
                         kkt = ConstrainedSolver(None, rows.fixed_dofs, rows.C, modes=support.modes,
-                                                pins=support.pins, factor=factor, path=path)
+                                                pins=support.pins, factor=factor, path=path,
+                                                first=(r, du_fixed))
                 except SingularSystem as err:
                     status.fail("singular", str(err))
                     return None
-            if not np.all(np.isfinite(r)):
-                status.fail("nan", f"the residual is NaN/inf at iteration {k}")
-                return None
-            du_fixed[:] = 0.0
-            du_fixed[rows.fixed_dofs] = target_fixed - u[rows.fixed_dofs]   # eq. 6
-            h = target_rows - rows.C @ u
             try:
                 with _Timer(timings, "solve"), prob.threads():
                     du, status.multipliers = kkt.solve(r, du_fixed, h)

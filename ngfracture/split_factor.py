@@ -379,11 +379,13 @@ class BorderedFactor(FactorBase):
         if B.shape[1]:
             bF = B[self._dofs]
             x = self._base_solve(self._Et @ bF)
-            XF = x[self._x]
             if len(self._border):
                 d = sla.lu_solve(self._Sd, bF[self._border] - self._Bt @ x)
-                XF -= (self._Z @ d)[self._x]
+                x -= self._Z @ d                  # on the base dofs, then copied out once
+                XF = x[self._x]
                 XF[self._border] += d
+            else:
+                XF = x[self._x]
             X[self._dofs] = XF
             if not np.all(np.isfinite(X)):
                 raise SingularSystem("the bordered factorisation produced NaN/inf")

@@ -98,6 +98,36 @@ def test_constrained_solve_equals_whole_kkt_solve(contact_state, path, inverse, 
     assert np.linalg.norm(lam - lam_ref) <= 1e-10 * np.linalg.norm(lam_ref)
 
 
+def test_first_solve_made_with_the_columns_saves_a_solve_and_equals_whole_kkt_solve(contact_state, monkeypatch):
+    """``first``: the first solve's K^+ q joins the block of the Schur columns; the same
+    solution as the whole KKT system (1e-10), one solve of the factorisation less."""
+    monkeypatch.setattr(kkt_module, "SPARSE_SCHUR_MIN_DOFS", 10 ** 9)
+    prob, rows, support, result = contact_state
+    K = to_scipy(prob.tangent())
+    ndof = prob.fes.ndof
+    free = np.ones(ndof, dtype=bool)
+    free[rows.fixed_dofs] = False
+    rng = np.random.default_rng(3)
+    r = np.where(free, rng.standard_normal(ndof), 0.0)
+    du_fixed = np.zeros(ndof)
+    du_fixed[rows.fixed_dofs] = 1e-3 * rng.standard_normal(rows.fixed_dofs.size)
+    h = 1e-3 * rng.standard_normal(rows.C.shape[0])
+    du_ref, lam_ref = whole_kkt_solution(K, rows, r, du_fixed, h)
+    calls = {}
+    for first in (None, (r, du_fixed)):
+        factor = kkt_module.EliminatedFactor(K, rows.fixed_dofs, support.pins)
+        solve, count = factor.solve, []
+        factor.solve = lambda B, solve=solve, count=count: count.append(B.shape) or solve(B)
+        kkt = ConstrainedSolver(None, rows.fixed_dofs, rows.C, modes=support.modes, pins=support.pins,
+                                factor=factor, path="schur", first=first)
+        du, lam = kkt.solve(r, du_fixed, h)
+        assert np.linalg.norm(du - du_ref) <= 1e-10 * np.linalg.norm(du_ref)
+        assert np.linalg.norm(lam - lam_ref) <= 1e-10 * np.linalg.norm(lam_ref)
+        calls[first is not None] = count
+    assert len(calls[True]) == len(calls[False]) - 1
+    assert (ndof, rows.C.shape[0] + 1) in calls[True]           # the columns and q in one block
+
+
 def test_sparse_schur_complement_and_complementarity_equal_the_columns(contact_state, monkeypatch):
     """C K^+ C^T from the sparse triangular solves equals C (K^+ C^T) from full solves to
     rounding (1e-13 of its largest entry), and the complementarity problem chooses the same
