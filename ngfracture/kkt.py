@@ -52,6 +52,7 @@ Failures are reported, never returned as numbers: a factorisation that produces
 NaN/inf or does not solve its own system is ``SingularSystem``.
 """
 import contextlib
+import copy
 import time
 import warnings
 
@@ -415,6 +416,24 @@ class EliminatedFactor(FactorBase):
                 raise SingularSystem(f"ILU factorisation failed: {err}") from None
             self._precond = spla.LinearOperator(Kff.shape, ilu.solve)
         self.seconds = time.perf_counter() - t0
+
+    def without_caches(self):
+        """The same factorisation, with none of the results kept from its solves.
+
+        It solves as a factor made afresh of the same matrix would, bit for bit: which rows
+        a block solve meets decides the block's rounding, so a factorisation carried to
+        another load step (solver.SavedTangent.kept) starts with no kept columns, as the
+        one a resumed run makes again.
+
+        Returns
+        -------
+        EliminatedFactor
+            Sharing the matrix and its factorisation (both read only).
+        """
+        other = copy.copy(self)
+        other._columns, other._reach, other._augmented = {}, {}, None
+        other.__dict__.pop("_modes", None)
+        return other
 
     @property
     def factorised(self):

@@ -204,11 +204,13 @@ class SavedTangent:
         Returns
         -------
         SavedTangent
-            The same fixed dofs, support, factorisation and state; no residual, no
+            The same fixed dofs, support, factorisation (an EliminatedFactor without the
+            results kept from its solves, ``without_caches``) and state; no residual, no
             contraction, no lineage.
         """
         other = SavedTangent()
-        other.fixed_dofs, other.support, other.factor, other.state = self.fixed_dofs, self.support, self.factor, self.state
+        other.fixed_dofs, other.support, other.state = self.fixed_dofs, self.support, self.state
+        other.factor = self.factor.without_caches() if isinstance(self.factor, EliminatedFactor) else self.factor
         return other
 
     @classmethod
