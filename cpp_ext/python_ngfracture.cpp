@@ -3,6 +3,7 @@
 #include "vertex_average.hpp"
 #include "internal_force.hpp"
 #include "sparse_triangular.hpp"
+#include "supernodal_solve.hpp"
 
 namespace py = pybind11;
 using namespace ngfracture;
@@ -222,6 +223,57 @@ Returns
     that cancel exactly included.)doc");
 }
 
+static void ExportSupernodalLDL (py::module & m)
+{
+  using I64 = py::array_t<int64_t, py::array::c_style | py::array::forcecast>;
+  using I32 = py::array_t<int32_t, py::array::c_style | py::array::forcecast>;
+  using F64 = py::array_t<double, py::array::c_style | py::array::forcecast>;
+  using F64F = py::array_t<double, py::array::f_style | py::array::forcecast>;
+  py::class_<SupernodalLDL>(m, "SupernodalLDL", R"doc(Solves with P A P^T = L D L^T, L kept in supernodes.
+
+Parameters
+----------
+n : int
+    Order.
+lp, li, lx : numpy.ndarray
+    CSC of the unit lower-triangular L (int64 pointers, int32 rows sorted within each
+    column, values); a stored unit diagonal is skipped.
+d : numpy.ndarray
+    The diagonal D (nonzero).
+perm : numpy.ndarray of int64
+    Row i of a right-hand side goes to row perm[i] of the permuted system, and x[i] is
+    row perm[i] of its solution.)doc")
+    .def(py::init([] (int64_t n, I64 lp, I32 li, F64 lx, F64 d, I64 perm)
+                  {
+                    if (n < 0 || lp.ndim() != 1 || lp.shape(0) != n + 1 || d.shape(0) != n || perm.shape(0) != n)
+                      throw py::value_error("ngfracture.SupernodalLDL: lp needs n + 1 entries, d and perm n");
+                    int64_t nnz = n ? lp.data()[n] : 0;
+                    if (li.shape(0) < nnz || lx.shape(0) < nnz)
+                      throw py::value_error("ngfracture.SupernodalLDL: li and lx need lp[n] entries");
+                    py::gil_scoped_release release;
+                    return new SupernodalLDL(n, lp.data(), li.data(), lx.data(), d.data(), perm.data());
+                  }),
+         py::arg("n"), py::arg("lp"), py::arg("li"), py::arg("lx"), py::arg("d"), py::arg("perm"))
+    .def("solve", [] (const SupernodalLDL & self, F64F b)
+         {
+           int64_t n = self.Order();
+           if (!(b.ndim() == 1 || b.ndim() == 2) || b.shape(0) != n)
+             throw py::value_error("ngfracture.SupernodalLDL.solve: b must have n = " + std::to_string(n) + " rows");
+           int64_t k = b.ndim() == 1 ? 1 : b.shape(1);
+           F64F x(b.ndim() == 1 ? std::vector<py::ssize_t>{n} : std::vector<py::ssize_t>{n, py::ssize_t(k)});
+           const double * in = b.data();
+           double * out = x.mutable_data();
+           {
+             py::gil_scoped_release release;
+             self.Solve(k, in, out);
+           }
+           return x;
+         }, py::arg("b"), "X = A^-1 B for a vector (n,) or a block (n, k); a new Fortran-ordered array.")
+    .def_property_readonly("supernodes", &SupernodalLDL::Supernodes, "Number of supernodes.")
+    .def_property_readonly("stored_entries", &SupernodalLDL::StoredEntries,
+                           "Entries of the panels (the diagonal blocks' upper parts included).");
+}
+
 PYBIND11_MODULE(_ngfracture, m)
 {
   m.doc() = "ngfracture's C++ kernels (vertex averaging, crack splitting, collision detection).";
@@ -229,6 +281,7 @@ PYBIND11_MODULE(_ngfracture, m)
   ExportInternalForces(m);
   ExportTangentStiffness(m);
   ExportSparseTriangular(m);
+  ExportSupernodalLDL(m);
   ExportCrack(m);
   ExportCollision(m);
 }

@@ -177,6 +177,15 @@ def reproducible_threads():
 #: faster than NGSolve's (117208 dofs: factorisation 2.2 s against 0.77 s).
 SUPERLU_MAX_DOFS = 40000
 
+#: from this many factorised dofs on, the triangular solves with SuperLU's factors go through
+#: ``_ngfracture.SupernodalLDL`` (L D L^T with L in dense supernodal panels, made once per
+#: factorisation), where every pivot was diagonal: one right-hand side 0.12 against 0.43 ms
+#: at 2.9k dofs, 1.6 against 4.2 ms at 16k, 5.7 against 10.3 ms at 31k (the plate's
+#: tangents); making it costs 5, 30 and 90 to 190 ms, paid back within a few dozen solves.
+#: Below, factorisations serve few solves each (contact rounds of the disks, full Newton)
+#: and SuperLU's own solve stays
+SUPERNODAL_MIN_DOFS = 2500
+
 #: from this many factorised dofs on (SuperLU), the Schur complement C K^-1 C^T is built by
 #: triangular solves that follow only the reach of each row's few nonzeros in the factors
 #: (EliminatedFactor.schur) instead of full solves for K^-1 C^T. Measured on the notched
@@ -400,6 +409,7 @@ class EliminatedFactor(FactorBase):
         self._reach = {}          # row key -> its sparse triangular solves (schur), last rows
         self._triangles = None    # the factors' arrays for the sparse triangular solves
         self._lu = None
+        self._ldl = None          # the supernodal L D L^T solver of the factors (SUPERNODAL_MIN_DOFS)
         self._free_block = None   # K on all free dofs (pins included), scipy CSC, made at first need
         self._checked = False     # direct solvers: the first solve checks its residual
         if inverse == "auto":
@@ -586,7 +596,7 @@ class EliminatedFactor(FactorBase):
     def _direct_solve(self, B, X):
         """X[factor_free] = K_ff^-1 B[factor_free] with the direct factorisation."""
         if self._lu is not None:
-            X[self.factor_free] = self._lu.solve(np.asfortranarray(B[self.factor_free]))
+            X[self.factor_free] = self._superlu_solve(B[self.factor_free])
         else:
             # one multi-vector solve instead of a Python loop over columns
             rhs = ng.MultiVector(self._tmp, B.shape[1])
@@ -618,7 +628,7 @@ class EliminatedFactor(FactorBase):
             If the solution has NaN/inf.
         """
         if self._lu is not None:
-            x = self._lu.solve(np.asfortranarray(b))
+            x = self._superlu_solve(b)
         else:
             B = np.zeros((self.ndof,) + b.shape[1:])
             B[self.factor_free] = b
@@ -626,6 +636,24 @@ class EliminatedFactor(FactorBase):
         if not np.all(np.isfinite(x)):
             raise SingularSystem("the factorised stiffness produced NaN/inf: singular (a floating body?)")
         return x
+
+    def _superlu_solve(self, b):
+        """K_ff^-1 b with SuperLU's factors: through the supernodal L D L^T solver where it
+        applies (``SUPERNODAL_MIN_DOFS``, every pivot diagonal), else SuperLU's own solve."""
+        if self._ldl is None:
+            lu = self._lu
+            n = lu.shape[0]
+            if n >= SUPERNODAL_MIN_DOFS and np.array_equal(lu.perm_r, lu.perm_c):
+                # diagonal pivots of the symmetric K_ff: U = D L^T (see schur)
+                L = lu.L.tocsc()
+                L.sort_indices()
+                self._ldl = _ext.SupernodalLDL(n, L.indptr.astype(np.int64), L.indices.astype(np.int32), L.data,
+                                               lu.U.diagonal(), lu.perm_r.astype(np.int64))
+            else:
+                self._ldl = False
+        if self._ldl is False:
+            return self._lu.solve(np.asfortranarray(b))
+        return self._ldl.solve(b)
 
     @property
     def sparse_schur(self):

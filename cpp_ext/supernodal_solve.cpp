@@ -1,0 +1,248 @@
+// Triangular solves with a symmetric factorisation L D L^T kept in supernodes (see the header).
+#include "supernodal_solve.hpp"
+#include <stdexcept>
+#include <string>
+
+namespace ngfracture
+{
+  SupernodalLDL::SupernodalLDL (int64_t n, const int64_t * lp, const int32_t * li, const double * lx,
+                                const double * d, const int64_t * perm)
+    : n_(n)
+  {
+    if (n < 0 || lp[0] != 0)
+      throw std::invalid_argument("SupernodalLDL: L must be CSC with lp[0] = 0");
+    // below[j]: the first entry of column j strictly below the diagonal
+    std::vector<int64_t> below(n);
+    for (int64_t j = 0; j < n; j++)
+      {
+        if (lp[j+1] < lp[j])
+          throw std::invalid_argument("SupernodalLDL: column pointers must not decrease");
+        int64_t p = lp[j];
+        if (p < lp[j+1] && li[p] == j) p++;           // the stored unit diagonal
+        below[j] = p;
+        for (int64_t q = p; q < lp[j+1]; q++)
+          if (li[q] <= j || li[q] >= n || (q > p && li[q] <= li[q-1]))
+            throw std::invalid_argument("SupernodalLDL: column " + std::to_string(j) +
+                                     " must hold rows below its diagonal, sorted");
+        if (!(d[j] != 0.0) || d[j] != d[j])
+          throw std::invalid_argument("SupernodalLDL: zero or NaN pivot " + std::to_string(j));
+      }
+    // column j + 1 continues the supernode of column j when its pattern below the diagonal
+    // is column j's without row j + 1
+    first_.push_back(0);
+    for (int64_t j = 0; j + 1 < n; j++)
+      {
+        int64_t a = below[j], la = lp[j+1] - a;
+        int64_t b = below[j+1], lb = lp[j+2] - b;
+        bool same = la == lb + 1 && la > 0 && li[a] == j + 1;
+        for (int64_t q = 0; same && q < lb; q++)
+          same = li[a + 1 + q] == li[b + q];
+        if (!same)
+          first_.push_back(j + 1);
+      }
+    if (n > 0) first_.push_back(n);
+    int64_t S = int64_t(first_.size()) - 1;
+    rowstart_.assign(1, 0);
+    valstart_.assign(1, 0);
+    for (int64_t s = 0; s < S; s++)
+      {
+        int64_t f = first_[s], c = first_[s+1] - f, last = f + c - 1;
+        int64_t r = c + (lp[last+1] - below[last]);
+        for (int64_t t = 0; t < c; t++)
+          rows_.push_back(int32_t(f + t));
+        for (int64_t q = below[last]; q < lp[last+1]; q++)
+          rows_.push_back(li[q]);
+        rowstart_.push_back(int64_t(rows_.size()));
+        int64_t at = int64_t(values_.size());
+        values_.resize(at + r * c, 0.0);
+        for (int64_t t = 0; t < c; t++)          // column f + t fills panel rows t + 1 .. r - 1
+          {
+            int64_t q = below[f + t];
+            for (int64_t i = t + 1; i < r; i++, q++)
+              values_[at + t * r + i] = lx[q];
+          }
+        valstart_.push_back(int64_t(values_.size()));
+      }
+    inv_d_.resize(n);
+    perm_.assign(perm, perm + n);
+    std::vector<char> seen(n, 0);
+    for (int64_t i = 0; i < n; i++)
+      {
+        inv_d_[i] = 1.0 / d[i];
+        if (perm_[i] < 0 || perm_[i] >= n || seen[perm_[i]])
+          throw std::invalid_argument("SupernodalLDL: perm is not a permutation of 0 .. n-1");
+        seen[perm_[i]] = 1;
+      }
+  }
+
+  void SupernodalLDL::Solve (int64_t k, const double * B, double * X) const
+  {
+    if (k > 1)
+      {
+        SolveBlock(k, B, X);
+        return;
+      }
+    int64_t n = n_, S = int64_t(first_.size()) - 1;
+    std::vector<double> z(n), work(n);
+    for (int64_t col = 0; col < k; col++)
+      {
+        const double * b = B + col * n;
+        double * x = X + col * n;
+        for (int64_t i = 0; i < n; i++)
+          z[perm_[i]] = b[i];
+        // L y = P b, supernode by supernode
+        for (int64_t s = 0; s < S; s++)
+          {
+            int64_t f = first_[s], c = first_[s+1] - f;
+            int64_t r = rowstart_[s+1] - rowstart_[s], m = r - c;
+            const int32_t * rows = rows_.data() + rowstart_[s] + c;
+            const double * P = values_.data() + valstart_[s];
+            double * zf = z.data() + f;
+            for (int64_t t = 0; t < c; t++)
+              {
+                const double * pc = P + t * r;
+                double zt = zf[t];
+                for (int64_t i = t + 1; i < c; i++)
+                  zf[i] -= pc[i] * zt;
+              }
+            double * acc = work.data();
+            for (int64_t i = 0; i < m; i++) acc[i] = 0.0;
+            for (int64_t t = 0; t < c; t++)
+              {
+                const double * pc = P + t * r + c;
+                double zt = zf[t];
+                for (int64_t i = 0; i < m; i++)
+                  acc[i] += pc[i] * zt;
+              }
+            for (int64_t i = 0; i < m; i++)
+              z[rows[i]] -= acc[i];
+          }
+        for (int64_t i = 0; i < n; i++)
+          z[i] *= inv_d_[i];
+        // L^T z = D^-1 y, supernodes in reverse
+        for (int64_t s = S - 1; s >= 0; s--)
+          {
+            int64_t f = first_[s], c = first_[s+1] - f;
+            int64_t r = rowstart_[s+1] - rowstart_[s], m = r - c;
+            const int32_t * rows = rows_.data() + rowstart_[s] + c;
+            const double * P = values_.data() + valstart_[s];
+            double * zf = z.data() + f;
+            double * g = work.data();
+            for (int64_t i = 0; i < m; i++)
+              g[i] = z[rows[i]];
+            for (int64_t t = c - 1; t >= 0; t--)
+              {
+                const double * pc = P + t * r;
+                // four partial sums in a fixed order: vectorised, and the same on every run
+                double a0 = 0.0, a1 = 0.0, a2 = 0.0, a3 = 0.0;
+                int64_t i = 0;
+                for (; i + 4 <= m; i += 4)
+                  {
+                    a0 += pc[c + i] * g[i];
+                    a1 += pc[c + i + 1] * g[i + 1];
+                    a2 += pc[c + i + 2] * g[i + 2];
+                    a3 += pc[c + i + 3] * g[i + 3];
+                  }
+                for (; i < m; i++)
+                  a0 += pc[c + i] * g[i];
+                double sum = (a0 + a1) + (a2 + a3);
+                for (int64_t j = t + 1; j < c; j++)
+                  sum += pc[j] * zf[j];
+                zf[t] -= sum;
+              }
+          }
+        for (int64_t i = 0; i < n; i++)
+          x[i] = z[perm_[i]];
+      }
+  }
+
+  // K right-hand sides at once, interleaved (row i's K values side by side): every panel is
+  // read once per solve direction for all of them; K is fixed at compile time so that the
+  // loops over the right-hand sides unroll
+  template <int K>
+  static void SolveInterleaved (int64_t n, const std::vector<int64_t> & first, const std::vector<int64_t> & rowstart,
+                                const std::vector<int32_t> & rows_all, const std::vector<int64_t> & valstart,
+                                const std::vector<double> & values, const std::vector<double> & inv_d,
+                                const std::vector<int64_t> & perm, const double * B, double * X)
+  {
+    int64_t S = int64_t(first.size()) - 1;
+    std::vector<double> z(n * K), work(n * K);
+    for (int j = 0; j < K; j++)
+      for (int64_t i = 0; i < n; i++)
+        z[perm[i] * K + j] = B[j * n + i];
+    for (int64_t s = 0; s < S; s++)
+      {
+        int64_t f = first[s], c = first[s+1] - f;
+        int64_t r = rowstart[s+1] - rowstart[s], m = r - c;
+        const int32_t * rows = rows_all.data() + rowstart[s] + c;
+        const double * P = values.data() + valstart[s];
+        double * zf = z.data() + f * K;
+        for (int64_t t = 0; t < c; t++)
+          {
+            const double * pc = P + t * r;
+            double zt[K];
+            for (int j = 0; j < K; j++) zt[j] = zf[t * K + j];
+            for (int64_t i = t + 1; i < c; i++)
+              for (int j = 0; j < K; j++)
+                zf[i * K + j] -= pc[i] * zt[j];
+          }
+        double * acc = work.data();
+        for (int64_t i = 0; i < m * K; i++) acc[i] = 0.0;
+        for (int64_t t = 0; t < c; t++)
+          {
+            const double * pc = P + t * r + c;
+            double zt[K];
+            for (int j = 0; j < K; j++) zt[j] = zf[t * K + j];
+            for (int64_t i = 0; i < m; i++)
+              for (int j = 0; j < K; j++)
+                acc[i * K + j] += pc[i] * zt[j];
+          }
+        for (int64_t i = 0; i < m; i++)
+          for (int j = 0; j < K; j++)
+            z[rows[i] * K + j] -= acc[i * K + j];
+      }
+    for (int64_t i = 0; i < n; i++)
+      for (int j = 0; j < K; j++)
+        z[i * K + j] *= inv_d[i];
+    for (int64_t s = S - 1; s >= 0; s--)
+      {
+        int64_t f = first[s], c = first[s+1] - f;
+        int64_t r = rowstart[s+1] - rowstart[s], m = r - c;
+        const int32_t * rows = rows_all.data() + rowstart[s] + c;
+        const double * P = values.data() + valstart[s];
+        double * zf = z.data() + f * K;
+        double * g = work.data();
+        for (int64_t i = 0; i < m; i++)
+          for (int j = 0; j < K; j++)
+            g[i * K + j] = z[rows[i] * K + j];
+        for (int64_t t = c - 1; t >= 0; t--)
+          {
+            const double * pc = P + t * r;
+            double sum[K] = {};
+            for (int64_t i = 0; i < m; i++)
+              for (int j = 0; j < K; j++)
+                sum[j] += pc[c + i] * g[i * K + j];
+            for (int64_t i = t + 1; i < c; i++)
+              for (int j = 0; j < K; j++)
+                sum[j] += pc[i] * zf[i * K + j];
+            for (int j = 0; j < K; j++)
+              zf[t * K + j] -= sum[j];
+          }
+      }
+    for (int j = 0; j < K; j++)
+      for (int64_t i = 0; i < n; i++)
+        X[j * n + i] = z[perm[i] * K + j];
+  }
+
+  // the columns in groups of four (then two, then one)
+  void SupernodalLDL::SolveBlock (int64_t k, const double * B, double * X) const
+  {
+    int64_t n = n_, j = 0;
+    for (; j + 4 <= k; j += 4)
+      SolveInterleaved<4>(n, first_, rowstart_, rows_, valstart_, values_, inv_d_, perm_, B + j * n, X + j * n);
+    for (; j + 2 <= k; j += 2)
+      SolveInterleaved<2>(n, first_, rowstart_, rows_, valstart_, values_, inv_d_, perm_, B + j * n, X + j * n);
+    if (j < k)
+      Solve(1, B + j * n, X + j * n);
+  }
+}

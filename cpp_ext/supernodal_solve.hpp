@@ -1,0 +1,39 @@
+#ifndef NGFRACTURE_SUPERNODAL_SOLVE_HPP
+#define NGFRACTURE_SUPERNODAL_SOLVE_HPP
+#include <cstdint>
+#include <vector>
+
+namespace ngfracture
+{
+  // Solves with a symmetric factorisation P A P^T = L D L^T (L unit lower triangular, D
+  // diagonal) for dense right-hand sides, L kept in supernodes: runs of columns with the
+  // same pattern below their diagonal block, packed as dense column-major panels. One solve
+  // reads every panel twice (L, then L^T) with one row index per panel row instead of one
+  // per entry, and updates the solution through contiguous gathers and scatters.
+  class SupernodalLDL
+  {
+  public:
+    // L: n x n CSC (column j holds the unit diagonal, optional, and the entries below it;
+    // rows sorted within a column); d: D; perm: x = A^-1 b is z = L^-T D^-1 L^-1 (b permuted:
+    // row i of b goes to row perm[i]), x[i] = z[perm[i]].
+    SupernodalLDL (int64_t n, const int64_t * lp, const int32_t * li, const double * lx,
+                   const double * d, const int64_t * perm);
+    // X = A^-1 B for k right-hand sides, B and X n x k column-major (may be the same array).
+    void Solve (int64_t k, const double * B, double * X) const;
+    int64_t Order () const { return n_; }
+    int64_t Supernodes () const { return int64_t(first_.size()) - 1; }
+    int64_t StoredEntries () const { return int64_t(values_.size()); }
+
+  private:
+    void SolveBlock (int64_t k, const double * B, double * X) const;
+    int64_t n_;
+    std::vector<int64_t> first_;     // first column of supernode s (first_[S] = n)
+    std::vector<int64_t> rowstart_;  // its rows: rows_[rowstart_[s] .. rowstart_[s+1])
+    std::vector<int32_t> rows_;      // the diagonal block's columns first, then the rows below
+    std::vector<int64_t> valstart_;  // its panel: values_[valstart_[s] ...], column-major
+    std::vector<double> values_;
+    std::vector<double> inv_d_;
+    std::vector<int64_t> perm_;
+  };
+}
+#endif
