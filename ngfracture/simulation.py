@@ -15,9 +15,10 @@ One load step, from an accepted state (mesh, displacement, load parameter x)::
 A failed solve (diverged, NaN, singular, inverted element, contact set that does not
 settle) sends the step back to the saved state: an increment solve that started from
 the tangent kept from the step before is made again with a tangent of its own; with
-modified Newton, the next retry solves the same attempt with full Newton (the tangent factorised at the start of a solve
-can be too far from the state that new contact rows impose: measured on the disk, Newton
-diverged with the saved tangent and converged with fresh ones); then a failure of the
+modified Newton, the next retry solves the same attempt with full Newton (the tangent
+factorised at the start of a solve can be too far from the state that new contact rows
+impose: measured on the disk, Newton diverged with the saved tangent and converged with
+fresh ones); then a failure of the
 increment solve is retried with the same target in twice as many Newton load steps (the
 load path does not change), a failure at fixed load after a split with dx * cut; after ``max_retries``
 failures the run stops with the last good state written and a reason.  The run ends when x reaches the scene's ``load_max``, after ``max_steps``
@@ -65,12 +66,11 @@ from .contact_solver import ContactSolver, fragment_overlap_area
 from .crack import (GROWTH_RULES, PAPER_RULES, StrainCriterion, element_strain, equivalent_strain,
                     nonlocal_opening, split_by_tensor, transfer_vertex_field)
 from .fragments import FragmentStatistics
-from .kkt import single_threaded_blas
+from .kkt import EliminatedFactor, SingularSystem, single_threaded_blas
 from .loadpath import load_path_cut, prescribed_increment
 from .materials import Material
 from .meshio import MeshArrays, mesh_from_arrays, mesh_to_arrays
 from .problem import ElasticProblem
-from .kkt import EliminatedFactor
 from .solver import SavedTangent
 
 #: wall time per phase; "linear" (factorisations and triangular solves) and "assembly"
@@ -773,9 +773,13 @@ class Simulation:
         if state.tangent is not None:
             return state.tangent
         t0 = time.perf_counter()
-        tangent = SavedTangent.assembled_at(prob, state.tangent_state)
-        for phase in ("solve", "linear"):
-            self.timings[phase] += time.perf_counter() - t0
+        try:
+            tangent = SavedTangent.assembled_at(prob, state.tangent_state)
+        except SingularSystem as err:
+            raise StepFailed("singular", "increment", f"the kept tangent: {err}") from None
+        finally:
+            for phase in ("solve", "linear"):
+                self.timings[phase] += time.perf_counter() - t0
         return tangent
 
     def _tangent_to_keep(self, tangent):

@@ -60,6 +60,19 @@ def contact_state(request):
     return prob, rows, support, result
 
 
+def random_kkt_load(ndof, rows, seed):
+    """A random right-hand side of the eliminated KKT system: (r, du_fixed, h), zero force at
+    the fixed dofs."""
+    free = np.ones(ndof, dtype=bool)
+    free[rows.fixed_dofs] = False
+    rng = np.random.default_rng(seed)
+    r = np.where(free, rng.standard_normal(ndof), 0.0)
+    du_fixed = np.zeros(ndof)
+    du_fixed[rows.fixed_dofs] = 1e-3 * rng.standard_normal(rows.fixed_dofs.size)
+    h = 1e-3 * rng.standard_normal(rows.C.shape[0])
+    return r, du_fixed, h
+
+
 def whole_kkt_solution(K, rows, r, du_fixed, h):
     """du and the multipliers of the general rows from one sparse LU of the whole system."""
     ndof, nfix = K.shape[0], rows.fixed_dofs.size
@@ -81,14 +94,7 @@ def test_constrained_solve_equals_whole_kkt_solve(contact_state, path, inverse, 
     assert n_contact > 0 and np.any(result.multipliers < 0)     # pieces pressed together
     K = prob.tangent()
     Ks = to_scipy(K)
-    ndof = prob.fes.ndof
-    free = np.ones(ndof, dtype=bool)
-    free[rows.fixed_dofs] = False
-    rng = np.random.default_rng(11)
-    r = np.where(free, rng.standard_normal(ndof), 0.0)
-    du_fixed = np.zeros(ndof)
-    du_fixed[rows.fixed_dofs] = 1e-3 * rng.standard_normal(rows.fixed_dofs.size)
-    h = 1e-3 * rng.standard_normal(rows.C.shape[0])
+    r, du_fixed, h = random_kkt_load(prob.fes.ndof, rows, seed=11)
     kkt = ConstrainedSolver(K, rows.fixed_dofs, rows.C, inverse=inverse, modes=support.modes, pins=support.pins,
                             path=path)
     assert kkt.path == path and (kkt.path == "schur" and kkt._Z is None) == sparse_schur
@@ -105,13 +111,7 @@ def test_first_solve_made_with_the_columns_saves_a_solve_and_equals_whole_kkt_so
     prob, rows, support, result = contact_state
     K = to_scipy(prob.tangent())
     ndof = prob.fes.ndof
-    free = np.ones(ndof, dtype=bool)
-    free[rows.fixed_dofs] = False
-    rng = np.random.default_rng(3)
-    r = np.where(free, rng.standard_normal(ndof), 0.0)
-    du_fixed = np.zeros(ndof)
-    du_fixed[rows.fixed_dofs] = 1e-3 * rng.standard_normal(rows.fixed_dofs.size)
-    h = 1e-3 * rng.standard_normal(rows.C.shape[0])
+    r, du_fixed, h = random_kkt_load(ndof, rows, seed=3)
     du_ref, lam_ref = whole_kkt_solution(K, rows, r, du_fixed, h)
     calls = {}
     for first in (None, (r, du_fixed)):

@@ -26,7 +26,7 @@ from ngfracture.simulation import Simulation
 from ngfracture.solver import _base_pins
 
 from test_contact_fractured import crack_bands, plate_mesh
-from test_kkt_paths import whole_kkt_solution
+from test_kkt_paths import random_kkt_load, whole_kkt_solution
 
 H = 0.1
 
@@ -100,14 +100,7 @@ def test_bordered_solve_equals_whole_kkt_solve_in_contact(split_in_contact, spar
     kkt = ConstrainedSolver(None, rows.fixed_dofs, rows.C, modes=support.modes, pins=support.pins,
                             factor=factor, path="schur")
     assert (kkt._Z is None) == sparse_schur
-    ndof = prob.fes.ndof
-    free = np.ones(ndof, dtype=bool)
-    free[rows.fixed_dofs] = False
-    rng = np.random.default_rng(3)
-    r = np.where(free, rng.standard_normal(ndof), 0.0)
-    du_fixed = np.zeros(ndof)
-    du_fixed[rows.fixed_dofs] = 1e-3 * rng.standard_normal(rows.fixed_dofs.size)
-    h = 1e-3 * rng.standard_normal(rows.C.shape[0])
+    r, du_fixed, h = random_kkt_load(prob.fes.ndof, rows, seed=3)
     du, lam = kkt.solve(r, du_fixed, h)
     du_ref, lam_ref = whole_kkt_solution(factor.K, rows, r, du_fixed, h)
     assert np.linalg.norm(du - du_ref) <= 1e-10 * np.linalg.norm(du_ref)
