@@ -1,5 +1,6 @@
 // Triangular solves with a symmetric factorisation L D L^T kept in supernodes (see the header).
 #include "supernodal_solve.hpp"
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -11,12 +12,13 @@ namespace ngfracture
   {
     if (n < 0 || lp[0] != 0)
       throw std::invalid_argument("SupernodalLDL: L must be CSC with lp[0] = 0");
+    for (int64_t j = 0; j < n; j++)        // all of them before any entry is read: lp[n] bounds li
+      if (lp[j+1] < lp[j])
+        throw std::invalid_argument("SupernodalLDL: column pointers must not decrease");
     // below[j]: the first entry of column j strictly below the diagonal
     std::vector<int64_t> below(n);
     for (int64_t j = 0; j < n; j++)
       {
-        if (lp[j+1] < lp[j])
-          throw std::invalid_argument("SupernodalLDL: column pointers must not decrease");
         int64_t p = lp[j];
         if (p < lp[j+1] && li[p] == j) p++;           // the stored unit diagonal
         below[j] = p;
@@ -24,8 +26,8 @@ namespace ngfracture
           if (li[q] <= j || li[q] >= n || (q > p && li[q] <= li[q-1]))
             throw std::invalid_argument("SupernodalLDL: column " + std::to_string(j) +
                                      " must hold rows below its diagonal, sorted");
-        if (!(d[j] != 0.0) || d[j] != d[j])
-          throw std::invalid_argument("SupernodalLDL: zero or NaN pivot " + std::to_string(j));
+        if (d[j] == 0.0 || !std::isfinite(d[j]))
+          throw std::invalid_argument("SupernodalLDL: zero or non-finite pivot " + std::to_string(j));
       }
     // column j + 1 continues the supernode of column j when its pattern below the diagonal
     // is column j's without row j + 1

@@ -441,7 +441,7 @@ class EliminatedFactor(FactorBase):
             Sharing the matrix and its factorisation (both read only).
         """
         other = copy.copy(self)
-        other._columns, other._reach, other._augmented = {}, {}, None
+        other._columns, other._reach, other._augmented, other._checked = {}, {}, None, False
         other.__dict__.pop("_modes", None)
         return other
 
@@ -647,8 +647,11 @@ class EliminatedFactor(FactorBase):
                 # diagonal pivots of the symmetric K_ff: U = D L^T (see schur)
                 L = lu.L.tocsc()
                 L.sort_indices()
-                self._ldl = _ext.SupernodalLDL(n, L.indptr.astype(np.int64), L.indices.astype(np.int32), L.data,
-                                               lu.U.diagonal(), lu.perm_r.astype(np.int64))
+                try:
+                    self._ldl = _ext.SupernodalLDL(n, L.indptr.astype(np.int64), L.indices.astype(np.int32),
+                                                   L.data, lu.U.diagonal(), lu.perm_r.astype(np.int64))
+                except ValueError as err:      # a zero or non-finite pivot: K_ff is singular
+                    raise SingularSystem(f"the sparse LU factors cannot be solved with: {err}") from None
             else:
                 self._ldl = False
         if self._ldl is False:

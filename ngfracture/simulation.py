@@ -44,9 +44,9 @@ Where the paper is vague, we chose:
 * The factorised tangent of a step's last solve starts the next step's increment solve
   (modified Newton, same mesh, at least ``KEEP_MIN_DOFS`` factorised dofs) while that
   solve contracted by ``KEEP_MAX_CONTRACTION`` or better: the paper's modified Newton
-  factorises at every load step, and a tangent from a few load steps back converges as
-  fast on glass strains (docs/performance.md). The displacement it was assembled at is
-  in the checkpoint, so a resumed run factorises the same tangent again.
+  factorises at every load step, and a tangent from a few load steps back converges in as
+  many iterations on glass strains (docs/solvers.md, path 7). The displacement it was
+  assembled at is in the checkpoint, so a resumed run factorises the same tangent again.
 * External work is the trapezoidal sum of reaction forces times the increments of
   the prescribed displacements; relaxation at fixed load does no work, so
   work - elastic energy is the energy released by cracking.
@@ -384,11 +384,13 @@ class StepFailed(Exception):
     phase : {"increment", "relaxation"}
         The solve of the increment, or one at fixed load after a split.
     message : str
+    from_kept : bool
+        The increment solve started from the tangent kept from the step before.
     """
 
-    def __init__(self, reason, phase, message):
+    def __init__(self, reason, phase, message, from_kept=False):
         super().__init__(f"{reason} ({phase}): {message}")
-        self.reason, self.phase, self.message = reason, phase, message
+        self.reason, self.phase, self.message, self.from_kept = reason, phase, message, from_kept
 
 
 @dataclass
@@ -743,7 +745,10 @@ class Simulation:
         self._split_positions = []      # per pass: reference positions of the vertices split
         prob = self._problem(self._mesh, self._x_try, state.u)
         start = self._kept_tangent(state, prob) if keep and self._method == "modified" else None
-        keys, tangent = self._equilibrium(prob, "increment", substeps, warm=state.contact_keys, start=start)
+        try:
+            keys, tangent = self._equilibrium(prob, "increment", substeps, warm=state.contact_keys, start=start)
+        except StepFailed as err:
+            raise StepFailed(err.reason, err.phase, err.message, from_kept=start is not None) from None
         self._dwork = self._increment_work(state, prob)
         new_prob, first, strength, inherited = self._crack_pass(prob, state.strength, tangent)
         c = self.control
@@ -766,29 +771,35 @@ class Simulation:
     def _kept_tangent(self, state, prob):
         """The factorised tangent the state keeps for ``prob`` (its mesh), or None.
 
-        A resumed run factorises it again at the displacement it was assembled at.
+        None also where the increment fixes other dofs than the tangent was factorised for
+        (the solve would not use it). A resumed run factorises it again at the displacement
+        it was assembled at, once per state.
         """
         if state.tangent_state is None:
             return None
-        if state.tangent is not None:
-            return state.tangent
-        t0 = time.perf_counter()
-        try:
-            tangent = SavedTangent.assembled_at(prob, state.tangent_state)
-        except SingularSystem as err:
-            raise StepFailed("singular", "increment", f"the kept tangent: {err}") from None
-        finally:
-            for phase in ("solve", "linear"):
-                self.timings[phase] += time.perf_counter() - t0
-        return tangent
+        if not np.array_equal(prob.assemble_constraints().fixed_dofs, state.fixed_dofs):
+            return None
+        if state.tangent is None:
+            t0 = time.perf_counter()
+            try:
+                state.tangent = SavedTangent.assembled_at(prob, state.tangent_state, state.fixed_dofs)
+            except SingularSystem as err:
+                raise StepFailed("singular", "increment", f"the kept tangent: {err}", from_kept=True) from None
+            finally:
+                for phase in ("solve", "linear"):
+                    self.timings[phase] += time.perf_counter() - t0
+        return state.tangent
 
-    def _tangent_to_keep(self, tangent):
-        """What the accepted state keeps of the last solve's tangent (see the module docstring)."""
+    def _tangent_to_keep(self, tangent, fixed_dofs):
+        """What the accepted state keeps of the last solve's tangent (see the module
+        docstring); ``fixed_dofs``: the accepted state's, which a kept tangent was factorised
+        for (a resumed run factorises it again for them)."""
         factor = tangent.factor if tangent is not None else None
         if (self._method != "modified" or not isinstance(factor, EliminatedFactor) or factor.linear_solver != "direct"
                 or tangent.state is None or tangent.contraction is None
                 or tangent.contraction > KEEP_MAX_CONTRACTION
-                or np.count_nonzero(factor.factor_free) < KEEP_MIN_DOFS):
+                or np.count_nonzero(factor.factor_free) < KEEP_MIN_DOFS
+                or not np.array_equal(tangent.fixed_dofs, fixed_dofs)):
             return None
         return tangent.kept()
 
@@ -838,7 +849,7 @@ class Simulation:
                     work=state.work + dwork, reactions=reactions, fixed_values=rows.fixed_values.copy(),
                     fixed_dofs=rows.fixed_dofs.copy(), peak_energy=max(state.peak_energy, energy),
                     history=state.history + [record], strength=strength, contact_keys=contact_keys)
-        kept = self._tangent_to_keep(tangent)
+        kept = self._tangent_to_keep(tangent, new.fixed_dofs)
         if kept is not None:
             new.tangent_state, new.tangent = kept.state, kept
         return new, prob, mesh, stats
@@ -878,13 +889,15 @@ class Simulation:
             except StepFailed as err:
                 self._retries += 1
                 self._failures.append(err.reason)
-                if self._retries > c.max_retries:
-                    return None, dx, err
-                if keep and err.phase == "increment" and self._method == "modified" and state.tangent_state is not None:
-                    keep = False                    # the same attempt with its own tangent
+                if err.from_kept:
+                    # the same attempt with its own tangent, not counted against max_retries
+                    keep = False
                     notes.append(f"the tangent kept from the step before failed ({err.reason}); "
                                  "the step factorised its own")
-                elif self._method == "modified":
+                    continue
+                if self._retries - (not keep) > c.max_retries:
+                    return None, dx, err
+                if self._method == "modified":
                     self._method = "full"           # the same attempt with fresh tangents
                 elif err.phase == "increment":
                     substeps *= 2

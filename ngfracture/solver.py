@@ -183,9 +183,9 @@ class SavedTangent:
         (u, load factor, out-of-balance there) at the end of the last solve: the next solve
         at the same state starts from it without assembling it again.
     contraction : float or None
-        How fast the last converged modified-Newton solve with this tangent contracted:
-        the ratio of its last two increments (0.0 when it needed fewer than three
-        iterations; None before any solve or after full Newton).
+        How fast the converged modified-Newton solves with this tangent contracted: the
+        largest ratio of the last two increments over those that took three iterations or
+        more (None: no such solve yet; a solve of fewer iterations gives no estimate).
     lineage : split_factor.Lineage or None
     """
 
@@ -214,16 +214,18 @@ class SavedTangent:
         return other
 
     @classmethod
-    def assembled_at(cls, problem, state):
+    def assembled_at(cls, problem, state, fixed_dofs):
         """The factorised tangent of ``problem`` at the displacement ``state``, as a solve
-        that started there would have made it (its support taken at ``state``, the default
-        direct solver): the same factorisation bit for bit.
+        that started there with these fixed dofs would have made it (its support taken at
+        ``state``, the default direct solver): the same factorisation bit for bit.
 
         Parameters
         ----------
         problem : ElasticProblem
         state : numpy.ndarray
             A displacement of the problem's space.
+        fixed_dofs : numpy.ndarray of int
+            The dofs fixed by single-dof rows when it was factorised.
 
         Returns
         -------
@@ -234,11 +236,12 @@ class SavedTangent:
         SingularSystem
             If the factorisation fails.
         """
-        rows = problem.assemble_constraints()
-        support = problem.support(rows, state)
+        fixed_dofs = np.asarray(fixed_dofs, dtype=np.int64)
+        support = problem.support(ConstraintRows(fixed_dofs, np.zeros(len(fixed_dofs)), sp.csr_matrix((0, len(state))),
+                                                 np.zeros(0), []), state)
         saved = cls()
-        saved.fixed_dofs, saved.support, saved.state = rows.fixed_dofs, support, np.array(state, dtype=float)
-        saved.factor = EliminatedFactor(problem.tangent(state), rows.fixed_dofs, support.pins)
+        saved.fixed_dofs, saved.support, saved.state = fixed_dofs, support, np.array(state, dtype=float)
+        saved.factor = EliminatedFactor(problem.tangent(state), fixed_dofs, support.pins)
         saved.factor.factorise()
         return saved
 
@@ -625,7 +628,8 @@ class NewtonSolver:
                 status.message = f"stalled at relative increment {ratio:.1e}" if stalled and ratio >= self.tol else ""
                 if self.tangent is not None:
                     self.tangent.residual = (u.copy(), prob.load_factor.Get(), r)
-                    self.tangent.contraction = None if self.method == "full" else (rho if k >= 2 else 0.0)
+                    if self.method == "modified" and k >= 2:
+                        self.tangent.contraction = max(self.tangent.contraction or 0.0, rho)
                 return factor
             if not np.isfinite(ratio) or ratio > self.divergence_factor:
                 status.fail("diverged", f"increment grew to {ratio:.2e} times the first one")

@@ -18,7 +18,7 @@ import pytest
 
 import ngfracture as nf
 from ngfracture import kkt as kkt_module
-from ngfracture import scenes, split_factor
+from ngfracture import _ngfracture, scenes, split_factor
 from ngfracture.contact_solver import ContactSolver
 from ngfracture.crack import split_by_tensor
 from ngfracture.kkt import ConstrainedSolver, EliminatedFactor
@@ -79,19 +79,26 @@ def split_in_contact():
     return prob, split_factor.lineage(factor, state, res.parent)
 
 
-@pytest.mark.parametrize("sparse_schur, inverse", [(False, "superlu"), (True, "superlu"), (False, "sparsecholesky")])
+@pytest.mark.parametrize("sparse_schur, inverse", [(False, "superlu"), (True, "superlu"), (False, "supernodal"),
+                                                  (False, "sparsecholesky")])
 def test_bordered_solve_equals_whole_kkt_solve_in_contact(split_in_contact, sparse_schur, inverse, monkeypatch):
     """Both Schur paths on a SuperLU base: the kept columns, and the sparse Schur complement
-    of the base plus the border's rank-m term (forced on this small mesh); and a base
+    of the base plus the border's rank-m term (forced on this small mesh); SuperLU's factors
+    solved by the supernodal L D L^T solver (the plates' path, forced here); and a base
     factorised by NGSolve's sparse Cholesky (the large meshes' solver)."""
     monkeypatch.setattr(kkt_module, "SPARSE_SCHUR_MIN_DOFS", 0 if sparse_schur else 10 ** 9)
     monkeypatch.setattr(kkt_module, "SPARSE_SCHUR_MIN_ROWS", 0)
     prob, lineage = split_in_contact
     if inverse != "superlu":
+        monkeypatch.setattr(kkt_module, "SUPERNODAL_MIN_DOFS", 0)
         base = lineage.base
-        other = EliminatedFactor(base.K, base.fixed_dofs, base.pins, inverse=inverse)
+        other = EliminatedFactor(base.K, base.fixed_dofs, base.pins,
+                                 inverse="superlu" if inverse == "supernodal" else inverse)
         other.solve(np.ones(base.ndof))
+        assert (inverse == "supernodal") == isinstance(other._ldl, _ngfracture.SupernodalLDL)
         lineage = split_factor.Lineage(other, lineage.state, lineage.parent)
+    else:
+        assert lineage.base._ldl is False                 # below SUPERNODAL_MIN_DOFS: SuperLU's solve
     rows = prob.assemble_constraints()
     support = _base_pins(prob.support(rows), lineage.base, prob.fes.ndof)
     factor = split_factor.BorderedFactor.build(lineage, prob, rows.fixed_dofs, support.pins)

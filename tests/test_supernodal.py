@@ -1,8 +1,8 @@
 """The supernodal L D L^T solve with SuperLU's factors (_ngfracture.SupernodalLDL, kkt).
 
 Checked against SuperLU's own solve and against the matrix: a backward error at rounding
-level (|A x - b| below 1e-13 |A| |x|), the same solution as SuperLU's to the rounding of
-two backward-stable solves, for single vectors and blocks of every width, bit for bit
+level (|A x - b| below 1e-14 (|A| |x| + |b|), infinity norms), the same solution as
+SuperLU's (1e-10), for single vectors and blocks of every width, bit for bit
 the same on every call; bad factors and right-hand sides are refused (ValueError) with a message.
 """
 import numpy as np
@@ -35,7 +35,8 @@ def supernodal(lu):
 
 
 def backward_error(A, x, b):
-    return np.linalg.norm(A @ x - b) / (abs(A).max() * np.abs(x).sum() + np.linalg.norm(b))
+    """The normwise backward error |A x - b| / (|A| |x| + |b|), infinity norms."""
+    return np.abs(A @ x - b).max() / (spla.norm(A, np.inf) * np.abs(x).max() + np.abs(b).max())
 
 
 @pytest.mark.parametrize("k", [0, 1, 2, 3, 4, 5, 9])
@@ -54,7 +55,9 @@ def test_solves_like_superlu_with_a_rounding_level_backward_error(k):
     X_ref = lu.solve(np.asfortranarray(B))
     for j in range(k):
         x, x_ref, b = (X[:, j], X_ref[:, j], B[:, j]) if k > 1 else (X, X_ref, B)
-        assert backward_error(A, x, b) < 1e-13
+        # backward stable: a few units of rounding (SuperLU's own solve: 2e-16); the same
+        # solution as SuperLU's to the tolerance of the package's other direct-solve checks
+        assert backward_error(A, x, b) < 1e-14
         assert np.linalg.norm(x - x_ref) <= 1e-10 * np.linalg.norm(x_ref)
     assert np.array_equal(ldl.solve(B), X)                  # deterministic
 
