@@ -407,7 +407,7 @@ class EliminatedFactor(FactorBase):
         self._tmp = ng.BaseVector(self.ndof)     # NGSolve's solvers work on its vectors
         self._columns = {}        # row key -> K^+ row^T, for the rows of the last Schur complement
         self._reach = {}          # row key -> its sparse triangular solves (schur), last rows
-        self._triangles = None    # the factors' arrays for the sparse triangular solves
+        self._triangles = None    # the factors' arrays for the C++ triangular solves (factor_arrays)
         self._lu = None
         self._ldl = None          # the supernodal L D L^T solver of the factors (SUPERNODAL_MIN_DOFS)
         self._free_block = None   # K on all free dofs (pins included), scipy CSC, made at first need
@@ -641,19 +641,15 @@ class EliminatedFactor(FactorBase):
         """K_ff^-1 b with SuperLU's factors: through the supernodal L D L^T solver where it
         applies (``SUPERNODAL_MIN_DOFS``, every pivot diagonal), else SuperLU's own solve."""
         if self._ldl is None:
-            lu = self._lu
-            n = lu.shape[0]
-            if n >= SUPERNODAL_MIN_DOFS and np.array_equal(lu.perm_r, lu.perm_c):
-                # diagonal pivots of the symmetric K_ff: U = D L^T (see schur)
-                L = lu.L.tocsc()
-                L.sort_indices()
+            n = self._lu.shape[0]
+            lower, _, pivots = self._factor_arrays() if n >= SUPERNODAL_MIN_DOFS else (None, None, None)
+            if pivots is None:
+                self._ldl = False
+            else:
                 try:
-                    self._ldl = _ext.SupernodalLDL(n, L.indptr.astype(np.int64), L.indices.astype(np.int32),
-                                                   L.data, lu.U.diagonal(), lu.perm_r.astype(np.int64))
+                    self._ldl = _ext.SupernodalLDL(n, *lower, pivots, self._lu.perm_r.astype(np.int64))
                 except ValueError as err:      # a zero or non-finite pivot: K_ff is singular
                     raise SingularSystem(f"the sparse LU factors cannot be solved with: {err}") from None
-            else:
-                self._ldl = False
         if self._ldl is False:
             return self._lu.solve(np.asfortranarray(b))
         return self._ldl.solve(b)
@@ -709,21 +705,18 @@ class EliminatedFactor(FactorBase):
         self.seconds += time.perf_counter() - t0
         return S
 
+    def _factor_arrays(self):
+        """:func:`factor_arrays` of the SuperLU factorisation, made once."""
+        if self._triangles is None:
+            self._triangles = factor_arrays(self._lu)
+        return self._triangles
+
     def _reach_solves(self, C):
         """Per row of C: ((rows, values) of its column of Y, the same of X), see :meth:`schur`."""
         n = self._lu.shape[0]
-        if self._triangles is None:
-            index = -np.ones(self.ndof, dtype=np.int64)
-            index[self.factor_free] = np.arange(n)      # dof -> row of K_ff
-            L = self._lu.L
-            lower = (L.indptr.astype(np.int64), L.indices.astype(np.int32), L.data)
-            if np.array_equal(self._lu.perm_r, self._lu.perm_c):
-                upper_t, pivots = None, self._lu.U.diagonal()
-            else:
-                Ut = self._lu.U.tocsr()                 # CSR of U = CSC of the lower U^T
-                upper_t, pivots = (Ut.indptr.astype(np.int64), Ut.indices.astype(np.int32), Ut.data), None
-            self._triangles = (index, lower, upper_t, pivots)
-        index, lower, upper_t, pivots = self._triangles
+        lower, upper_t, pivots = self._factor_arrays()
+        index = -np.ones(self.ndof, dtype=np.int64)
+        index[self.factor_free] = np.arange(n)          # dof -> row of K_ff
         B = C.tocoo()
         rows = index[B.col]
         keep = rows >= 0
@@ -744,6 +737,32 @@ class EliminatedFactor(FactorBase):
             xp, xi, xx = solve(upper_t, self._lu.perm_c, False)
         return [((yi[yp[j]:yp[j + 1]], yx[yp[j]:yp[j + 1]]), (xi[xp[j]:xp[j + 1]], xx[xp[j]:xp[j + 1]]))
                 for j in range(C.shape[0])]
+
+
+def factor_arrays(lu):
+    """SuperLU's factors Pr K_ff Pc = L U as the arrays of the C++ triangular solves.
+
+    Parameters
+    ----------
+    lu : scipy.sparse.linalg.SuperLU
+
+    Returns
+    -------
+    lower : (numpy.ndarray int64, numpy.ndarray int32, numpy.ndarray)
+        L as CSC (pointers, rows sorted within each column, values; its unit diagonal stored).
+    upper_t : same as lower, or None
+        U^T as CSC (the CSR of U); None where every pivot was diagonal (Pr = Pc^T): the
+        symmetric K_ff then has U = D L^T.
+    pivots : numpy.ndarray or None
+        D where U = D L^T, else None.
+    """
+    L = lu.L.tocsc()
+    L.sort_indices()
+    lower = (L.indptr.astype(np.int64), L.indices.astype(np.int32), L.data)
+    if np.array_equal(lu.perm_r, lu.perm_c):
+        return lower, None, lu.U.diagonal()
+    Ut = lu.U.tocsr()
+    return lower, (Ut.indptr.astype(np.int64), Ut.indices.astype(np.int32), Ut.data), None
 
 
 def _sparse_columns(columns, n):

@@ -748,7 +748,8 @@ class Simulation:
         try:
             keys, tangent = self._equilibrium(prob, "increment", substeps, warm=state.contact_keys, start=start)
         except StepFailed as err:
-            raise StepFailed(err.reason, err.phase, err.message, from_kept=start is not None) from None
+            err.from_kept = start is not None
+            raise
         self._dwork = self._increment_work(state, prob)
         new_prob, first, strength, inherited = self._crack_pass(prob, state.strength, tangent)
         c = self.control
@@ -777,12 +778,13 @@ class Simulation:
         """
         if state.tangent_state is None:
             return None
-        if not np.array_equal(prob.assemble_constraints().fixed_dofs, state.fixed_dofs):
+        rows = prob.assemble_constraints()
+        if not np.array_equal(rows.fixed_dofs, state.fixed_dofs):
             return None
         if state.tangent is None:
             t0 = time.perf_counter()
             try:
-                state.tangent = SavedTangent.assembled_at(prob, state.tangent_state, state.fixed_dofs)
+                state.tangent = SavedTangent.assembled_at(prob, state.tangent_state, rows)
             except SingularSystem as err:
                 raise StepFailed("singular", "increment", f"the kept tangent: {err}", from_kept=True) from None
             finally:

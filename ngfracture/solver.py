@@ -214,9 +214,9 @@ class SavedTangent:
         return other
 
     @classmethod
-    def assembled_at(cls, problem, state, fixed_dofs):
+    def assembled_at(cls, problem, state, rows):
         """The factorised tangent of ``problem`` at the displacement ``state``, as a solve
-        that started there with these fixed dofs would have made it (its support taken at
+        that started there with these rows would have made it (its support taken at
         ``state``, the default direct solver): the same factorisation bit for bit.
 
         Parameters
@@ -224,8 +224,8 @@ class SavedTangent:
         problem : ElasticProblem
         state : numpy.ndarray
             A displacement of the problem's space.
-        fixed_dofs : numpy.ndarray of int
-            The dofs fixed by single-dof rows when it was factorised.
+        rows : ConstraintRows
+            Constraints with the fixed dofs it is factorised for (only those are used).
 
         Returns
         -------
@@ -236,12 +236,10 @@ class SavedTangent:
         SingularSystem
             If the factorisation fails.
         """
-        fixed_dofs = np.asarray(fixed_dofs, dtype=np.int64)
-        support = problem.support(ConstraintRows(fixed_dofs, np.zeros(len(fixed_dofs)), sp.csr_matrix((0, len(state))),
-                                                 np.zeros(0), []), state)
+        support = problem.support(rows, state)
         saved = cls()
-        saved.fixed_dofs, saved.support, saved.state = fixed_dofs, support, np.array(state, dtype=float)
-        saved.factor = EliminatedFactor(problem.tangent(state), fixed_dofs, support.pins)
+        saved.fixed_dofs, saved.support, saved.state = rows.fixed_dofs, support, np.array(state, dtype=float)
+        saved.factor = EliminatedFactor(problem.tangent(state), rows.fixed_dofs, support.pins)
         saved.factor.factorise()
         return saved
 
