@@ -34,7 +34,8 @@ import ngsolve
 from netgen.occ import Glue, MoveTo, OCCGeometry
 
 import benchmark_json
-from ngfracture import collision, contact
+from ngfracture.contact import collision
+from ngfracture.contact import rows as contact
 
 
 def pieces_mesh(ntri_target, k):

@@ -32,7 +32,7 @@ import ngsolve
 from netgen.geom2d import unit_square
 
 import benchmark_json
-from ngfracture import crack
+from ngfracture.fracture import crack
 
 
 def maxh_for(ntri):

@@ -39,7 +39,7 @@ import tempfile
 
 import benchmark_json
 from ngfracture import scenes
-from ngfracture.ensemble import Ensemble, comparable_report
+from ngfracture.studies.ensemble import Ensemble, comparable_report
 
 
 def measure(workers, samples, maxh, steps):

@@ -4,7 +4,7 @@ Problem: the L-shape of the paper (section 4.1, eq. 15), linear elasticity,
 E = 1e5, nu = 0.3, plane strain, exact Dirichlet data (``Set()``) on the whole
 boundary (``--variant traction-free``: free reentrant edges).
 
-For order 1 and 2, on uniform and graded meshes (``ngfracture.lshape``), every
+For order 1 and 2, on uniform and graded meshes (``ngfracture.studies.lshape``), every
 level is solved twice in the same run on the same mesh:
 
 * ``t_ngfracture``: ``ElasticProblem`` + ``add_dirichlet`` + ``solve`` (modified Newton),
@@ -41,7 +41,8 @@ import time
 import numpy as np
 
 import benchmark_json
-from ngfracture import lshape, verify
+from ngfracture.studies import lshape
+from ngfracture.studies import verify
 from ngfracture.cli import _int_at_least
 
 TARGETS = (1e-2, 1e-3, 1e-4)

@@ -17,7 +17,7 @@ import time
 import ngsolve
 
 import benchmark_json
-from ngfracture.meshcheck import validate_mesh
+from ngfracture.geometry.meshcheck import validate_mesh
 from crack import crack_pass, plate, solve_stretch     # the sibling benchmark's mesh and solve
 
 

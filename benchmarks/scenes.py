@@ -50,8 +50,8 @@ import ngsolve
 
 import benchmark_json
 from ngfracture import scenes
-from ngfracture.problem import ElasticProblem
-from ngfracture.simulation import Simulation, StepControl
+from ngfracture.mechanics.problem import ElasticProblem
+from ngfracture.run.simulation import Simulation, StepControl
 
 
 def unit_solve(scene):

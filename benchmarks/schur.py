@@ -18,8 +18,9 @@ import numpy as np
 import scipy.sparse as sp
 
 import benchmark_json
-from ngfracture import kkt, scenes
-from ngfracture.problem import ElasticProblem
+from ngfracture import scenes
+from ngfracture.linalg import kkt
+from ngfracture.mechanics.problem import ElasticProblem
 
 
 def contact_like_rows(mesh, ndof, count=150, width=0.02):

@@ -15,7 +15,7 @@ import ngsolve as ng
 from netgen.geom2d import SplineGeometry
 
 import ngfracture as nf
-from ngfracture.simulation import Scene
+from ngfracture.run.simulation import Scene
 
 
 def beam_mesh(maxh):

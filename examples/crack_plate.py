@@ -9,7 +9,7 @@ strain splits vertices), repeated solve + split passes at fixed load until no ve
 overstrained (release of energy through crack formation, paper section 4.2).
 
 It illustrates how to:
-- run `ngfracture.crack.crack_step` in a load step,
+- run `ngfracture.fracture.crack.crack_step` in a load step,
 - carry the displacement exactly to the split mesh,
 - write the cracked mesh with displacement and fragment number to VTK (pyvista).
 
@@ -22,7 +22,7 @@ import numpy as np
 import ngsolve
 from netgen.geom2d import SplineGeometry
 
-from ngfracture import crack
+from ngfracture.fracture import crack
 
 
 def plate_with_hole(maxh):
@@ -34,7 +34,7 @@ def plate_with_hole(maxh):
 
 
 def solve(mesh, stretch, E=1.0, nu=0.18):
-    """Displacement as a VectorH1 GridFunction (what ngfracture.crack expects)."""
+    """Displacement as a VectorH1 GridFunction (what ngfracture.fracture.crack expects)."""
     lam, mu = E * nu / ((1 + nu) * (1 - 2 * nu)), E / (2 * (1 + nu))
     # gliding: x fixed on left and right, y free; solved in H1 x H1, whose dof layout
     # (component blocks) is that of VectorH1

@@ -103,7 +103,7 @@ CONTROL_OPTIONS = [
 
 def _scene_help():
     from . import scenes
-    from .scene_source import format_parameters
+    from .run.scene_source import format_parameters
     lines = [f"{name}: {_plain(func.__doc__.splitlines()[0].rstrip('.'))} (load: "
              f"{scenes.LOAD_DESCRIPTIONS[name]}; parameters {format_parameters(func)})"
              for name, func in sorted(scenes.SCENES.items())]
@@ -227,7 +227,7 @@ def _print_json_progress(info):
 
 
 def _default_out(spec):
-    from .scene_source import builtin_scenes
+    from .run.scene_source import builtin_scenes
     if spec in builtin_scenes():
         return os.path.join("out", spec)
     if spec.endswith(".py"):
@@ -236,8 +236,8 @@ def _default_out(spec):
 
 
 def _run_run(args):
-    from .scene_source import load_scene_function, parse_assignments
-    from .simulation import Simulation, StepControl
+    from .run.scene_source import load_scene_function, parse_assignments
+    from .run.simulation import Simulation, StepControl
 
     if args.force and args.resume:
         raise ValueError("--force and --resume exclude each other")
@@ -297,7 +297,7 @@ def _run_scenes(args):
     import inspect
 
     from . import scenes
-    from .scene_source import scene_parameters
+    from .run.scene_source import scene_parameters
     for name, func in sorted(scenes.SCENES.items()):
         print(f"{name}: {_plain(func.__doc__.splitlines()[0].rstrip('.'))}")
         print(f"  load x: {scenes.LOAD_DESCRIPTIONS[name]}")
@@ -319,10 +319,10 @@ def _add_render(subparsers):
 
 
 def _run_render(args):
-    from . import checkpoint
-    from .output import final_pictures, picture_scale
-    from .fragments import FragmentStatistics
-    from .meshio import MeshArrays, mesh_from_arrays
+    from .run import checkpoint
+    from .output.vtk import final_pictures, picture_scale
+    from .fracture.fragments import FragmentStatistics
+    from .geometry.meshio import MeshArrays, mesh_from_arrays
 
     folder = args.dir
     if not os.path.isdir(folder):
@@ -344,7 +344,7 @@ def _run_render(args):
 
 
 def _add_verify(subparsers):
-    from . import verify
+    from .studies import verify
 
     p = subparsers.add_parser(
         "verify", help="convergence study against an exact solution",
@@ -386,7 +386,7 @@ def _add_verify(subparsers):
 
 
 def _run_verify(args):
-    from . import verify
+    from .studies import verify
 
     if args.json is not None and os.path.exists(args.json) and not args.force:
         raise FileExistsError(f"{args.json} exists; pass --force to overwrite it")
@@ -442,8 +442,8 @@ def _add_ensemble(subparsers):
 
 
 def _run_ensemble(args):
-    from .ensemble import Ensemble, SceneFactory
-    from .scene_source import load_scene_function, parse_assignments, scene_parameters
+    from .studies.ensemble import Ensemble, SceneFactory
+    from .run.scene_source import load_scene_function, parse_assignments, scene_parameters
 
     function = load_scene_function(args.scene)
     accepted = scene_parameters(function)
@@ -518,7 +518,7 @@ def main(argv=None):
     int
         Exit status: 0 on success, 2 on bad input, 1 on a failed computation.
     """
-    from .checkpoint import CheckpointError
+    from .run.checkpoint import CheckpointError
 
     parser = build_parser()
     args = parser.parse_args(argv)

@@ -1,7 +1,7 @@
 """The paper's scenes (section 4.2) as functions that return a Scene.
 
 Each is short on purpose: copy one, change the geometry, material or loading, and
-pass it to :class:`ngfracture.simulation.Simulation`.
+pass it to :class:`ngfracture.run.simulation.Simulation`.
 
 * :func:`plate`: a square glass plate with small notches on the top and bottom edges,
   pulled apart by gliding conditions on the left and right sides.
@@ -19,9 +19,9 @@ import ngsolve as ng
 from netgen.geom2d import SplineGeometry
 from netgen.meshing import MeshingParameters, Pnt
 
-from .materials import StVenantKirchhoff
-from .simulation import Scene
-from .strength import scene_strength
+from .mechanics.materials import StVenantKirchhoff
+from .run.simulation import Scene
+from .fracture.strength import scene_strength
 
 #: the paper's glass: E = 5 GPa, nu = 0.18, critical principal strain 1.3817e-4
 GLASS = dict(E=5e9, nu=0.18, critical=1.3817e-4)
@@ -153,7 +153,7 @@ def plate(maxh=0.034, strain_max=1e-3, dx=None, material=None, critical=GLASS["c
         them, where the crack runs. None: the paper's one-ring nodal strain (mesh
         dependent: its crack patterns change with maxh).
     weibull_m, weibull_scale, weibull_area, seed
-        Random strength, see :func:`ngfracture.strength.scene_strength`: a Weibull
+        Random strength, see :func:`ngfracture.fracture.strength.scene_strength`: a Weibull
         modulus (None: uniform strength), the scale (default: mean = ``critical``), the
         reference area of the size effect, the seed (default 0).
 
@@ -195,7 +195,7 @@ def cored_disk_mesh(maxh=0.06, radius=1.0, hole=0.25, core_inner=0.125):
 
     Regions ``disk`` (hole < r < radius) and ``core`` (core_inner < r < hole). The two
     share no vertex: the interface circle is meshed once and the core gets its own copies
-    of the interface vertices (:func:`ngfracture.meshio.separate_region`), so contact
+    of the interface vertices (:func:`ngfracture.geometry.meshio.separate_region`), so contact
     alone couples them. Boundaries: ``outer``, ``hole`` (the disk's side of the
     interface), ``core_surface`` (the core's side), ``core_inner``.
 
@@ -216,7 +216,7 @@ def cored_disk_mesh(maxh=0.06, radius=1.0, hole=0.25, core_inner=0.125):
     ValueError
         A size that is not a finite positive number, or radii out of order.
     """
-    from .meshio import separate_region
+    from .geometry.meshio import separate_region
     for name, v in (("maxh", maxh), ("radius", radius), ("hole", hole), ("core_inner", core_inner)):
         _positive(name, v)
     if not core_inner < hole < radius:

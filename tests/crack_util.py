@@ -3,7 +3,8 @@ import numpy as np
 import ngsolve
 from netgen.meshing import Mesh as NGMesh, FaceDescriptor
 
-from ngfracture import crack, ElementAreas
+from ngfracture._ngfracture import ElementAreas
+from ngfracture.fracture import crack
 
 
 def mesh_from_arrays(points, trigs, material="solid", bcname="outer"):

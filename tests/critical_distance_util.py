@@ -10,8 +10,8 @@ import ngsolve as ng
 from netgen.geom2d import SplineGeometry
 from netgen.meshing import MeshingParameters
 
-from ngfracture.crack import StrainCriterion, principal, split_vertices
-from ngfracture.materials import LinearElastic
+from ngfracture.fracture.crack import StrainCriterion, principal, split_vertices
+from ngfracture.mechanics.materials import LinearElastic
 
 
 def solve_linear(mesh, material, dirichlet, value, tractions=()):

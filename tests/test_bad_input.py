@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 
 import ngfracture as nf
-from ngfracture import crack
-from ngfracture.meshcheck import MeshError, validate_mesh
-from ngfracture.meshio import MeshArrays, merge_meshes, mesh_from_arrays
+from ngfracture.fracture import crack
+from ngfracture.geometry.meshcheck import MeshError, validate_mesh
+from ngfracture.geometry.meshio import MeshArrays, merge_meshes, mesh_from_arrays
 from conftest import square_mesh
 
 

@@ -4,7 +4,7 @@ import json
 import numpy as np
 import pytest
 
-from ngfracture import checkpoint as ck
+from ngfracture.run import checkpoint as ck
 
 
 def state(seed=0):

@@ -14,7 +14,7 @@ from conftest import child_env
 
 from ngfracture import cli, scenes
 from ngfracture.cli import main
-from ngfracture.simulation import Scene
+from ngfracture.run.simulation import Scene
 
 SMALL = ["--maxh", "0.1", "--quiet", "--pictures", "none"]
 OPTIONS = ["--maxh", "--steps", "--load-max", "--out", "--force", "--resume", "--pictures", "--contact",

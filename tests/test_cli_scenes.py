@@ -13,9 +13,11 @@ import pytest
 from conftest import child_env
 
 import ngfracture
-from ngfracture import output, scenes, simulation
+from ngfracture import scenes
+from ngfracture.output import vtk as output
+from ngfracture.run import simulation
 from ngfracture.cli import main, progress_json
-from ngfracture.scene_source import scene_parameters
+from ngfracture.run.scene_source import scene_parameters
 
 ROOT = Path(__file__).resolve().parents[1]
 BEAM = str(ROOT / "examples" / "beam_scene.py")

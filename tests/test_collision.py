@@ -6,7 +6,7 @@ import pytest
 
 import ngfracture  # noqa: F401  (loads NGSolve's libraries first)
 from ngfracture import _ngfracture as ext
-from ngfracture import collision
+from ngfracture.contact import collision
 
 
 def exact_sign(a, b, c):

@@ -1,7 +1,7 @@
 """Contact on meshes cracked by the crack engine and between separate bodies.
 
 The lips of a crack made by node splitting coincide in the reference configuration;
-ContactSolver treats them with node-to-node rows across the seam (ngfracture.seams).
+ContactSolver treats them with node-to-node rows across the seam (ngfracture.contact.seams).
 Checked here: the active set settles, Kuhn-Tucker holds, the fragments do not overlap,
 and a closed straight crack across a uniaxial load transmits it exactly.
 """
@@ -11,11 +11,11 @@ import pytest
 from netgen.occ import X, Y, Glue, MoveTo, OCCGeometry
 
 import ngfracture as nf
-from ngfracture.collision import boundary_edge_mask
-from ngfracture.contact_solver import ContactSolver, _space_columns, fragment_overlap_area
-from ngfracture.crack import split_by_tensor
-from ngfracture.meshio import mesh_to_arrays
-from ngfracture.seams import find_seams, seam_constraints
+from ngfracture.contact.collision import boundary_edge_mask
+from ngfracture.contact.solver import ContactSolver, _space_columns, fragment_overlap_area
+from ngfracture.fracture.crack import split_by_tensor
+from ngfracture.geometry.meshio import mesh_to_arrays
+from ngfracture.contact.seams import find_seams, seam_constraints
 
 
 def plate_mesh(maxh, cuts=(), origin=(0.0, 0.0)):
@@ -82,7 +82,7 @@ def test_pressed_zigzag_crack_does_not_overlap(d):
     History (d = 1e-3): rows linearised at the prediction only, 3.9e-8; re-linearised at
     the settled solution, 3.3e-10, all of it in triangle pairs at three-copy junctions
     (a copy's apex slid into a reflex wedge past the edge it shares no facet with); with
-    the junction rows of ngfracture.seams, 4e-16 (measured 4.1e-16, 8.1e-16, 0, 5.1e-16
+    the junction rows of ngfracture.contact.seams, 4e-16 (measured 4.1e-16, 8.1e-16, 0, 5.1e-16
     for d = 1e-3, 1e-4, 1e-5, 1e-2).
     """
     h = 0.1
@@ -116,8 +116,8 @@ def test_far_from_the_origin_nothing_changes():
 def without_junction_rows(monkeypatch, kind):
     """Make ContactSolver see seams without the junction rows of one kind ("edge_rows" of
     reflex wedges or "diagonal" pairs), checking that the mesh had some."""
-    import ngfracture.contact_solver as contact_solver
-    from ngfracture import seams as seams_module
+    import ngfracture.contact.solver as contact_solver
+    from ngfracture.contact import seams as seams_module
 
     def find_seams(points, segments):
         found = seams_module.find_seams(points, segments)
@@ -287,7 +287,7 @@ def test_disk_expansion_runs_to_the_end():
     test, 1e-10 of the area (measured: 42 steps, 3 fragments, overlap 6.5e-17 of the area,
     84 s)."""
     from ngfracture import scenes
-    from ngfracture.simulation import Simulation
+    from ngfracture.run.simulation import Simulation
     r = Simulation(scenes.disk(maxh=0.1, expansion=50 * scenes.FIRST_CRACK, radius=None), pictures="none").run()
     assert r.reason == "load_max", r.summary["message"]
     assert r.summary["max_overlap_area"] <= 1e-10 * r.summary["area_initial"]

@@ -4,7 +4,8 @@ import pytest
 import scipy.sparse as sp
 
 import ngfracture  # noqa: F401
-from ngfracture import collision, contact
+from ngfracture.contact import collision
+from ngfracture.contact import rows as contact
 
 from test_collision import boundary_edges_of, two_blocks
 

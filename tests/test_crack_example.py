@@ -8,7 +8,7 @@ import ngsolve
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "examples"))
 import crack_plate  # noqa: E402
 
-from ngfracture.fragments import FragmentStatistics  # noqa: E402
+from ngfracture.fracture.fragments import FragmentStatistics  # noqa: E402
 
 
 def test_crack_plate_example(tmp_path):

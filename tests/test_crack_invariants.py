@@ -4,7 +4,7 @@ import pytest
 import ngsolve
 from netgen.geom2d import SplineGeometry, unit_square
 
-from ngfracture import crack
+from ngfracture.fracture import crack
 from crack_util import check_invariants, grid_mesh, coords
 
 
@@ -158,7 +158,7 @@ def test_pieces_from_the_engines_fragments_equal_the_graph_search():
     numbering of rigid.pieces (connected components of the vertex graph) on shattered meshes,
     returns None for a vertex in no triangle and refuses labels that are not per triangle
     or split a piece."""
-    from ngfracture import rigid
+    from ngfracture.mechanics import rigid
     rng = np.random.default_rng(7)
     mesh = netgen_square(0.08)
     checked = 0

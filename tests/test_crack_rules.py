@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 import ngsolve
 
-from ngfracture import crack, ElementAreas
+from ngfracture._ngfracture import ElementAreas
+from ngfracture.fracture import crack
 from crack_util import grid_mesh, vid, fan_mesh, check_invariants, coords
 
 X = [[1.0, 0.0]]   # maximum strain along x: cracks want to run along y

@@ -7,7 +7,7 @@ from netgen.csg import unit_cube
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
-from ngfracture import crack
+from ngfracture.fracture import crack
 from crack_util import grid_mesh, check_invariants, coords, triangles, edge_table
 
 

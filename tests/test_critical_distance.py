@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 import ngsolve as ng
 
-from ngfracture.crack import StrainCriterion, critical_distance, nonlocal_opening, principal, toughness
+from ngfracture.fracture.crack import StrainCriterion, critical_distance, nonlocal_opening, principal, toughness
 from critical_distance_util import centre_crack_mesh, plate_initiation, solve_linear, tada_centre_crack
-from ngfracture.materials import LinearElastic
+from ngfracture.mechanics.materials import LinearElastic
 from ngfracture import _ngfracture as _C
 
 E, NU, CRITICAL = 1.0, 0.25, 1e-3
@@ -198,7 +198,7 @@ def test_scene_radius_is_checked_before_any_work():
 
 def test_a_critical_distance_scene_splits_one_vertex_per_pass_unless_told_otherwise():
     from ngfracture import scenes
-    from ngfracture.simulation import Simulation, StepControl
+    from ngfracture.run.simulation import Simulation, StepControl
     assert Simulation(scenes.plate(maxh=0.1, radius=None)).control.split == "spread"
     assert Simulation(scenes.plate(maxh=0.1, radius=0.05)).control.split == "one"
     assert Simulation(scenes.plate(maxh=0.1, radius=0.05), StepControl(split="spread")).control.split == "spread"
@@ -245,7 +245,7 @@ def test_plate_breaks_along_one_crack_from_notch_to_notch():
     length within 15 % of the 0.92 from notch tip to notch tip (the issue's bound; a crack
     along mesh edges zigzags by about 3 %). The one-ring criterion gives 2.85 here."""
     from ngfracture import scenes
-    from ngfracture.simulation import Simulation
+    from ngfracture.run.simulation import Simulation
     scene = scenes.plate()
     assert scene.radius == scenes.PLATE_RADIUS == 0.04
     result = Simulation(scene, pictures="none").run()

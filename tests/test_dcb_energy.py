@@ -18,9 +18,9 @@ import pytest
 from netgen.geom2d import SplineGeometry
 from netgen.meshing import MeshingParameters
 
-from ngfracture.crack import split_vertices, toughness
-from ngfracture.materials import StVenantKirchhoff
-from ngfracture.simulation import Scene, Simulation, StepControl
+from ngfracture.fracture.crack import split_vertices, toughness
+from ngfracture.mechanics.materials import StVenantKirchhoff
+from ngfracture.run.simulation import Scene, Simulation, StepControl
 
 E, NU, CRITICAL, R = 5e9, 0.18, 1.3817e-4, 0.005
 A0, HALF = 0.3, 0.5               # pre-crack length, arm height

@@ -5,9 +5,9 @@ import numpy as np
 import pytest
 
 from ngfracture import scenes
-from ngfracture.fragments import FragmentStatistics
-from ngfracture.meshio import mesh_to_arrays
-from ngfracture.simulation import Simulation
+from ngfracture.fracture.fragments import FragmentStatistics
+from ngfracture.geometry.meshio import mesh_to_arrays
+from ngfracture.run.simulation import Simulation
 
 
 
@@ -135,7 +135,7 @@ def test_disintegration_many_disjoint_fragments(maxh):
     """Measured: see the table in docs/verification.md (maxh 0.08 is the scene's default, the paper's
     "coarse initial mesh": 118 steps, about 5 minutes on a busy machine; 0.06, the disk's
     resolution: 155 steps, 53 disk pieces, about 20 minutes). Without the diagonal
-    rows at four-way junctions (ngfracture.seams) 0.08 stopped at step 75 (x = 0.00457)
+    rows at four-way junctions (ngfracture.contact.seams) 0.08 stopped at step 75 (x = 0.00457)
     with 19 disk pieces; with them but the contact solve's re-linearisations capped at five,
     step 106 failed seven times (penetration 8.1e-15 against 8e-15, still contracting by 20
     per update). 0.06 failed at step 33 until the KKT solves refined their solution."""

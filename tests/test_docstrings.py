@@ -1,6 +1,6 @@
 """Every public function, class and method of ngfracture has a numpy-style docstring (issue #7).
 
-A callable defined in a public module (``ngfracture/*.py`` without a leading underscore)
+A callable defined in a public module (``ngfracture/**/*.py`` without a leading underscore)
 needs
 
 - a docstring;
@@ -29,8 +29,9 @@ EXCLUDED = set()
 
 
 def public_modules():
-    """Names of the public modules of the package, sorted."""
-    return sorted(p.stem for p in PACKAGE_DIR.glob("*.py") if not p.stem.startswith("_"))
+    """Dotted names of the public modules of the package and its subpackages, sorted."""
+    return sorted(".".join(p.relative_to(PACKAGE_DIR).with_suffix("").parts)
+                  for p in PACKAGE_DIR.rglob("*.py") if not p.stem.startswith("_"))
 
 
 # -- reading a docstring ------------------------------------------------------------------
@@ -197,12 +198,12 @@ def test_the_check_covers_the_package():
     """An empty or partial module list would pass the check above without checking anything."""
     modules = set(public_modules())
     assert EXCLUDED <= modules
-    assert {"simulation", "cli", "scene_source", "problem", "solver", "contact_solver", "kkt", "crack",
-            "scenes", "output"} <= modules
+    assert {"run.simulation", "cli", "run.scene_source", "mechanics.problem", "mechanics.newton",
+            "contact.solver", "linalg.kkt", "fracture.crack", "scenes", "output.vtk"} <= modules
     offenders(sorted(EXCLUDED))  # they are imported and parsed, only their verdict is ignored
     # the checker reports an undocumented public function of a real module of the package
-    source = (PACKAGE_DIR / "rigid.py").read_text() + "\n\ndef undocumented_probe(a):\n    return a\n"
-    namespace = dict(vars(importlib.import_module("ngfracture.rigid")))
+    source = (PACKAGE_DIR / "mechanics" / "rigid.py").read_text() + "\n\ndef undocumented_probe(a):\n    return a\n"
+    namespace = dict(vars(importlib.import_module("ngfracture.mechanics.rigid")))
     exec(compile("def undocumented_probe(a):\n    return a\n", "probe", "exec"), namespace)
     assert check_source(source, namespace, "rigid") == ["rigid.undocumented_probe: no docstring"]
 

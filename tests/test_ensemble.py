@@ -18,8 +18,8 @@ import pytest
 from conftest import child_env
 
 from ngfracture import scenes
-from ngfracture.ensemble import KILL_HOOK, Ensemble, comparable_report
-from ngfracture.statistics import fit_fragment_sizes, fragment_size_statistics
+from ngfracture.studies.ensemble import KILL_HOOK, Ensemble, comparable_report
+from ngfracture.studies.statistics import fit_fragment_sizes, fragment_size_statistics
 
 FACTORY = functools.partial(scenes.plate, maxh=0.15, weibull_m=8)
 OPTIONS = dict(control={"max_steps": 14}, contact="never", progress=False)

@@ -12,12 +12,12 @@ import ngsolve as ng
 import pytest
 from netgen.geom2d import SplineGeometry
 
-from ngfracture.contact_solver import ContactSolver
-from ngfracture.kkt import ConstrainedSolver, to_scipy
-from ngfracture.materials import StVenantKirchhoff
-from ngfracture.meshio import separate_region
-from ngfracture.problem import ElasticProblem
-from ngfracture.solver import NewtonSolver
+from ngfracture.contact.solver import ContactSolver
+from ngfracture.linalg.kkt import ConstrainedSolver, to_scipy
+from ngfracture.mechanics.materials import StVenantKirchhoff
+from ngfracture.geometry.meshio import separate_region
+from ngfracture.mechanics.problem import ElasticProblem
+from ngfracture.mechanics.newton import NewtonSolver
 
 MAXH = 0.15
 
@@ -172,7 +172,7 @@ def test_mode_groups_are_numbered_as_scipys_connected_components():
     random symmetric couplings of 1 to 100 modes (above 64 it is scipy's call)."""
     import scipy.sparse as sp
     from scipy.sparse.csgraph import connected_components
-    from ngfracture import rigid
+    from ngfracture.mechanics import rigid
     rng = np.random.default_rng(0)
     for k in [1, 2, 3, 5, 10, 30, 64, 65, 100]:
         for _ in range(10):

@@ -15,8 +15,8 @@ import scipy.sparse as sp
 
 import ngfracture as nf
 from ngfracture import _ngfracture as _C
-from ngfracture.kkt import to_scipy
-from ngfracture.problem import ElasticProblem
+from ngfracture.linalg.kkt import to_scipy
+from ngfracture.mechanics.problem import ElasticProblem
 from ngfracture.scenes import cored_disk_mesh
 
 from conftest import square_mesh

@@ -10,9 +10,12 @@ import json
 import numpy as np
 import pyvista as pv
 
-from ngfracture import checkpoint, kkt, scenes, simulation
-from ngfracture.kkt import EliminatedFactor
-from ngfracture.simulation import Simulation, StepControl
+from ngfracture import scenes
+from ngfracture.run import checkpoint
+from ngfracture.linalg import kkt
+from ngfracture.run import simulation
+from ngfracture.linalg.kkt import EliminatedFactor
+from ngfracture.run.simulation import Simulation, StepControl
 
 
 def counted_run(monkeypatch, scene, keep, **options):

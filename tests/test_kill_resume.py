@@ -22,7 +22,7 @@ ARGS = ["run", "plate", "--maxh", "0.06", "--quiet", "--pictures", "none"]
 
 CHILD = """
 import os, sys, time
-from ngfracture import checkpoint
+from ngfracture.run import checkpoint
 from ngfracture.cli import main
 real = os.replace
 slow = int(sys.argv[1])

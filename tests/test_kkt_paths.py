@@ -20,10 +20,10 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 import ngfracture as nf
-from ngfracture.contact_solver import ContactSolver
-from ngfracture import kkt as kkt_module
-from ngfracture.kkt import ConstrainedSolver, to_scipy
-from ngfracture.solver import NewtonSolver
+from ngfracture.contact.solver import ContactSolver
+from ngfracture.linalg import kkt as kkt_module
+from ngfracture.linalg.kkt import ConstrainedSolver, to_scipy
+from ngfracture.mechanics.newton import NewtonSolver
 
 from test_contact_fractured import crack_bands, plate_mesh
 
@@ -187,7 +187,7 @@ def test_a_cracking_run_takes_the_same_path_with_the_sparse_schur_complement(mon
     steps and split vertices, and crack length, energy and the displacement of the final
     state equal to the rounding of the solves (1e-9 relative)."""
     from ngfracture import scenes
-    from ngfracture.simulation import Simulation
+    from ngfracture.run.simulation import Simulation
 
     runs = {}
     for sparse in (False, True):

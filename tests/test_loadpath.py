@@ -5,9 +5,9 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
 from ngfracture import scenes
-from ngfracture.loadpath import deformed_fragments, load_path_cut, prescribed_increment
-from ngfracture.meshio import mesh_to_arrays
-from ngfracture.simulation import Simulation
+from ngfracture.run.loadpath import deformed_fragments, load_path_cut, prescribed_increment
+from ngfracture.geometry.meshio import mesh_to_arrays
+from ngfracture.run.simulation import Simulation
 
 # two unit squares, [0,1]^2 and [1,2]x[0,1], each of two triangles; `joined` shares the
 # vertices at x = 1, `apart` has its own copies of them (a crack along x = 1)

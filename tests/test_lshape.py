@@ -13,8 +13,8 @@ import ngsolve as ng
 import numpy as np
 import pytest
 
-from ngfracture import lshape
-from ngfracture.verify import fit_rate, lshape_study, solve_ngfracture, solve_plain, time_to_error
+from ngfracture.studies import lshape
+from ngfracture.studies.verify import fit_rate, lshape_study, solve_ngfracture, solve_plain, time_to_error
 
 ALPHA_REF = 0.544483736782  # 12 digits, NGSOLVE_NOTES.md (root of sin(3 pi a / 2) = a)
 C1_REF = 1.841364331171
@@ -187,7 +187,7 @@ def test_graded_rates(order):
 
 
 def test_set_versus_nodal_data(sol):
-    # The docstring of ngfracture.verify: Set() and nodal (dual) Dirichlet data change the
+    # The docstring of ngfracture.studies.verify: Set() and nodal (dual) Dirichlet data change the
     # L2 error, not the energy rate alpha.
     e = {False: [], True: []}
     h = []

@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 from netgen.geom2d import SplineGeometry
 
-from ngfracture import ElementAreas
-from ngfracture.collision import boundary_edge_mask
-from ngfracture.meshio import (MeshArrays, merge_meshes, mesh_from_arrays, mesh_to_arrays,
+from ngfracture._ngfracture import ElementAreas
+from ngfracture.contact.collision import boundary_edge_mask
+from ngfracture.geometry.meshio import (MeshArrays, merge_meshes, mesh_from_arrays, mesh_to_arrays,
                              separate_region)
 from conftest import square_mesh, two_region_bar_mesh
 
@@ -36,7 +36,7 @@ def test_merged_bodies_share_no_vertex():
     assert set(m.GetBoundaries()) == {"bottom", "right", "top", "left", "top2"}
     assert ng.Integrate(ng.CF(1), m) == pytest.approx(2.0, rel=1e-14)
     # two pieces: their vertex sets are disjoint
-    from ngfracture.rigid import pieces
+    from ngfracture.mechanics.rigid import pieces
     ncomp, _ = pieces(mesh_to_arrays(m).triangles, m.nv)
     assert ncomp == 2
 

@@ -10,8 +10,9 @@ import ngsolve
 import pytest
 import pyvista as pv
 
-from ngfracture import crack, output
-from ngfracture.fragments import FragmentStatistics, fragment_ids
+from ngfracture.fracture import crack
+from ngfracture.output import vtk as output
+from ngfracture.fracture.fragments import FragmentStatistics, fragment_ids
 from crack_util import grid_mesh, mesh_from_arrays, coords
 
 

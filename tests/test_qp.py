@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from ngfracture.qp import Infeasible, convex_qp
+from ngfracture.linalg.qp import Infeasible, convex_qp
 
 
 def kuhn_tucker_error(H, c, A_eq, b_eq, A_in, b_in, x, u_eq, u_in):

@@ -4,7 +4,7 @@ import pytest
 import scipy.sparse as sp
 
 import ngfracture as nf
-from ngfracture import rigid
+from ngfracture.mechanics import rigid
 from conftest import square_mesh
 
 

@@ -1,11 +1,11 @@
-"""Scenes by name, file or module (ngfracture.scene_source), and --set NAME=VALUE parsing."""
+"""Scenes by name, file or module (ngfracture.run.scene_source), and --set NAME=VALUE parsing."""
 import inspect
 import textwrap
 
 import pytest
 
 from ngfracture import scenes
-from ngfracture.scene_source import (convert_value, load_scene_function, parse_assignments,
+from ngfracture.run.scene_source import (convert_value, load_scene_function, parse_assignments,
                                      scene_parameters)
 
 

@@ -1,4 +1,4 @@
-"""Junction rows of ngfracture.seams on hand-made junctions (no mesh needed).
+"""Junction rows of ngfracture.contact.seams on hand-made junctions (no mesh needed).
 
 A point split into copies, each copy owning a wedge between its outgoing and incoming
 boundary segment (domain on the left). The far ends of the lips are twins as well, so
@@ -7,7 +7,7 @@ adjacent wedges share a facet.
 import numpy as np
 import pytest
 
-from ngfracture.seams import DIAGONAL_RIGHT, _point_ids, find_seams, seam_constraints
+from ngfracture.contact.seams import DIAGONAL_RIGHT, _point_ids, find_seams, seam_constraints
 
 
 def junction(angles_deg):

@@ -6,9 +6,10 @@ import numpy as np
 import pytest
 import pyvista as pv
 
-from ngfracture import checkpoint, scenes
-from ngfracture.materials import LinearElastic
-from ngfracture.simulation import Scene, Simulation, StepControl, crack_length
+from ngfracture import scenes
+from ngfracture.run import checkpoint
+from ngfracture.mechanics.materials import LinearElastic
+from ngfracture.run.simulation import Scene, Simulation, StepControl, crack_length
 
 NOTCH_TIPS = np.array([[0.5, 0.04], [0.5, 0.96]])
 
@@ -207,7 +208,7 @@ def test_failed_steps_stop_cleanly_with_the_last_good_state(tmp_path):
 
 
 def test_crack_length_of_a_straight_cut():
-    from ngfracture.meshio import MeshArrays
+    from ngfracture.geometry.meshio import MeshArrays
     pts = np.array([[0, 0], [0, 1], [0, 0], [0, 1.0]])
     a = MeshArrays(pts, np.zeros((0, 3), int), np.zeros(0, int), ["r"], np.array([[0, 1], [3, 2]]),
                    np.array([1, 1]), ["crack"])

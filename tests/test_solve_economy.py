@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 
 import ngfracture as nf
-from ngfracture.contact_solver import ContactSolver
-from ngfracture.solver import NewtonSolver
+from ngfracture.contact.solver import ContactSolver
+from ngfracture.mechanics.newton import NewtonSolver
 
 from conftest import square_mesh
 from test_contact_solve import pressed_blocks

@@ -17,13 +17,14 @@ import numpy as np
 import pytest
 
 import ngfracture as nf
-from ngfracture import kkt as kkt_module
-from ngfracture import _ngfracture, scenes, split_factor
-from ngfracture.contact_solver import ContactSolver
-from ngfracture.crack import split_by_tensor
-from ngfracture.kkt import ConstrainedSolver, EliminatedFactor
-from ngfracture.simulation import Simulation
-from ngfracture.solver import _base_pins
+from ngfracture.linalg import kkt as kkt_module
+from ngfracture import _ngfracture, scenes
+from ngfracture.linalg import bordered as split_factor
+from ngfracture.contact.solver import ContactSolver
+from ngfracture.fracture.crack import split_by_tensor
+from ngfracture.linalg.kkt import ConstrainedSolver, EliminatedFactor
+from ngfracture.run.simulation import Simulation
+from ngfracture.mechanics.newton import _base_pins
 
 from test_contact_fractured import crack_bands, plate_mesh
 from test_kkt_paths import random_kkt_load, whole_kkt_solution

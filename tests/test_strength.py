@@ -1,12 +1,13 @@
-"""Random strength (ngfracture.strength): Weibull moments, weakest-link size effect, reproducibility,
+"""Random strength (ngfracture.fracture.strength): Weibull moments, weakest-link size effect, reproducibility,
 and a random field carried through splits and a resume."""
 import math
 
 import numpy as np
 import pytest
 
-from ngfracture import scenes, strength
-from ngfracture.simulation import Simulation, StepControl
+from ngfracture import scenes
+from ngfracture.fracture import strength
+from ngfracture.run.simulation import Simulation, StepControl
 
 
 @pytest.mark.parametrize("m", [3.0, 6.0])

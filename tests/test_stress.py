@@ -12,11 +12,11 @@ import numpy as np
 import pytest
 
 import ngfracture as nf
-from ngfracture import crack
-from ngfracture.crack import vertex_displacement
-from ngfracture.kkt import to_scipy
-from ngfracture.meshcheck import MeshQualityWarning
-from ngfracture.meshio import MeshArrays, merge_meshes, mesh_from_arrays
+from ngfracture.fracture import crack
+from ngfracture.fracture.crack import vertex_displacement
+from ngfracture.linalg.kkt import to_scipy
+from ngfracture.geometry.meshcheck import MeshQualityWarning
+from ngfracture.geometry.meshio import MeshArrays, merge_meshes, mesh_from_arrays
 from conftest import square_mesh
 
 

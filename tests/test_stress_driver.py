@@ -27,9 +27,9 @@ import pytest
 import pyvista as pv
 
 from ngfracture import scenes
-from ngfracture.fragments import FragmentStatistics
-from ngfracture.meshio import mesh_from_arrays
-from ngfracture.simulation import Simulation, StepControl
+from ngfracture.fracture.fragments import FragmentStatistics
+from ngfracture.geometry.meshio import mesh_from_arrays
+from ngfracture.run.simulation import Simulation, StepControl
 
 
 # -- critical strain 1e-12 ---------------------------------------------------------------------
@@ -89,8 +89,8 @@ import sys
 import numpy as np
 import ngsolve as ng
 from ngfracture import scenes
-from ngfracture.problem import ElasticProblem
-from ngfracture.simulation import Simulation
+from ngfracture.mechanics.problem import ElasticProblem
+from ngfracture.run.simulation import Simulation
 n = int(sys.argv[1])
 ng.SetNumThreads(n)
 ElasticProblem.PARALLEL_MIN_DOFS = 0          # assemble in the TaskManager on a small mesh

@@ -11,8 +11,9 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from ngfracture import _ngfracture as ext
-from ngfracture import kkt, scenes
-from ngfracture.problem import ElasticProblem
+from ngfracture import scenes
+from ngfracture.linalg import kkt
+from ngfracture.mechanics.problem import ElasticProblem
 
 
 def plate_factor():

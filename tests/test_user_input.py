@@ -5,11 +5,12 @@ import os
 import numpy as np
 import pytest
 
-from ngfracture import contact_solver, scenes
-from ngfracture.contact_solver import ContactSolver
-from ngfracture.qp import QPError
-from ngfracture.simulation import PHASES, Scene, Simulation, StepControl
-from ngfracture.solver import NewtonSolver
+from ngfracture import scenes
+from ngfracture.contact import solver as contact_solver
+from ngfracture.contact.solver import ContactSolver
+from ngfracture.linalg.qp import QPError
+from ngfracture.run.simulation import PHASES, Scene, Simulation, StepControl
+from ngfracture.mechanics.newton import NewtonSolver
 from test_contact_solve import pressed_blocks
 
 
@@ -59,7 +60,7 @@ def test_a_bad_load_is_refused_before_the_folder_is_touched(case, message, coars
 
 
 def test_a_bad_material_region_is_refused_before_the_folder_is_touched(coarse_plate, earlier_results):
-    from ngfracture.materials import LinearElastic
+    from ngfracture.mechanics.materials import LinearElastic
     scene = with_load(coarse_plate, coarse_plate.apply_load, material={"glass": LinearElastic(1.0, 0.3)})
     before = snapshot(earlier_results)
     with pytest.raises(ValueError, match="material region 'glass' does not exist in the mesh"):
@@ -150,7 +151,7 @@ def test_a_complementarity_problem_that_raises_is_a_recorded_note(monkeypatch):
 
 def test_solver_notes_reach_history_and_summary(monkeypatch, tmp_path):
     """A note of a contact solve is in its step's history and in summary['notes']."""
-    import ngfracture.simulation as simulation
+    import ngfracture.run.simulation as simulation
 
     class Noting(ContactSolver):
         def solve(self, warm=(), lineage=None, start=None):

@@ -1,11 +1,11 @@
-"""VTK XML files written without VTK (ngfracture.vtkxml), read back by VTK's own readers
+"""VTK XML files written without VTK (ngfracture.output.vtkxml), read back by VTK's own readers
 (through PyVista): every array bit for bit, with its VTK type, for every compression; arrays
 larger than one compressed block (32 KiB) and ending in a partial block; empty files."""
 import numpy as np
 import pytest
 import pyvista as pv
 
-from ngfracture import vtkxml
+from ngfracture.output import vtkxml
 
 
 def grid(n=60):

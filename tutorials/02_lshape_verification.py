@@ -21,7 +21,7 @@
 #
 # - evaluate the exact solution of eq. 15 as an NGSolve `CoefficientFunction`,
 # - build uniform and graded mesh hierarchies of the L-shape,
-# - run a convergence study with `ngfracture.verify.lshape_study` and read its rates,
+# - run a convergence study with `ngfracture.studies.verify.lshape_study` and read its rates,
 # - plot errors against the number of dofs and against the solve time,
 # - run the same study from the command line.
 
@@ -34,7 +34,8 @@ import matplotlib.tri as mtri
 import ngsolve as ng
 import numpy as np
 
-from ngfracture import lshape, verify
+from ngfracture.studies import lshape
+from ngfracture.studies import verify
 
 # %% [markdown]
 # ## Problem definition

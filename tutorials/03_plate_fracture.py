@@ -18,7 +18,7 @@
 # It illustrates how to:
 #
 # - look at the crack criterion: the nodal principal strain against the critical strain,
-# - split overstrained vertices by hand with `ngfracture.crack`,
+# - split overstrained vertices by hand with `ngfracture.fracture.crack`,
 # - run a whole simulation under load control (`Simulation`, `StepControl`),
 # - read `summary.json`: steps, increments, energies, fragments, timings,
 # - look at the result (the PNG the run writes, or the VTK files in PyVista/ParaView).
@@ -32,8 +32,9 @@ import matplotlib.tri as mtri
 import numpy as np
 
 import ngfracture as nf
-from ngfracture import crack, scenes
-from ngfracture.simulation import Simulation, StepControl
+from ngfracture import scenes
+from ngfracture.fracture import crack
+from ngfracture.run.simulation import Simulation, StepControl
 
 # %% [markdown]
 # ## The scene
@@ -193,9 +194,9 @@ plt.show()
 # first-crack extension is the critical strain over the largest measure):
 
 # %%
-from ngfracture.crack import StrainCriterion, principal
-from ngfracture.materials import LinearElastic
-from ngfracture.problem import ElasticProblem
+from ngfracture.fracture.crack import StrainCriterion, principal
+from ngfracture.mechanics.materials import LinearElastic
+from ngfracture.mechanics.problem import ElasticProblem
 
 glass = LinearElastic(5e9, 0.18, plane="stress")
 critical, r = scenes.GLASS["critical"], 0.02
@@ -218,7 +219,7 @@ assert levels[2][0] < 0.8 * levels[1][0]                 # still falling
 # %% [markdown]
 # The one-ring extension falls by about 1/sqrt(2) per halving of h; the
 # critical-distance one changes by less than 1 %. Its toughness follows from the
-# critical strain and r: `ngfracture.crack.toughness(critical, r, E)` is
+# critical strain and r: `ngfracture.fracture.crack.toughness(critical, r, E)` is
 # `E critical sqrt(2 pi r)`.
 #
 # ## A whole run with the critical distance

@@ -34,11 +34,11 @@ import numpy as np
 
 import ngfracture as nf
 from ngfracture import scenes
-from ngfracture.contact_solver import ContactSolver
-from ngfracture.crack import vertex_displacement
-from ngfracture.fragments import FragmentStatistics
-from ngfracture.output import plot_fragment_sizes
-from ngfracture.simulation import Simulation
+from ngfracture.contact.solver import ContactSolver
+from ngfracture.fracture.crack import vertex_displacement
+from ngfracture.fracture.fragments import FragmentStatistics
+from ngfracture.output.vtk import plot_fragment_sizes
+from ngfracture.run.simulation import Simulation
 
 # %% [markdown]
 # ## Two bodies

@@ -37,8 +37,8 @@ import pyvista as pv
 from netgen.geom2d import SplineGeometry
 
 import ngfracture as nf
-from ngfracture.fragments import FragmentStatistics
-from ngfracture.simulation import Scene, Simulation, StepControl
+from ngfracture.fracture.fragments import FragmentStatistics
+from ngfracture.run.simulation import Scene, Simulation, StepControl
 
 # %% [markdown]
 # ## Geometry and mesh

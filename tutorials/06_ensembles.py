@@ -35,8 +35,9 @@ from pathlib import Path
 import matplotlib.pyplot as plt  # inline in Jupyter; Agg (no window) in a headless script
 import numpy as np
 
-from ngfracture import scenes, strength
-from ngfracture.ensemble import Ensemble
+from ngfracture import scenes
+from ngfracture.fracture import strength
+from ngfracture.studies.ensemble import Ensemble
 
 # %% [markdown]
 # ## A Weibull strength field

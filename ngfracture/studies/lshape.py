@@ -44,7 +44,7 @@ import netgen.geom2d
 import ngsolve as ng
 import numpy as np
 
-from .materials import lame_parameters
+from ..mechanics.materials import lame_parameters
 
 OMEGA = 3.0 * math.pi / 4.0
 """Half of the reentrant interior angle 3 pi / 2."""
@@ -117,7 +117,7 @@ class LShapeSolution:
     Raises
     ------
     ValueError
-        On invalid material parameters (``ngfracture.materials.lame_parameters``).
+        On invalid material parameters (``ngfracture.mechanics.materials.lame_parameters``).
 
     Attributes
     ----------

@@ -1,13 +1,13 @@
 """Contact across coincident lips: crack faces made by node splitting, split interfaces.
 
-Where the crack engine splits a vertex, or :func:`ngfracture.meshio.separate_region`
+Where the crack engine splits a vertex, or :func:`ngfracture.geometry.meshio.separate_region`
 gives a body its own copies of the interface vertices, two boundary edges lie on top of
 each other in the reference configuration: a *seam facet*, edge (p, q) of side A (its
 triangle on the left) and edge (q2, p2) of side B with X[p2] = X[p], X[q2] = X[q]. Across a
 seam every lip node has a twin at the same reference point, and the two lips were one
 edge, so the contact normal is that edge's normal, defined on both sides alike.
 
-Node-to-segment selection (paper rules 1-4, :mod:`ngfracture.contact`) is ill-posed there:
+Node-to-segment selection (paper rules 1-4, :mod:`ngfracture.contact.rows`) is ill-posed there:
 at zero gap every lip node is at once a slave of the other lip and an end of its master
 segments, both lips offer a master with a different normal (at a kink), and which one wins
 depends on rounding in the predicted configuration. The choice flips from one linearisation
@@ -60,7 +60,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .contact import ContactConstraints, _gap_offset
+from .rows import ContactConstraints, _gap_offset
 
 __all__ = ["Seams", "find_seams", "seam_constraints", "KINK_ANGLE", "SLIP"]
 

@@ -139,8 +139,8 @@ def solve_ngfracture(mesh, order, sol, variant="dirichlet", model="linear", retu
     RuntimeError
         If the solve did not converge.
     """
-    from .materials import make_material
-    from .problem import ElasticProblem
+    from ..mechanics.materials import make_material
+    from ..mechanics.problem import ElasticProblem
 
     bnd = dirichlet_boundaries(variant)
     prob = ElasticProblem(mesh, make_material(model, sol.E, sol.nu, sol.plane), order=order)

@@ -9,7 +9,7 @@ Pipeline for one (predicted) configuration::
 
 or :func:`contact_constraints` for all of it. Where two lips coincide in the reference
 configuration (crack faces, split interfaces) ContactSolver uses the node-to-node rows of
-:mod:`ngfracture.seams` instead: there rules 1-4 have no stable answer.
+:mod:`ngfracture.contact.seams` instead: there rules 1-4 have no stable answer.
 
 Dof layout: component-blocked, as NGSolve's P1 ``VectorH1``: the dof of component ``comp``
 (0 = x, 1 = y) of vertex ``v`` is ``comp * nv + v`` (x dofs 0..nv-1, then y dofs nv..2nv-1).
@@ -73,7 +73,7 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components, reverse_cuthill_mckee
 
-from . import _ngfracture as _ext
+from .. import _ngfracture as _ext
 from .collision import (_as_array, _check_tol, _check_tris, boundary_edge_mask,
                         current_coordinates, detect_collisions)
 
@@ -267,7 +267,7 @@ def select_contacts(coords, displacement, tris, boundary_edges, pairs, tol=0.0,
     boundary_edges : array_like, shape (ne, 2)
         Directed boundary / crack edges with their triangle on the left.
     pairs : array_like of int, shape (k, 2)
-        Colliding pairs, e.g. from :func:`ngfracture.collision.detect_collisions`.
+        Colliding pairs, e.g. from :func:`ngfracture.contact.collision.detect_collisions`.
     tol : float
         Precision threshold (a length, >= 0): the largest signed distance of a slave.
     angle_tol : float

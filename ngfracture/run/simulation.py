@@ -61,17 +61,18 @@ from typing import Callable
 
 import numpy as np
 
-from . import checkpoint, split_factor
-from .contact_solver import ContactSolver, fragment_overlap_area
-from .crack import (GROWTH_RULES, PAPER_RULES, StrainCriterion, element_strain, equivalent_strain,
+from . import checkpoint
+from ..linalg import bordered as split_factor
+from ..contact.solver import ContactSolver, fragment_overlap_area
+from ..fracture.crack import (GROWTH_RULES, PAPER_RULES, StrainCriterion, element_strain, equivalent_strain,
                     nonlocal_opening, split_by_tensor, transfer_vertex_field)
-from .fragments import FragmentStatistics
-from .kkt import EliminatedFactor, SingularSystem, single_threaded_blas
+from ..fracture.fragments import FragmentStatistics
+from ..linalg.kkt import EliminatedFactor, SingularSystem, single_threaded_blas
 from .loadpath import load_path_cut, prescribed_increment
-from .materials import Material
-from .meshio import MeshArrays, mesh_from_arrays, mesh_to_arrays
-from .problem import ElasticProblem
-from .solver import SavedTangent
+from ..mechanics.materials import Material
+from ..geometry.meshio import MeshArrays, mesh_from_arrays, mesh_to_arrays
+from ..mechanics.problem import ElasticProblem
+from ..mechanics.newton import SavedTangent
 
 #: wall time per phase; "linear" (factorisations and triangular solves) and "assembly"
 #: (NGSolve's residual and tangent assembly) are parts of "solve"
@@ -133,7 +134,7 @@ class Scene:
         Critical distance of the crack criterion (docs/criterion.md), or one per region;
         None: the paper's one-ring nodal strain.
     strength : numpy.ndarray, optional
-        Critical strain per vertex of ``mesh`` (a random field, :mod:`ngfracture.strength`);
+        Critical strain per vertex of ``mesh`` (a random field, :mod:`ngfracture.fracture.strength`);
         it replaces the region's critical strain at the vertices of regions that can
         crack. The copies of a split vertex inherit its strength.
     load_description : str
@@ -598,7 +599,7 @@ class Simulation:
         return own
 
     def _prepare_output(self):
-        from .output import TimeSeriesWriter
+        from ..output.vtk import TimeSeriesWriter
         own = self.check_output(self.out, self.force, self.resume)
         if self.resume:
             arrays, header = checkpoint.latest(self.out)
@@ -1030,7 +1031,7 @@ class Simulation:
         t0 = time.perf_counter()
         self.writer.write(state.step, state.x, prob.mesh, prob.u, stats.fragment)
         if self.pictures == "every":
-            from .output import picture_scale, render_png
+            from ..output.vtk import picture_scale, render_png
             render_png(prob.mesh, prob.u, stats.fragment, self.out / f"step_{state.step:06d}.png",
                        scale=picture_scale(state.arrays.points, state.u))
         self.timings["output"] += time.perf_counter() - t0
@@ -1085,7 +1086,7 @@ class Simulation:
         return {**{k: v for k, v in asdict(self.control).items() if k != "max_steps"}, "contact": self.contact}
 
     def _final_outputs(self, state, prob, stats, summary):
-        from .output import final_pictures, picture_scale, write_summary
+        from ..output.vtk import final_pictures, picture_scale, write_summary
         t0 = time.perf_counter()
         pictures = {}
         if self.pictures != "none":     # ours: a resumed run redraws them

@@ -112,7 +112,7 @@ def tributary_areas(arrays, regions=None):
 
     Parameters
     ----------
-    arrays : ngfracture.meshio.MeshArrays
+    arrays : ngfracture.geometry.meshio.MeshArrays
     regions : iterable of str, optional
         Count only the triangles of these material regions (default all).
 
@@ -233,7 +233,7 @@ def scene_strength(mesh, regions, critical, weibull_m=None, weibull_scale=None, 
     scale = critical / math.gamma(1 + 1 / m) if weibull_scale is None else weibull_scale
     seed = 0 if seed is None else seed
     m, scale, seed, area = check_weibull(m, scale, seed, weibull_area)
-    from .meshio import mesh_to_arrays
+    from ..geometry.meshio import mesh_to_arrays
     arrays = mesh_to_arrays(mesh)
     areas = tributary_areas(arrays, regions)
     field = weibull_strength(len(arrays.points), m, scale, seed, areas, area)

@@ -16,15 +16,15 @@ import numpy as np
 import ngsolve as ng
 import scipy.sparse as sp
 
-from . import _ngfracture as _C
+from .. import _ngfracture as _C
 from . import rigid
 from .constraints import ConstraintSet
-from .crack import vertex_displacement
-from .kkt import to_scipy
+from ..fracture.crack import vertex_displacement
+from ..linalg.kkt import to_scipy
 from .materials import Material
-from .meshcheck import validate_mesh
-from .meshio import mesh_to_arrays
-from .solver import NewtonSolver
+from ..geometry.meshcheck import validate_mesh
+from ..geometry.meshio import mesh_to_arrays
+from .newton import NewtonSolver
 
 
 def check_mesh(mesh):

@@ -55,7 +55,7 @@ def _as_array(values):
     if v.dtype == bool:
         v = v.astype(np.uint8)
     if v.dtype.newbyteorder("=") not in _TYPES:
-        raise TypeError(f"ngfracture.vtkxml: arrays of dtype {v.dtype} have no VTK type")
+        raise TypeError(f"ngfracture.output.vtkxml: arrays of dtype {v.dtype} have no VTK type")
     v = v.reshape(len(v), -1) if v.ndim > 2 else v
     return np.ascontiguousarray(v, dtype=v.dtype.newbyteorder("<"))
 
@@ -92,7 +92,7 @@ class _Appended:
 def _escape(text):
     text = str(text)
     if any(ord(c) < 32 for c in text):
-        raise ValueError(f"ngfracture.vtkxml: the name {text!r} has control characters")
+        raise ValueError(f"ngfracture.output.vtkxml: the name {text!r} has control characters")
     return text.replace("&", "&amp;").replace('"', "&quot;").replace("<", "&lt;").replace(">", "&gt;")
 
 
@@ -103,7 +103,7 @@ def _attributes(tag, arrays, appended, indent, rows):
         return [f"{indent}<{tag}/>"]
     for name, values in arrays.items():
         if len(values) != rows:
-            raise ValueError(f"ngfracture.vtkxml: {tag} array {name!r} has {len(values)} rows, expected {rows}")
+            raise ValueError(f"ngfracture.output.vtkxml: {tag} array {name!r} has {len(values)} rows, expected {rows}")
     first = next(iter(arrays))
     lines = [f'{indent}<{tag} Scalars="{_escape(first)}">']
     lines += [appended.data_array(name, values, indent + "  ") for name, values in arrays.items()]
@@ -127,13 +127,13 @@ def _file(kind, piece, body, field_strings, appended):
 
 def _check(compression, points, cells, corners):
     if compression not in COMPRESSORS:
-        raise ValueError(f"ngfracture.vtkxml: compression must be one of {list(COMPRESSORS)}, got {compression!r}")
+        raise ValueError(f"ngfracture.output.vtkxml: compression must be one of {list(COMPRESSORS)}, got {compression!r}")
     p = np.asarray(points)
     c = np.asarray(cells)
     if p.ndim != 2 or p.shape[1] not in (2, 3):
-        raise ValueError(f"ngfracture.vtkxml: points must have shape (n, 2) or (n, 3), got {p.shape}")
+        raise ValueError(f"ngfracture.output.vtkxml: points must have shape (n, 2) or (n, 3), got {p.shape}")
     if c.size and (c.ndim != 2 or c.shape[1] != corners):
-        raise ValueError(f"ngfracture.vtkxml: cells must have shape (m, {corners}), got {c.shape}")
+        raise ValueError(f"ngfracture.output.vtkxml: cells must have shape (m, {corners}), got {c.shape}")
     p3 = np.zeros((len(p), 3))
     p3[:, :p.shape[1]] = p
     return p3, c.reshape(-1, corners).astype(np.int64)

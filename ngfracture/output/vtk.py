@@ -38,9 +38,10 @@ from pathlib import Path
 
 import numpy as np
 
-from . import crack, vtkxml
-from .meshio import mesh_to_arrays
-from .problem import check_mesh
+from ..fracture import crack
+from . import vtkxml
+from ..geometry.meshio import mesh_to_arrays
+from ..mechanics.problem import check_mesh
 
 __all__ = ["vertex_arrays", "element_strain", "to_pyvista", "cracks_to_pyvista",
            "TimeSeriesWriter", "RenderError", "render_png", "plot_fragment_sizes", "final_pictures",
@@ -59,7 +60,7 @@ def vertex_arrays(mesh):
 
     Returns
     -------
-    ngfracture.meshio.MeshArrays
+    ngfracture.geometry.meshio.MeshArrays
         Regions and boundary numbers are 1-based into their name lists; crack faces are
         ``arrays.boundary_segments("crack")``.
 
@@ -75,10 +76,10 @@ def vertex_arrays(mesh):
 def _displacement(mesh, u):
     U = crack.vertex_displacement(u)
     if U.shape != (mesh.nv, 2):
-        raise ValueError(f"ngfracture.output: displacement has {U.shape[0]} vertex values, "
+        raise ValueError(f"ngfracture.output.vtk: displacement has {U.shape[0]} vertex values, "
                          f"the mesh has {mesh.nv} vertices")
     if not np.all(np.isfinite(U)):
-        raise ValueError("ngfracture.output: displacement has NaN or inf values")
+        raise ValueError("ngfracture.output.vtk: displacement has NaN or inf values")
     return U
 
 
@@ -111,7 +112,7 @@ def element_strain(mesh, u, measure="green", arrays=None):
         Unknown measure, or a displacement that does not fit the mesh.
     """
     if measure not in ("green", "linear"):
-        raise ValueError(f"ngfracture.output: measure must be 'green' or 'linear', got {measure!r}")
+        raise ValueError(f"ngfracture.output.vtk: measure must be 'green' or 'linear', got {measure!r}")
     a = arrays if arrays is not None else vertex_arrays(mesh)
     U = _displacement(mesh, u)
     X, T = a.points, a.triangles
@@ -136,7 +137,7 @@ def _add_user_data(data, extra, n, where):
     for name, values in (extra or {}).items():
         v = np.asarray(values)
         if v.shape[:1] != (n,):
-            raise ValueError(f"ngfracture.output: {where} array {name!r} has shape {v.shape}, "
+            raise ValueError(f"ngfracture.output.vtk: {where} array {name!r} has shape {v.shape}, "
                              f"expected {n} rows")
         data[name] = v
 
@@ -197,7 +198,7 @@ def _mesh_fields(mesh, u=None, fragment=None, strain="green", point_data=None, c
     if fragment is not None:
         f = np.asarray(fragment)
         if f.shape != (ne,) or not np.issubdtype(f.dtype, np.integer):
-            raise ValueError(f"ngfracture.output: fragment must be {ne} integers (one per "
+            raise ValueError(f"ngfracture.output.vtk: fragment must be {ne} integers (one per "
                              f"triangle), got shape {f.shape} dtype {f.dtype}")
         cells["fragment"] = f
     if u is not None:
@@ -349,14 +350,14 @@ def _publish(tmp, path, force, sync=True):
         try:
             os.link(tmp, path)
         except FileExistsError:
-            raise FileExistsError(f"ngfracture.output: {path} exists; pass force=True to overwrite it") from None
+            raise FileExistsError(f"ngfracture.output.vtk: {path} exists; pass force=True to overwrite it") from None
         os.unlink(tmp)
     if sync:
         _fsync_dir(Path(path).parent)
 
 
 #: compressions of the binary VTK arrays: lz4 through VTK's writer (its setter, used by
-#: _save_vtk), the others written by :mod:`ngfracture.vtkxml` (no VTK import, no setter)
+#: _save_vtk), the others written by :mod:`ngfracture.output.vtkxml` (no VTK import, no setter)
 _COMPRESSIONS = {"lz4": "SetCompressorTypeToLZ4", "zlib": None, "lzma": None, None: None}
 
 
@@ -374,7 +375,7 @@ def _save_vtk(obj, path, compression):
     try:
         writer.SetFileName(tmp)
         if writer.Write() != 1:
-            raise OSError(f"ngfracture.output: VTK could not write {path.name}")
+            raise OSError(f"ngfracture.output.vtk: VTK could not write {path.name}")
         os.replace(tmp, path)
     except BaseException:
         if os.path.exists(tmp):
@@ -402,7 +403,7 @@ class TimeSeriesWriter:
         With ``resume``: the last step to keep (e.g. the step of the checkpoint resumed from).
     compression : {'zlib', 'lzma', 'lz4', None}
         Compression of the binary VTK arrays (lossless). zlib (level 1) by default, written
-        by :mod:`ngfracture.vtkxml` without importing VTK; lzma for the smallest files; lz4
+        by :mod:`ngfracture.output.vtkxml` without importing VTK; lzma for the smallest files; lz4
         goes through VTK's writer (ParaView >= 5.5 reads it); None writes the raw bytes.
 
     Attributes
@@ -670,7 +671,7 @@ def render_png(mesh, u, fragment, path, window_size=(1200, 900), scale=1.0, crac
         buf = io.BytesIO()
         image.reduce(ss).save(buf, format="PNG")
     except Exception as e:
-        raise RenderError(f"ngfracture.output: Pillow could not draw {path.name} "
+        raise RenderError(f"ngfracture.output.vtk: Pillow could not draw {path.name} "
                           f"({type(e).__name__}: {e})") from e
     _atomic_bytes(path, buf.getvalue(), force)
     return path

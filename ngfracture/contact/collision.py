@@ -37,7 +37,7 @@ Outputs are sorted pairs (i, j), i < j, of triangle indices.
 """
 import numpy as np
 
-from . import _ngfracture as _ext
+from .. import _ngfracture as _ext
 
 __all__ = [
     "orient2d", "boundary_edge_mask", "candidate_mask", "broad_phase_pairs",

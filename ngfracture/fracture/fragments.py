@@ -13,9 +13,9 @@ import math
 
 import numpy as np
 
-from . import rigid
-from ._ngfracture import ElementAreas
-from .problem import check_mesh, element_vertices
+from ..mechanics import rigid
+from .._ngfracture import ElementAreas
+from ..mechanics.problem import check_mesh, element_vertices
 
 __all__ = ["FragmentStatistics", "fragment_ids"]
 
@@ -24,7 +24,7 @@ def fragment_ids(mesh):
     """Fragment number of every triangle: connected components through shared vertices.
 
     Numbered by their smallest triangle (fragment 0 holds triangle 0), as in
-    :class:`ngfracture.crack.SplitResult`.
+    :class:`ngfracture.fracture.crack.SplitResult`.
 
     Parameters
     ----------

@@ -62,7 +62,7 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from . import _ngfracture as _ext
+from .. import _ngfracture as _ext
 
 LINEAR_SOLVERS = ("direct", "gmres")
 
@@ -1045,7 +1045,7 @@ class ConstrainedSolver:
             min 1/2 lam^T S lam - b^T lam   s.t.  G^T lam = R^T q,  lam_i <= 0 (i unilateral)
 
         with b = C (du_fixed + K^+ q) - h, solved exactly by the dual active-set method
-        (:func:`ngfracture.qp.convex_qp`); S is positive definite on the null space of G^T
+        (:func:`ngfracture.linalg.qp.convex_qp`); S is positive definite on the null space of G^T
         when the rows are independent and the free modes held, as the constructor checks.
         With ``dependent_rows`` S is only semidefinite: 1e-10 (relative to its unit
         diagonal after equilibration) is added to it, which picks the smallest multipliers

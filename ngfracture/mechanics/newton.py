@@ -20,8 +20,8 @@ import scipy.sparse as sp
 
 from . import rigid
 from .constraints import ConstraintRows
-from .kkt import ConstrainedSolver, EliminatedFactor, SingularSystem, single_threaded_blas
-from .split_factor import BorderedFactor
+from ..linalg.kkt import ConstrainedSolver, EliminatedFactor, SingularSystem, single_threaded_blas
+from ..linalg.bordered import BorderedFactor
 
 METHODS = ("modified", "full")
 #: linear solvers of the Newton step (kkt.ConstrainedSolver)
@@ -492,7 +492,7 @@ class NewtonSolver:
         SingularSystem
             An unheld free mode or a singular stiffness.
         qp.QPError
-            If the dual active-set method fails (see :func:`ngfracture.qp.convex_qp`).
+            If the dual active-set method fails (see :func:`ngfracture.linalg.qp.convex_qp`).
         """
         prob = self.problem
         rows = prob.assemble_constraints()

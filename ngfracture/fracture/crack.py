@@ -65,9 +65,9 @@ import time
 import numpy as np
 import ngsolve
 
-from . import _ngfracture as _C
-from .meshcheck import validate_mesh
-from .meshio import ngsolve_mesh
+from .. import _ngfracture as _C
+from ..geometry.meshcheck import validate_mesh
+from ..geometry.meshio import ngsolve_mesh
 
 __all__ = [
     "RULE_1", "RULE_1A", "RULE_1B", "RULE_2", "RULE_2A", "RULE_2B", "RULE_2C", "RULE_TIP", "RULE_TIP1",
@@ -118,7 +118,7 @@ class SplitRules:
 
     def __post_init__(self):
         if not (isinstance(self.enter_angle, (int, float)) and 0 <= self.enter_angle < math.pi / 2):
-            raise ValueError(f"ngfracture.crack: enter_angle must be in [0, pi/2) radians, got {self.enter_angle!r}")
+            raise ValueError(f"ngfracture.fracture.crack: enter_angle must be in [0, pi/2) radians, got {self.enter_angle!r}")
 
 
 PAPER_RULES = SplitRules()
@@ -148,23 +148,23 @@ def _check_critical(critical, what="critical strain"):
     try:
         c = float(critical)
     except (TypeError, ValueError):
-        raise ValueError(f"ngfracture.crack: {what} must be a number, got {critical!r}") from None
+        raise ValueError(f"ngfracture.fracture.crack: {what} must be a number, got {critical!r}") from None
     if not math.isfinite(c) or c <= 0:
-        raise ValueError(f"ngfracture.crack: {what} must be finite and > 0, got {critical!r}")
+        raise ValueError(f"ngfracture.fracture.crack: {what} must be finite and > 0, got {critical!r}")
     return c
 
 
 def _check_mesh(mesh):
     if not isinstance(mesh, ngsolve.Mesh):
-        raise TypeError(f"ngfracture.crack: expected an ngsolve.Mesh, got {type(mesh).__name__}")
+        raise TypeError(f"ngfracture.fracture.crack: expected an ngsolve.Mesh, got {type(mesh).__name__}")
     if mesh.dim != 2:
-        raise ValueError(f"ngfracture.crack: the mesh must be 2D, it has dimension {mesh.dim}")
+        raise ValueError(f"ngfracture.fracture.crack: the mesh must be 2D, it has dimension {mesh.dim}")
 
 
 def _field_order(gf):
     fes = gf.space
     if not isinstance(fes, ngsolve.VectorH1) or fes.mesh.dim != 2:
-        raise TypeError("ngfracture.crack: the displacement must be a GridFunction on a 2D "
+        raise TypeError("ngfracture.fracture.crack: the displacement must be a GridFunction on a 2D "
                         f"ngsolve.VectorH1 space, got {type(fes).__name__}")
     return fes.globalorder
 
@@ -195,7 +195,7 @@ def vertex_displacement(u):
         return v.reshape(2, -1)[:, :nv].T.copy()   # component-blocked dofs, vertices first
     a = np.array(u, dtype=float)
     if a.ndim != 2 or a.shape[1] != 2:
-        raise TypeError(f"ngfracture.crack: vertex displacement must have shape (nv, 2), got {a.shape}")
+        raise TypeError(f"ngfracture.fracture.crack: vertex displacement must have shape (nv, 2), got {a.shape}")
     return a
 
 
@@ -203,10 +203,10 @@ def _vertex_values(mesh, u):
     """The displacement's vertex values (nv, 2), checked to fit the mesh and to be finite."""
     U = vertex_displacement(u)
     if U.shape[0] != mesh.nv:
-        raise ValueError(f"ngfracture.crack: displacement has {U.shape[0]} vertex values, "
+        raise ValueError(f"ngfracture.fracture.crack: displacement has {U.shape[0]} vertex values, "
                          f"the mesh has {mesh.nv} vertices")
     if not np.all(np.isfinite(U)):
-        raise ValueError("ngfracture.crack: displacement has NaN or inf values")
+        raise ValueError("ngfracture.fracture.crack: displacement has NaN or inf values")
     return U
 
 
@@ -236,10 +236,10 @@ def element_strain(mesh, u, measure="green"):
     """
     _check_mesh(mesh)
     if measure not in ("green", "linear"):
-        raise ValueError(f"ngfracture.crack: measure must be 'green' or 'linear', got {measure!r}")
+        raise ValueError(f"ngfracture.fracture.crack: measure must be 'green' or 'linear', got {measure!r}")
     if isinstance(u, ngsolve.GridFunction) and _field_order(u) > 1:
         if u.space.mesh.nv != mesh.nv or u.space.mesh.ne != mesh.ne:
-            raise ValueError("ngfracture.crack: the displacement lives on another mesh")
+            raise ValueError("ngfracture.fracture.crack: the displacement lives on another mesh")
         H = ngsolve.Grad(u)
         E = 0.5 * (H + H.trans)
         if measure == "green":
@@ -277,7 +277,7 @@ def vertex_strain(mesh, u, measure="green"):
     if isinstance(u, ngsolve.GridFunction) and _field_order(u) > 1:
         return _C.VertexAverage(mesh, element_strain(mesh, u, measure))
     if measure not in ("green", "linear"):
-        raise ValueError(f"ngfracture.crack: measure must be 'green' or 'linear', got {measure!r}")
+        raise ValueError(f"ngfracture.fracture.crack: measure must be 'green' or 'linear', got {measure!r}")
     return _C.CrackVertexStrain(mesh, _vertex_values(mesh, u), measure)
 
 
@@ -312,12 +312,12 @@ def equivalent_strain(mesh, strain, material):
     """
     e = np.asarray(strain, dtype=float)
     if e.shape != (mesh.ne, 3):
-        raise ValueError(f"ngfracture.crack: element strains must have shape ({mesh.ne}, 3), got {e.shape}")
+        raise ValueError(f"ngfracture.fracture.crack: element strains must have shape ({mesh.ne}, 3), got {e.shape}")
     names = list(mesh.GetMaterials())
     mats = material if isinstance(material, dict) else {n: material for n in names}
     missing = [n for n in names if n not in mats]
     if missing:
-        raise ValueError(f"ngfracture.crack: no material for regions {missing}")
+        raise ValueError(f"ngfracture.fracture.crack: no material for regions {missing}")
     region = mesh.ngmesh.Elements2D().NumPy()["index"].astype(int) - 1   # netgen counts regions from 1
     lam = np.array([mats[n].lam / mats[n].E for n in names])[region]
     two_mu = np.array([2 * mats[n].mu / mats[n].E for n in names])[region]
@@ -365,17 +365,17 @@ def nonlocal_opening(mesh, element_tensors, radius, ndir=72):
     _check_mesh(mesh)
     t = np.asarray(element_tensors, dtype=float)
     if t.shape != (mesh.ne, 3):
-        raise ValueError(f"ngfracture.crack: element tensors must have shape ({mesh.ne}, 3), got {t.shape}")
+        raise ValueError(f"ngfracture.fracture.crack: element tensors must have shape ({mesh.ne}, 3), got {t.shape}")
     if not np.all(np.isfinite(t)):
-        raise ValueError("ngfracture.crack: element tensors have NaN or inf values")
+        raise ValueError("ngfracture.fracture.crack: element tensors have NaN or inf values")
     if np.ndim(radius) == 0:
         r = np.full(mesh.nv, _check_critical(radius, "critical distance"))
     else:
         r = np.asarray(radius, dtype=float)
         if r.shape != (mesh.nv,) or not np.all(np.isfinite(r)):
-            raise ValueError(f"ngfracture.crack: radius must be a number or {mesh.nv} finite values")
+            raise ValueError(f"ngfracture.fracture.crack: radius must be a number or {mesh.nv} finite values")
     if isinstance(ndir, bool) or not isinstance(ndir, (int, np.integer)) or ndir < 8:
-        raise ValueError(f"ngfracture.crack: ndir must be an integer >= 8, got {ndir!r}")
+        raise ValueError(f"ngfracture.fracture.crack: ndir must be an integer >= 8, got {ndir!r}")
     nodal = _C.VertexAverage(mesh, t)
     return _C.CrackNonlocalOpening(mesh, nodal, r, int(ndir))
 
@@ -452,9 +452,9 @@ def principal(tensors):
     """
     t = np.asarray(tensors, dtype=float)
     if t.ndim != 2 or t.shape[1] != 3:
-        raise ValueError(f"ngfracture.crack: tensors must have shape (n, 3), got {t.shape}")
+        raise ValueError(f"ngfracture.fracture.crack: tensors must have shape (n, 3), got {t.shape}")
     if not np.all(np.isfinite(t)):
-        raise ValueError("ngfracture.crack: tensor field has NaN or inf values")
+        raise ValueError("ngfracture.fracture.crack: tensor field has NaN or inf values")
     return _C.CrackPrincipal(t)
 
 
@@ -520,7 +520,7 @@ class StrainCriterion:
     def __init__(self, critical, measure="green", radius=None, material=None, ndir=72):
         self.critical = _check_critical(critical)
         if measure not in ("green", "linear"):
-            raise ValueError(f"ngfracture.crack: measure must be 'green' or 'linear', got {measure!r}")
+            raise ValueError(f"ngfracture.fracture.crack: measure must be 'green' or 'linear', got {measure!r}")
         self.measure = measure
         self.radius = None if radius is None else _check_critical(radius, "critical distance")
         self.material = material
@@ -632,15 +632,15 @@ def split_vertices(mesh, vertices, directions, crack_name="crack", skip_neighbou
     v = np.ascontiguousarray(vertices, dtype=np.int32).reshape(-1)
     d = np.ascontiguousarray(directions, dtype=float)
     if d.ndim != 2 or d.shape != (len(v), 2):
-        raise ValueError(f"ngfracture.crack: directions must have shape ({len(v)}, 2), got {d.shape}")
+        raise ValueError(f"ngfracture.fracture.crack: directions must have shape ({len(v)}, 2), got {d.shape}")
     if len(v) and (v.min() < 0 or v.max() >= mesh.nv):
-        raise ValueError(f"ngfracture.crack: vertex numbers must be in [0, {mesh.nv})")
+        raise ValueError(f"ngfracture.fracture.crack: vertex numbers must be in [0, {mesh.nv})")
     if len(np.unique(v)) != len(v):
-        raise ValueError("ngfracture.crack: a vertex appears twice in the processing order")
+        raise ValueError("ngfracture.fracture.crack: a vertex appears twice in the processing order")
     if not np.all(np.isfinite(d)) or np.any(np.all(d == 0, axis=1)):
-        raise ValueError("ngfracture.crack: directions must be finite and nonzero")
+        raise ValueError("ngfracture.fracture.crack: directions must be finite and nonzero")
     if not isinstance(rules, SplitRules):
-        raise TypeError(f"ngfracture.crack: rules must be a SplitRules, got {type(rules).__name__}")
+        raise TypeError(f"ngfracture.fracture.crack: rules must be a SplitRules, got {type(rules).__name__}")
     r = _C.CrackSplit(mesh.ngmesh, v, d, crack_name, bool(skip_neighbours), float(rules.enter_angle),
                       bool(rules.single_edge_tips))
     t0 = time.perf_counter()
@@ -679,7 +679,7 @@ def transfer_vertex_field(values, result):
     """
     a = np.asarray(values)
     if a.shape[0] != result.record["nv_old"]:
-        raise ValueError(f"ngfracture.crack: field has {a.shape[0]} rows, the old mesh has "
+        raise ValueError(f"ngfracture.fracture.crack: field has {a.shape[0]} rows, the old mesh has "
                          f"{result.record['nv_old']} vertices")
     return a[result.parent]
 
@@ -716,12 +716,12 @@ def transfer(u, result):
     """
     p = _field_order(u)
     if p > 2:   # refused even when nothing split: the same call must not depend on the data
-        raise NotImplementedError("ngfracture.crack.transfer: order >= 3 is not supported "
+        raise NotImplementedError("ngfracture.fracture.crack.transfer: order >= 3 is not supported "
                                   "(edge dof orientation changes with the vertex numbers)")
     if result.mesh is u.space.mesh:
         return u                      # nothing was split: the field is already there
     if u.space.mesh.nv != result.record["nv_old"]:
-        raise ValueError("ngfracture.crack.transfer: the field is not on the split mesh")
+        raise ValueError("ngfracture.fracture.crack.transfer: the field is not on the split mesh")
     fes = ngsolve.VectorH1(result.mesh, order=p)
     gf = ngsolve.GridFunction(fes)
     if p == 1:
@@ -775,7 +775,7 @@ def split_by_tensor(mesh, tensors, critical, crack_name="crack", skip_neighbours
     c = _check_critical(critical)
     t = np.asarray(tensors, dtype=float)
     if t.shape != (mesh.nv, 3):
-        raise ValueError(f"ngfracture.crack: tensor field must have shape ({mesh.nv}, 3), got {t.shape}")
+        raise ValueError(f"ngfracture.fracture.crack: tensor field must have shape ({mesh.nv}, 3), got {t.shape}")
     if check_mesh:
         validate_mesh(mesh)
     return _split_pass(mesh, t, c, crack_name, skip_neighbours, first_only, rules)
@@ -838,21 +838,21 @@ def crack_step(mesh, u, critical=None, measure="green", criterion=None, crack_na
     _check_mesh(mesh)
     if criterion is None:
         if critical is None:
-            raise ValueError("ngfracture.crack: give a critical strain or a criterion")
+            raise ValueError("ngfracture.fracture.crack: give a critical strain or a criterion")
         criterion = StrainCriterion(critical, measure)
     if isinstance(u, ngsolve.GridFunction):
         if _field_order(u) > 2:
-            raise NotImplementedError("ngfracture.crack: displacement order >= 3 is not supported")
+            raise NotImplementedError("ngfracture.fracture.crack: displacement order >= 3 is not supported")
         if u.space.mesh.nv != mesh.nv or u.space.mesh.ne != mesh.ne:
-            raise ValueError("ngfracture.crack: the displacement does not live on this mesh")
+            raise ValueError("ngfracture.fracture.crack: the displacement does not live on this mesh")
     else:
-        raise TypeError("ngfracture.crack.crack_step: u must be an ngsolve.GridFunction; "
+        raise TypeError("ngfracture.fracture.crack.crack_step: u must be an ngsolve.GridFunction; "
                         "use split_by_tensor for plain arrays")
     c = _check_critical(criterion.critical)
     validate_mesh(mesh)
     tensors = np.asarray(criterion.vertex_tensor(mesh, u), dtype=float)
     if tensors.shape != (mesh.nv, 3):
-        raise ValueError(f"ngfracture.crack: the criterion's tensor field must have shape ({mesh.nv}, 3), "
+        raise ValueError(f"ngfracture.fracture.crack: the criterion's tensor field must have shape ({mesh.nv}, 3), "
                          f"got {tensors.shape}")
     res = _split_pass(mesh, tensors, c, crack_name)
     return res.mesh, transfer(u, res), res

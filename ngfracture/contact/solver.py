@@ -10,8 +10,8 @@ manner:
        - across seams, where two lips coincide in the reference configuration (crack
          faces from node splitting, interfaces from ``meshio.separate_region``),
          node-to-node rows between twins, chosen once at the prediction
-         (:mod:`ngfracture.seams`: one row per straight node, one per facet at a kink);
-       - elsewhere, node-to-segment rows of the paper's rules 1-4 (:mod:`ngfracture.contact`)
+         (:mod:`ngfracture.contact.seams`: one row per straight node, one per facet at a kink);
+       - elsewhere, node-to-segment rows of the paper's rules 1-4 (:mod:`ngfracture.contact.rows`)
          found at the current configuration; a row stays a candidate while it is active
          or found again, rows of a twin against its own seam are left out;
        every candidate is re-linearised at the configuration of the last solve, so the
@@ -56,7 +56,7 @@ the gaps to the contact forces, S = C K^-1 C^T, is an M-matrix; nearly parallel 
 kink (two facet rows of one node pair) are far from it, and it cycled (measured on the disk
 scene at maxh 0.1: period 4 between 58 and 63 rows, multipliers -1.86e6 and +1.83e6 on two
 rows of one node pair). The complementarity problem with S positive definite has one
-solution, found in finitely many steps (:mod:`ngfracture.qp`); it costs a dense QP on the
+solution, found in finitely many steps (:mod:`ngfracture.linalg.qp`); it costs a dense QP on the
 candidate rows, so it is used only where the cheap update fails.
 
 At the end the Kuhn-Tucker conditions of eq. 8 hold to the solver tolerance for the rows
@@ -72,14 +72,14 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 
-from . import contact
+from . import rows as contact
 from .collision import detect_collisions
-from .crack import vertex_displacement
-from .meshio import boundary_only
+from ..fracture.crack import vertex_displacement
+from ..geometry.meshio import boundary_only
 from .seams import KINK_ANGLE, find_seams, seam_constraints
-from .kkt import SingularSystem, single_threaded_blas
-from .qp import QPError
-from .solver import NewtonSolver, SavedTangent, SolveStatus, check_solve_options
+from ..linalg.kkt import SingularSystem, single_threaded_blas
+from ..linalg.qp import QPError
+from ..mechanics.newton import NewtonSolver, SavedTangent, SolveStatus, check_solve_options
 
 LABEL = "contact"
 
@@ -222,7 +222,7 @@ class ContactSolver:
         solve with reason "penetration".
     kink_angle : float
         Seam facets meeting at a larger angle (radians, in the reference configuration)
-        get a row each at their common node (see :mod:`ngfracture.seams`). The default
+        get a row each at their common node (see :mod:`ngfracture.contact.seams`). The default
         (1e-6) keeps every kink: the exact non-penetration of the polygonal lips. A large
         value (pi) gives one row with the mean normal per node: overlap first order in
         the slip (measured 100 to 1100 times more on a zigzag crack), and a body held only by

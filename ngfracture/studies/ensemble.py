@@ -1,6 +1,6 @@
 """Ensembles of runs: one scene, many seeds, run on dask.distributed.
 
-Each sample is an ordinary :class:`~ngfracture.simulation.Simulation` run in
+Each sample is an ordinary :class:`~ngfracture.run.simulation.Simulation` run in
 ``DIR/sample_NNNN/`` with its checkpoints and summary.json. The samples are independent
 tasks of a ``dask.distributed`` client: by default a ``LocalCluster`` of single-threaded
 worker processes, or any cluster the caller connects to (``dask-jobqueue``, SSH,
@@ -16,7 +16,7 @@ depend on the worker that ran it.
 
 ``DIR/ensemble.json`` holds per sample its seed, reason, steps, split vertices,
 fragments, crack length, peak load and wall time, and the statistics of
-:mod:`ngfracture.statistics`. The peak load is the largest ``2 W / x`` over the accepted
+:mod:`ngfracture.studies.statistics`. The peak load is the largest ``2 W / x`` over the accepted
 steps (W the elastic energy, x the load parameter): by Clapeyron's theorem the
 generalised force conjugate to x of a linear elastic body under one prescribed
 displacement parameter (contact without gap keeps the problem homogeneous of degree one
@@ -173,8 +173,8 @@ def run_sample(scene_factory, seed, index, out, options):
     t0, cpu0 = time.perf_counter(), time.process_time()
     import ngsolve
     ngsolve.SetNumThreads(1)        # one thread per worker process: results do not depend on it
-    from . import checkpoint
-    from .simulation import Simulation, StepControl, _jsonish
+    from ..run import checkpoint
+    from ..run.simulation import Simulation, StepControl, _jsonish
     scene = scene_factory(seed=seed)
     directory = sample_directory(out, index)
     summary = _finished_summary(directory, _jsonish(scene.parameters))
@@ -201,7 +201,7 @@ class SceneFactory:
     Parameters
     ----------
     spec : str
-        As for :func:`ngfracture.scene_source.load_scene_function`: a built-in name, a
+        As for :func:`ngfracture.run.scene_source.load_scene_function`: a built-in name, a
         file path (made absolute here: the workers must see the same file) or
         ``package.module:function``.
     parameters : dict
@@ -224,7 +224,7 @@ class SceneFactory:
         -------
         Scene
         """
-        from .scene_source import load_scene_function
+        from ..run.scene_source import load_scene_function
         return load_scene_function(self.spec)(**self.parameters, seed=seed)
 
     def __repr__(self):
@@ -318,7 +318,7 @@ class Ensemble:
 
     def _request(self):
         """What defines the ensemble: scene, its base parameters, seeds, options (checked once here)."""
-        from .simulation import Scene, StepControl, _jsonish
+        from ..run.simulation import Scene, StepControl, _jsonish
         try:
             scene = self.scene_factory(seed=self.seeds[0])
         except TypeError as err:
@@ -363,7 +363,7 @@ class Ensemble:
             The content of ensemble.json.
         """
         from distributed import Client, LocalCluster, as_completed
-        from .output import write_summary
+        from ..output.vtk import write_summary
         t0 = time.perf_counter()
         cluster = None
         if client is None:

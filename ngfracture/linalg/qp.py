@@ -9,7 +9,7 @@ finitely many steps (unlike the primal-dual active set, which can cycle when the
 constraint response is not an M-matrix). No feasible start is needed.
 
 Used by the contact solver for the linear complementarity problem of one linearisation
-(:meth:`ngfracture.kkt.ConstrainedSolver.solve_unilateral`): a few hundred unknowns. The
+(:meth:`ngfracture.linalg.kkt.ConstrainedSolver.solve_unilateral`): a few hundred unknowns. The
 QR factorisation of the working set is updated by Givens rotations when a constraint
 enters or leaves (scipy.linalg.qr_insert / qr_delete), O(n k) per step for k active
 constraints. It was recomputed at every step before: 73 % of the run time of the

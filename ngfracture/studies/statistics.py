@@ -233,7 +233,7 @@ def plot_ensemble(report, folder):
     dict of str -> str
         Picture name -> file name.
     """
-    from .output import _atomic_bytes
+    from ..output.vtk import _atomic_bytes
     import io
     done = [s for s in report["samples"] if s.get("ok")]
     pictures = {}

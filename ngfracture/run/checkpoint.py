@@ -81,7 +81,7 @@ def write(folder, step, arrays, meta, keep=2):
     pathlib.Path
         The written file.
     """
-    from . import __version__
+    from .. import __version__
     folder = Path(folder)
     header = {"format": FORMAT, "format_version": FORMAT_VERSION, "ngfracture": __version__,
               "step": int(step), "meta": meta}

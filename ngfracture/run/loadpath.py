@@ -18,7 +18,7 @@ rigid motion are exact there to first order, and glass strains are 1e-4.
 """
 import numpy as np
 
-from . import rigid
+from ..mechanics import rigid
 
 __all__ = ["prescribed_increment", "deformed_fragments", "load_path_cut"]
 

@@ -1,0 +1,7 @@
+"""Studies made of many runs or solves: ensembles and verification.
+
+ensemble    many seeds of a scene on dask.distributed, resumable, ``ensemble.json``
+statistics  pooled fragment sizes with bootstrap intervals, distribution fits, plots
+lshape      the L-shape manufactured solution of the paper (section 4.1), meshes, errors
+verify      convergence studies against exact solutions
+"""
