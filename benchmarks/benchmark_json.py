@@ -1,7 +1,7 @@
 """The benchmarks' common outputs: ``--json FILE``, ``--force`` and plots.
 
 Every benchmark writes its result as JSON, to stdout or, with ``--json FILE``, atomically
-to FILE (``ngfracture.cli.write_json_atomic``). An existing FILE (or plot) is refused before
+to FILE (``ngfracture.output.atomic.write_json``). An existing FILE (or plot) is refused before
 any measurement unless ``--force``: a benchmark can run for hours, and a finished result is
 not overwritten by mistake.
 """
@@ -9,7 +9,7 @@ import json
 import os
 import sys
 
-from ngfracture.cli import write_json_atomic
+from ngfracture.output.atomic import write_file, write_json
 
 
 def add_options(parser, force_help="overwrite an existing --json file"):
@@ -30,16 +30,14 @@ def save_figure(fig, path):
     """Save a matplotlib figure as PNG at ``path`` atomically (a temporary file, then a rename)
     and close it."""
     import matplotlib.pyplot as plt
-    tmp = f"{path}.tmp.png"
-    fig.savefig(tmp, dpi=120)
+    write_file(path, lambda tmp: fig.savefig(tmp, dpi=120, format="png"), force=True)
     plt.close(fig)
-    os.replace(tmp, path)
 
 
 def write(args, result):
     """Write ``result`` to ``args.json`` (atomically) or to stdout."""
     if args.json:
-        write_json_atomic(args.json, result, force=args.force)
+        write_json(args.json, result, force=args.force, make_folder=True)
     else:
         json.dump(result, sys.stdout, indent=1)
         print()

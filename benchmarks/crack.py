@@ -9,7 +9,7 @@ solve, assembled in a TaskManager); then one crack pass is timed phase by phase:
   t_rebuild   netgen mesh rebuild in C++ + ngsolve.Mesh(...)
   t_transfer  new VectorH1 space + GridFunction + exact copy through the vertex map
   t_nonlocal  the critical-distance measure instead of the nodal strain (element strain,
-              crack.nonlocal_opening with radius r = 4 h, h the mesh size), not part of
+              fracture.nonlocal_opening with radius r = 4 h, h the mesh size), not part of
               the pass above; ``nonlocal_ratio`` = t_nonlocal / t_solve
 
 The critical strain is the 99% quantile of the principal strain, so about 1% of the
@@ -32,7 +32,7 @@ import ngsolve
 from netgen.geom2d import unit_square
 
 import benchmark_json
-from ngfracture.fracture import crack
+from ngfracture import fracture
 
 
 def maxh_for(ntri):
@@ -47,7 +47,7 @@ def plate(ntri):
 def nonlocal_measure(mesh, u, radius):
     """Seconds of the critical-distance measure of every vertex (element strain + rays)."""
     t0 = time.perf_counter()
-    crack.nonlocal_opening(mesh, crack.element_strain(mesh, u), radius)
+    fracture.nonlocal_opening(mesh, fracture.element_strain(mesh, u), radius)
     return time.perf_counter() - t0
 
 
@@ -74,20 +74,20 @@ def solve_stretch(mesh, stretch=1e-3, E=1.0, nu=0.3):
 def crack_pass(mesh, u):
     t = {}
     t0 = time.perf_counter()
-    S = crack.vertex_strain(mesh, u, "green")
-    val, d = crack.principal(S)
+    S = fracture.vertex_strain(mesh, u, "green")
+    val, d = fracture.principal(S)
     t["t_strain"] = time.perf_counter() - t0
     critical = float(np.quantile(val, 0.99))
     t0 = time.perf_counter()
-    order = crack.select(val, critical)
+    order = fracture.select(val, critical)
     t_sel = time.perf_counter() - t0
     t0 = time.perf_counter()
-    res = crack.split_vertices(mesh, order, d[order])
+    res = fracture.split_vertices(mesh, order, d[order])
     t_split_all = time.perf_counter() - t0
     t["t_select"] = t_sel + res.timings["split"]
     t["t_rebuild"] = t_split_all - res.timings["split"]
     t0 = time.perf_counter()
-    crack.transfer(u, res)
+    fracture.transfer(u, res)
     t["t_transfer"] = time.perf_counter() - t0
     return t, res
 

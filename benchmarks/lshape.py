@@ -15,6 +15,19 @@ each the minimum over ``--repeat`` runs (at least 5 for small cases; the
 machine is shared), the two alternating.  ``ratio = t_ngfracture / t_plain``
 (wall time); ``ratio_cpu`` is the same for the process CPU time of all
 threads, less sensitive to other processes on the machine.
+
+Threads: both solvers run with the same NGSolve thread count, ``--threads``
+(default 1), set with ``ngsolve.SetNumThreads`` before every timed solve.  It has
+to be set each time: ngfracture factorises on one thread by design
+(``reproducible_threads``, bitwise reproducible results), and that setting
+outlives the factorisation (``SetNumThreads`` is global and the count restored
+is read outside a TaskManager, where it is 1), so without it every solve after
+the first sparse-Cholesky factorisation of the run (the first case above 40000
+dofs) ran on one thread, the plain baseline's too, and the smaller cases before
+it on all cores: the ratios depended on the order of the cases.  With
+``--threads 2`` the plain baseline also factorises on two threads, ngfracture on
+one: the ratio then includes that choice, not only the cost of the machinery.
+
 ``time_to_error`` gives the ngfracture solve time needed for a relative L2
 error of 1e-2, 1e-3, 1e-4, interpolated in log-log between measured levels
 (``"extrapolated": true`` when the levels do not bracket the target); the
@@ -29,6 +42,7 @@ Usage::
 
     PYTHONPATH=. python benchmarks/lshape.py [--json F] [--plot F.png] [--force]
         [--max-level-p1 7] [--max-level-p2 6] [--repeat 2] [--variant dirichlet]
+        [--threads 1]
 
 Without ``--json`` the JSON goes to stdout; ``--plot`` writes Fig. 6b of the
 paper (relative L2 error against number of vertices, log-log).
@@ -38,6 +52,7 @@ import gc
 import sys
 import time
 
+import ngsolve
 import numpy as np
 
 import benchmark_json
@@ -50,15 +65,17 @@ RATIO_FLOOR = 1.15
 RATIO_MIN_DOFS = 100_000
 
 
-def _timed(fn, *args):
-    """Result, wall time and process CPU time (all threads) of ``fn(*args)``."""
+def _timed(threads, fn, *args):
+    """Result, wall time and process CPU time (all threads) of ``fn(*args)`` on ``threads``
+    NGSolve threads (set before every call: see the module docstring)."""
+    ngsolve.SetNumThreads(threads)
     gc.collect()
     c0, t0 = time.process_time(), time.perf_counter()
     out = fn(*args)
     return out, time.perf_counter() - t0, time.process_time() - c0
 
 
-def run_cases(max_levels, repeat, variant, log=sys.stderr):
+def run_cases(max_levels, repeat, variant, threads=1, log=sys.stderr):
     """Solve every (order, mesh, level) case with both solvers.
 
     Parameters
@@ -68,6 +85,8 @@ def run_cases(max_levels, repeat, variant, log=sys.stderr):
     repeat : int
         Timing repetitions per solver (the minimum is kept).
     variant : {"dirichlet", "traction-free"}
+    threads : int
+        NGSolve threads of both solvers.
     log : file
         Progress lines go here.
 
@@ -78,6 +97,7 @@ def run_cases(max_levels, repeat, variant, log=sys.stderr):
     """
     sol = lshape.LShapeSolution(E=1e5, nu=0.3, plane="strain")
     # Warm-up: the first solves pay one-off costs (thread pool, code generation).
+    ngsolve.SetNumThreads(threads)
     for order in max_levels:
         coarse = lshape.lshape_mesh(0)
         verify.solve_ngfracture(coarse, order, sol, variant)
@@ -95,14 +115,14 @@ def run_cases(max_levels, repeat, variant, log=sys.stderr):
                     runs = ["n", "p"] if k % 2 == 0 else ["p", "n"]
                     for tag in runs:
                         if tag == "n":
-                            (u_ngf, status), dt, dc = _timed(verify.solve_ngfracture, mesh, order,
+                            (u_ngf, status), dt, dc = _timed(threads, verify.solve_ngfracture, mesh, order,
                                                              sol, variant, "linear", True)
                             if not t_ngf or dt < min(t_ngf):
                                 phases = {p: round(v, 4) for p, v in status.timings.items()}
                             t_ngf.append(dt)
                             c_ngf.append(dc)
                         else:
-                            u_plain, dt, dc = _timed(verify.solve_plain, mesh, order, sol, variant)
+                            u_plain, dt, dc = _timed(threads, verify.solve_plain, mesh, order, sol, variant)
                             t_plain.append(dt)
                             c_plain.append(dc)
                 rel_l2, rel_energy = lshape.relative_errors(mesh, u_ngf, sol, order)
@@ -196,14 +216,18 @@ def main(argv=None):
                         help="timing repetitions per solver and case, minimum kept (default 3)")
     parser.add_argument("--variant", choices=verify.VARIANTS, default="dirichlet",
                         help="boundary conditions (default dirichlet: exact data everywhere)")
+    parser.add_argument("--threads", type=_int_at_least(1), default=1,
+                        help="NGSolve threads of both solvers (default 1; ngfracture factorises "
+                             "on one thread whatever this is)")
     args = parser.parse_args(argv)
     benchmark_json.refuse_existing(parser, args, args.plot)
 
-    cases = run_cases({1: args.max_level_p1, 2: args.max_level_p2}, args.repeat, args.variant)
+    cases = run_cases({1: args.max_level_p1, 2: args.max_level_p2}, args.repeat, args.variant,
+                      args.threads)
     tte = time_to_error_table(cases)
     checks = floors(cases, tte)
     result = {"problem": "lshape", "variant": args.variant, "model": "linear",
-              "cases": cases, "time_to_error": tte, "floors": checks}
+              "threads": args.threads, "cases": cases, "time_to_error": tte, "floors": checks}
     benchmark_json.write(args, result)
     if args.plot:
         plot_fig6b(cases, args.plot)

@@ -35,7 +35,7 @@ from ngfracture import scenes   # noqa: E402
 from ngfracture.cli import _int_at_least   # noqa: E402
 
 import benchmark_json   # noqa: E402
-from ngfracture.run.simulation import Simulation   # noqa: E402
+from ngfracture import Simulation   # noqa: E402
 
 NOTCH_TO_NOTCH = 0.92
 

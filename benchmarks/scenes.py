@@ -29,7 +29,7 @@ and per scene run at two or more factors:
   growth       the exponent p of the least-squares fit seconds_per_step ~ ntri^p over
                the factors (and of wall ~ ntri^p), with the cases it was fitted to
 
-Writes JSON {"cases": [...], "growth": {...}} (stdout, or the file of --json FILE). Floors (issue 15): cost per step grows at
+Writes JSON {"cases": [...], "growth": {...}} (stdout, or the file of --json FILE). Targets: cost per step grows at
 most like N^1.2 between the 1x, 4x and 16x plate; the 16x plate (about 31k triangles)
 runs until broken in at most 150 solve-equivalents. The modules the run loads on first
 use (pyvista, matplotlib) are imported before the first case, as NGSolve itself is: a
@@ -51,7 +51,7 @@ import ngsolve
 import benchmark_json
 from ngfracture import scenes
 from ngfracture.mechanics.problem import ElasticProblem
-from ngfracture.run.simulation import Simulation, StepControl
+from ngfracture import Simulation, StepControl
 
 
 def unit_solve(scene):

@@ -1,5 +1,5 @@
 """Benchmark of the Schur complement S = C K^-1 C^T of contact rows: kept columns against
-sparse triangular solves (kkt.SPARSE_SCHUR_MIN_DOFS).
+sparse triangular solves (linalg.factor.SPARSE_SCHUR_MIN_DOFS).
 
 For the notched plate at mesh factors f (maxh 0.034 / sqrt f), rows like the contact rows
 of a crack across the middle (node to node between neighbouring vertices near x = 0.5, unit
@@ -19,7 +19,7 @@ import scipy.sparse as sp
 
 import benchmark_json
 from ngfracture import scenes
-from ngfracture.linalg import kkt
+from ngfracture.linalg import factor as factor_module
 from ngfracture.mechanics.problem import ElasticProblem
 
 
@@ -48,7 +48,7 @@ def case(factor, repeat=3):
     for name in ("columns", "sparse"):
         best = np.inf
         for _ in range(repeat):
-            f = kkt.EliminatedFactor(K, fixed, inverse="superlu")
+            f = factor_module.EliminatedFactor(K, fixed, inverse="superlu")
             f.factorise()
             t0 = time.perf_counter()
             S[name] = C @ f.columns(C) if name == "columns" else f.schur(C)
@@ -67,7 +67,7 @@ def main(argv=None):
     args = parser.parse_args(argv)
     benchmark_json.refuse_existing(parser, args)
     cases = [case(f) for f in args.factors]
-    benchmark_json.write(args, {"cases": cases, "sparse_schur_min_dofs": kkt.SPARSE_SCHUR_MIN_DOFS})
+    benchmark_json.write(args, {"cases": cases, "sparse_schur_min_dofs": factor_module.SPARSE_SCHUR_MIN_DOFS})
 
 
 if __name__ == "__main__":

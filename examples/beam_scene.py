@@ -15,7 +15,7 @@ import ngsolve as ng
 from netgen.geom2d import SplineGeometry
 
 import ngfracture as nf
-from ngfracture.run.simulation import Scene
+from ngfracture import Scene
 
 
 def beam_mesh(maxh):

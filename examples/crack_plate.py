@@ -9,7 +9,7 @@ strain splits vertices), repeated solve + split passes at fixed load until no ve
 overstrained (release of energy through crack formation, paper section 4.2).
 
 It illustrates how to:
-- run `ngfracture.fracture.crack.crack_step` in a load step,
+- run `ngfracture.fracture.crack_step` in a load step,
 - carry the displacement exactly to the split mesh,
 - write the cracked mesh with displacement and fragment number to VTK (pyvista).
 
@@ -22,7 +22,7 @@ import numpy as np
 import ngsolve
 from netgen.geom2d import SplineGeometry
 
-from ngfracture.fracture import crack
+from ngfracture import fracture
 
 
 def plate_with_hole(maxh):
@@ -34,7 +34,7 @@ def plate_with_hole(maxh):
 
 
 def solve(mesh, stretch, E=1.0, nu=0.18):
-    """Displacement as a VectorH1 GridFunction (what ngfracture.fracture.crack expects)."""
+    """Displacement as a VectorH1 GridFunction (what ngfracture.fracture expects)."""
     lam, mu = E * nu / ((1 + nu) * (1 - 2 * nu)), E / (2 * (1 + nu))
     # gliding: x fixed on left and right, y free; solved in H1 x H1, whose dof layout
     # (component blocks) is that of VectorH1
@@ -67,7 +67,7 @@ def write_vtk(mesh, u, result, path):
     cells = np.column_stack([np.full(len(T), 3), T]).ravel()
     grid = pv.UnstructuredGrid(cells, np.full(len(T), pv.CellType.TRIANGLE),
                                np.column_stack([P, np.zeros(len(P))]))
-    U = crack.vertex_displacement(u)
+    U = fracture.vertex_displacement(u)
     grid.point_data["displacement"] = np.column_stack([U, np.zeros(len(U))])
     grid.cell_data["fragment"] = result.fragment
     grid.save(path)
@@ -81,7 +81,7 @@ def main(outdir=".", maxh=0.03, stretch=4e-3, critical=6.5e-3, max_passes=40):
     history = []
     result = None
     for _ in range(max_passes):
-        new_mesh, new_u, res = crack.crack_step(mesh, u, critical)
+        new_mesh, new_u, res = fracture.crack_step(mesh, u, critical)
         n = new_mesh.nv - mesh.nv
         if n == 0 and result is not None:
             break

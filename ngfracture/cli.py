@@ -18,47 +18,10 @@ import math
 import os
 import re
 import sys
-import tempfile
 
 import numpy as np
 
 from . import __version__
-
-
-def write_json_atomic(path, data, force=False):
-    """Write ``data`` as JSON to ``path`` through a temporary file and a rename.
-
-    A reader never sees a half-written file, and an interrupted run leaves the
-    old file (if any) intact.
-
-    Parameters
-    ----------
-    path : str or os.PathLike
-        Target file; missing parent folders are created.
-    data : object
-        JSON-serialisable data.
-    force : bool
-        Replace an existing file; without it an existing file is an error.
-
-    Raises
-    ------
-    FileExistsError
-        If ``path`` exists and ``force`` is false.
-    """
-    path = os.fspath(path)
-    if os.path.exists(path) and not force:
-        raise FileExistsError(f"{path} exists; pass --force to overwrite it")
-    directory = os.path.dirname(os.path.abspath(path))
-    os.makedirs(directory, exist_ok=True)  # e.g. out/ on a fresh checkout
-    fd, tmp = tempfile.mkstemp(dir=directory, prefix=os.path.basename(path) + ".", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
-            json.dump(data, f, indent=2, allow_nan=False)
-            f.write("\n")
-        os.replace(tmp, path)
-    except BaseException:
-        os.unlink(tmp)
-        raise
 
 
 def _int_at_least(minimum):
@@ -237,6 +200,7 @@ def _default_out(spec):
 
 def _run_run(args):
     from .run.scene_source import load_scene_function, parse_assignments
+    from .run.files import check_folder
     from .run.simulation import Simulation, StepControl
 
     if args.force and args.resume:
@@ -248,8 +212,8 @@ def _run_run(args):
     settings = {name: getattr(args, name) for name, _, _ in CONTROL_OPTIONS if getattr(args, name) is not None}
     control = StepControl(max_steps=args.steps, **settings)
     out = args.out if args.out is not None else _default_out(args.scene)
-    Simulation.check_output(out, force=args.force, resume=args.resume,     # before meshing
-                            option_names=("--force", "--resume"))
+    check_folder(out, force=args.force, resume=args.resume,     # before meshing
+                 option_names=("--force", "--resume"))
     try:
         scene = make_scene(**params)
     except (TypeError, ValueError) as exc:
@@ -319,26 +283,23 @@ def _add_render(subparsers):
 
 
 def _run_render(args):
-    from .run import checkpoint
-    from .output.vtk import final_pictures, picture_scale
     from .fracture.fragments import FragmentStatistics
-    from .geometry.meshio import MeshArrays, mesh_from_arrays
+    from .output.pictures import final_pictures, picture_scale
+    from .run.state import load_state
 
     folder = args.dir
     if not os.path.isdir(folder):
         raise ValueError(f"{folder} is not a folder")
-    arrays, header = checkpoint.latest(folder)
-    meta = header.get("meta", header)
-    mesh = mesh_from_arrays(MeshArrays.from_dict(arrays))
+    state, _ = load_state(folder)
     # the checkpoint's vector is in VectorH1 layout: components blocked, vertex dofs first
-    u = np.asarray(arrays["u"]).reshape(2, -1)[:, :mesh.nv].T
-    stats = FragmentStatistics(mesh)
-    scale = picture_scale(MeshArrays.from_dict(arrays).points, u)      # as the run draws it
-    pictures = final_pictures(folder, mesh, u, stats, scale, sizes_min_fragments=1)   # asked for: both
+    u = np.asarray(state.u).reshape(2, -1)[:, :state.mesh.nv].T
+    stats = FragmentStatistics(state.mesh)
+    scale = picture_scale(state.arrays.points, u)      # as the run draws it
+    pictures = final_pictures(folder, state.mesh, u, stats, scale, sizes_min_fragments=1)   # asked for: both
     if "final_error" in pictures:
         print(f"final.png was not drawn: {pictures['final_error']}", file=sys.stderr)
         return 1
-    print(f"{folder}/: final.png and fragment_sizes.png of step {meta['step']} (load {meta['x']:.6g}, "
+    print(f"{folder}/: final.png and fragment_sizes.png of step {state.step} (load {state.x:.6g}, "
           f"{stats.count} fragments)")
     return 0
 
@@ -405,7 +366,8 @@ def _run_verify(args):
     rates = res["rates"]
     print(f"rates over the finest three levels: L2 {rates['l2']:.3f}, energy {rates['energy']:.3f}")
     if args.json is not None:
-        write_json_atomic(args.json, res, force=args.force)
+        from .output.atomic import write_json
+        write_json(args.json, res, force=args.force, make_folder=True)
     return 0
 
 

@@ -20,7 +20,7 @@ from netgen.geom2d import SplineGeometry
 from netgen.meshing import MeshingParameters, Pnt
 
 from .mechanics.materials import StVenantKirchhoff
-from .run.simulation import Scene
+from .run.scene import Scene
 from .fracture.strength import scene_strength
 
 #: the paper's glass: E = 5 GPa, nu = 0.18, critical principal strain 1.3817e-4
@@ -333,9 +333,9 @@ def disintegration(maxh=0.08, expansion=None, dx=None, core_stiffness=0.1, E=GLA
     ----------
     maxh : float
         Mesh size. Coarser than :func:`disk`'s by default (0.08, about 1000 triangles), as
-        the paper ran this case "using a coarse initial mesh": 101 steps and 7 disk pieces
-        in about 30 s on one core; with the one-ring criterion 116 steps and 31 pieces in
-        about 40 s, maxh 0.06 a few minutes (docs/verification.md).
+        the paper ran this case "using a coarse initial mesh": 101 steps and 7 disk pieces;
+        with the one-ring criterion 116 steps, the core and 30 disk pieces
+        (docs/verification.md; run times in docs/performance.md).
     expansion, dx, core_stiffness, E, nu, critical, core_nu, radius, weibull_m, weibull_scale, weibull_area, seed
         As for :func:`disk` (default radius 0.16; None: the paper's criterion, Fig. 10).
 

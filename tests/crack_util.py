@@ -4,7 +4,7 @@ import ngsolve
 from netgen.meshing import Mesh as NGMesh, FaceDescriptor
 
 from ngfracture._ngfracture import ElementAreas
-from ngfracture.fracture import crack
+from ngfracture import fracture
 
 
 def mesh_from_arrays(points, trigs, material="solid", bcname="outer"):

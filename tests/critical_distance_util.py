@@ -10,7 +10,7 @@ import ngsolve as ng
 from netgen.geom2d import SplineGeometry
 from netgen.meshing import MeshingParameters
 
-from ngfracture.fracture.crack import StrainCriterion, principal, split_vertices
+from ngfracture.fracture import Criterion, principal, split_vertices
 from ngfracture.mechanics.materials import LinearElastic
 
 
@@ -58,10 +58,10 @@ def plate_initiation(notch_h, radius, maxh=0.034, critical=1.3817e-4, notch_zone
     mesh = notched_plate_mesh(maxh=maxh, notch_maxh=notch_h, notch_zone=notch_zone)
     mat = glass_plane_stress()
     u = solve_linear(mesh, mat, ("left|right", ""), ng.CF((ng.IfPos(ng.x - 0.5, 0.5, -0.5), 0)))
-    crit = StrainCriterion(critical, "linear", radius=radius, material=mat if radius else None)
-    values, _ = principal(crit.vertex_tensor(mesh, u))
+    crit = Criterion(critical, radius=radius, material=mat if radius else None, measure="linear")
+    values, _ = principal(crit.overstrain(mesh, u))     # overstrain: 1 at the critical measure
     k = int(np.argmax(values))
-    return critical / values[k], mesh, k
+    return 1.0 / values[k], mesh, k
 
 
 def tada_centre_crack(a, b):

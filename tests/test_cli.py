@@ -6,7 +6,8 @@ import sys
 
 import pytest
 
-from ngfracture.cli import main, write_json_atomic
+from ngfracture.cli import main
+from ngfracture.output.atomic import write_json
 
 
 def test_verify_writes_schema(tmp_path, capsys):
@@ -35,9 +36,9 @@ def test_existing_json_needs_force(tmp_path):
     assert main(["verify", "lshape", "--levels", "2", "--json", str(out), "--force"]) == 0
     assert json.loads(out.read_text())["problem"] == "lshape"
     with pytest.raises(FileExistsError):
-        write_json_atomic(out, {})
+        write_json(out, {})
     nested = tmp_path / "new" / "dir" / "r.json"  # the README writes to out/ on a fresh checkout
-    write_json_atomic(nested, {"a": 1})
+    write_json(nested, {"a": 1}, make_folder=True)
     assert json.loads(nested.read_text()) == {"a": 1}
 
 

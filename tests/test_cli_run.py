@@ -14,14 +14,14 @@ from conftest import child_env
 
 from ngfracture import cli, scenes
 from ngfracture.cli import main
-from ngfracture.run.simulation import Scene
+from ngfracture import Scene
 
 SMALL = ["--maxh", "0.1", "--quiet", "--pictures", "none"]
 OPTIONS = ["--maxh", "--steps", "--load-max", "--out", "--force", "--resume", "--pictures", "--contact",
            "--quiet", "--set", "--max-new-cracks", "--method", "--tol", "--maxit", "--cut", "--grow",
            "--grow-after", "--dx-min", "--dx-max", "--max-retries", "--split", "--checkpoint-every",
            "--threads", "--progress"]
-#: issue 5's list of what summary.json holds
+#: what summary.json holds at least (the README's Outputs table)
 SUMMARY_KEYS = ["scene", "parameters", "n_steps", "n_split_vertices", "crack_length", "n_fragments",
                 "fragment_areas", "area_initial", "area_final", "max_overlap_area", "energy",
                 "newton_iterations", "timings"]

@@ -14,7 +14,7 @@ from conftest import child_env
 
 import ngfracture
 from ngfracture import scenes
-from ngfracture.output import vtk as output
+from ngfracture.output import pictures
 from ngfracture.run import simulation
 from ngfracture.cli import main, progress_json
 from ngfracture.run.scene_source import scene_parameters
@@ -147,8 +147,8 @@ def test_render_redraws_the_pictures_of_a_run(tmp_path, capsys):
 
 def test_a_failed_final_picture_is_printed(tmp_path, capsys, monkeypatch):
     def broken(*args, **kwargs):
-        raise output.RenderError("no OpenGL here")
-    monkeypatch.setattr(output, "render_png", broken)
+        raise pictures.RenderError("no OpenGL here")
+    monkeypatch.setattr(pictures, "render_png", broken)
     out = tmp_path / "f"
     assert main(["run", "plate", "--maxh", "0.1", "--steps", "1", "--progress", "none", "--out", str(out)]) == 0
     assert "final.png was not drawn: no OpenGL here" in capsys.readouterr().err

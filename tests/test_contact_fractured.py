@@ -12,8 +12,9 @@ from netgen.occ import X, Y, Glue, MoveTo, OCCGeometry
 
 import ngfracture as nf
 from ngfracture.contact.collision import boundary_edge_mask
-from ngfracture.contact.solver import ContactSolver, _space_columns, fragment_overlap_area
-from ngfracture.fracture.crack import split_by_tensor
+from ngfracture.contact.overlap import fragment_overlap_area
+from ngfracture.contact.solver import ContactSolver, space_columns
+from ngfracture.fracture import split_by_tensor
 from ngfracture.geometry.meshio import mesh_to_arrays
 from ngfracture.contact.seams import find_seams, seam_constraints
 
@@ -67,7 +68,7 @@ def kuhn_tucker(prob, result, h):
     """Largest adhesive multiplier, penetration and |lambda g| relative to the force scale."""
     cs, lam = result.constraints, result.multipliers
     u = prob.u.vec.FV().NumPy()
-    gap = _space_columns(cs.C, prob.mesh.nv, prob.fes.ndof // 2) @ u + cs.g
+    gap = space_columns(cs.C, prob.mesh.nv, prob.fes.ndof // 2) @ u + cs.g
     scale = np.abs(lam).max()
     return lam.max() / scale, -gap.min() / h, np.abs(lam * gap).max() / (scale * h)
 
@@ -76,7 +77,7 @@ def kuhn_tucker(prob, result, h):
 def test_pressed_zigzag_crack_does_not_overlap(d):
     """A crack grown through an unstructured mesh (kinks at every lip node, branches meeting
     at three-copy points) closes under compression: the active set settles, Kuhn-Tucker
-    holds, and the overlap after the solve is below 1e-10 of the area (the issue's bound)
+    holds, and the overlap after the solve is below 1e-10 of the area (the required bound)
     for boundary displacements up to 1 % of the length.
 
     History (d = 1e-3): rows linearised at the prediction only, 3.9e-8; re-linearised at
@@ -263,10 +264,10 @@ def test_cross_cracks_four_fragments_biaxial():
 @pytest.mark.parametrize("bands", [[(0, 1.0), (1, 0.5)], [(1, 0.45)]], ids=["cross", "horizontal"])
 def test_obliquely_pressed_kinked_lips_settle(bands):
     """Zigzag cracks pressed and sheared (right edge moved by (-1e-4, +-3e-4)): nearly
-    parallel rows at kinks give a response that is no M-matrix, and the primal-dual update
-    wandered or cycled (before: reason "active_set" after 20 rounds in both cases, as on the
-    disk scene). Now the set is the exact solution of the linearised complementarity
-    problem once the update has not settled: Kuhn-Tucker to rounding."""
+    parallel rows at kinks give a response that is no M-matrix, on which the primal-dual
+    update alone wanders or cycles (reason "active_set" after 20 rounds in both cases, as on
+    the disk scene). Once the update has not settled, the set is the exact solution of the
+    linearised complementarity problem: Kuhn-Tucker to rounding."""
     h = 0.1
     res = crack_bands(plate_mesh(h), bands, 0.6 * h)
     prob = nf.ElasticProblem(res.mesh, nf.LinearElastic(1.0, 0.3, plane="stress"))
@@ -287,7 +288,7 @@ def test_disk_expansion_runs_to_the_end():
     test, 1e-10 of the area (measured: 42 steps, 3 fragments, overlap 6.5e-17 of the area,
     84 s)."""
     from ngfracture import scenes
-    from ngfracture.run.simulation import Simulation
+    from ngfracture import Simulation
     r = Simulation(scenes.disk(maxh=0.1, expansion=50 * scenes.FIRST_CRACK, radius=None), pictures="none").run()
     assert r.reason == "load_max", r.summary["message"]
     assert r.summary["max_overlap_area"] <= 1e-10 * r.summary["area_initial"]

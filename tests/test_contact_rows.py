@@ -5,6 +5,7 @@ import scipy.sparse as sp
 
 import ngfracture  # noqa: F401
 from ngfracture.contact import collision
+from ngfracture.contact import redundancy
 from ngfracture.contact import rows as contact
 
 from test_collision import boundary_edges_of, two_blocks
@@ -153,7 +154,7 @@ def test_selected_and_stacked_rows_carry_their_own_matrix():
         assert C.shape == picked.C.shape and (C != picked.C).nnz == 0
     assert np.array_equal(picked.g, g_ref)
     with pytest.raises(ValueError, match="different numbers|vertices"):
-        contact.ContactConstraints.stack([cs, contact._no_constraints(len(X) + 1)])
+        contact.ContactConstraints.stack([cs, contact.no_constraints(len(X) + 1)])
 
 
 def test_banded_and_pivoted_agree_on_long_chains():
@@ -176,7 +177,7 @@ def test_banded_and_pivoted_agree_on_long_chains():
 
 @pytest.mark.parametrize("distance", [None, 0.5e-5, 2e-5, 1e-3])
 def test_gram_shortcut_agrees_with_the_pivoted_qr(monkeypatch, distance):
-    """Rows that are clearly independent skip the pivoted QR (contact._clearly_independent)
+    """Rows that are clearly independent skip the pivoted QR (redundancy._clearly_independent)
     and the answer must be the QR's. 150 sparse rows, 20 fixed dofs and 6 dense hold rows G
     (one component, like the contact solver's rigid-mode holds); with `distance` the last
     row is a combination of two others moved off by that much (rtol = 1e-5): at 0.5 rtol
@@ -195,14 +196,14 @@ def test_gram_shortcut_agrees_with_the_pivoted_qr(monkeypatch, distance):
         C[-1] = combo / np.linalg.norm(combo) + distance * kick
     C = sp.csr_matrix(C)
     answered = []
-    shortcut = contact._clearly_independent
+    shortcut = redundancy._clearly_independent
 
     def spy(*args):
         answered.append(shortcut(*args))
         return answered[-1]
-    monkeypatch.setattr(contact, "_clearly_independent", spy)
+    monkeypatch.setattr(redundancy, "_clearly_independent", spy)
     fast = contact.independent_rows(C, fixed_dofs=fixed, G=G, rtol=rtol)
-    monkeypatch.setattr(contact, "_clearly_independent", lambda *args: False)
+    monkeypatch.setattr(redundancy, "_clearly_independent", lambda *args: False)
     qr = contact.independent_rows(C, fixed_dofs=fixed, G=G, rtol=rtol)
     assert np.array_equal(fast, qr)
     if distance is None:

@@ -4,7 +4,7 @@ import pytest
 import ngsolve
 from netgen.geom2d import SplineGeometry, unit_square
 
-from ngfracture.fracture import crack
+from ngfracture import fracture
 from crack_util import check_invariants, grid_mesh, coords
 
 
@@ -34,7 +34,7 @@ def run_single_splits(mesh, nsteps, rng):
     """Split one random vertex at a time (copies included), checking after each."""
     for _ in range(nsteps):
         v = int(rng.integers(mesh.nv))
-        res = crack.split_vertices(mesh, [v], random_directions(rng, 1))
+        res = fracture.split_vertices(mesh, [v], random_directions(rng, 1))
         check_invariants(mesh, res)
         mesh = res.mesh
     return mesh
@@ -43,7 +43,7 @@ def run_single_splits(mesh, nsteps, rng):
 def run_passes(mesh, npass, per_pass, rng):
     for _ in range(npass):
         v = rng.choice(mesh.nv, size=min(per_pass, mesh.nv), replace=False)
-        res = crack.split_vertices(mesh, v, random_directions(rng, len(v)))
+        res = fracture.split_vertices(mesh, v, random_directions(rng, len(v)))
         check_invariants(mesh, res)
         mesh = res.mesh
     return mesh
@@ -67,9 +67,9 @@ def test_every_vertex_same_direction_then_perpendicular():
     # adversarial: all vertices at once, ties everywhere, then again crosswise
     for mesh in (grid_mesh(12, 12), netgen_square(0.08)):
         n = mesh.nv
-        res = crack.split_vertices(mesh, np.arange(n), np.tile([1.0, 0.0], (n, 1)))
+        res = fracture.split_vertices(mesh, np.arange(n), np.tile([1.0, 0.0], (n, 1)))
         check_invariants(mesh, res)
-        res2 = crack.split_vertices(res.mesh, np.arange(res.mesh.nv), np.tile([0.0, 1.0], (res.mesh.nv, 1)))
+        res2 = fracture.split_vertices(res.mesh, np.arange(res.mesh.nv), np.tile([0.0, 1.0], (res.mesh.nv, 1)))
         check_invariants(res.mesh, res2)
         assert res2.nfragments > res.nfragments > 1
 
@@ -79,7 +79,7 @@ def test_grid_shatters_into_single_triangles_at_most():
     mesh = grid_mesh(6, 6)
     rng = np.random.default_rng(3)
     for d in [[1, 0], [0, 1], [1, -1], [1, 1], [1, 0], [0, 1]]:
-        res = crack.split_vertices(mesh, rng.permutation(mesh.nv), np.tile(d, (mesh.nv, 1)) * 1.0)
+        res = fracture.split_vertices(mesh, rng.permutation(mesh.nv), np.tile(d, (mesh.nv, 1)) * 1.0)
         check_invariants(mesh, res)
         mesh = res.mesh
     assert res.nfragments <= mesh.ne
@@ -103,8 +103,8 @@ def test_determinism():
     mesh = netgen_square(0.05)
     v = rng.choice(mesh.nv, size=200, replace=False)
     d = random_directions(rng, 200)
-    r1 = crack.split_vertices(mesh, v, d)
-    r2 = crack.split_vertices(mesh, v, d)
+    r1 = fracture.split_vertices(mesh, v, d)
+    r2 = fracture.split_vertices(mesh, v, d)
     assert r1.record.keys() == r2.record.keys()
     for k in r1.record:
         assert np.array_equal(r1.record[k], r2.record[k]), k
@@ -164,7 +164,7 @@ def test_pieces_from_the_engines_fragments_equal_the_graph_search():
     checked = 0
     for d in [[1, 0], [0, 1], [1, -1], [1, 1]]:
         order = rng.permutation(mesh.nv)[: mesh.nv // 2]
-        res = crack.split_vertices(mesh, order, np.tile(d, (len(order), 1)) * 1.0)
+        res = fracture.split_vertices(mesh, order, np.tile(d, (len(order), 1)) * 1.0)
         mesh = res.mesh
         T = mesh.ngmesh.Elements2D().NumPy()["nodes"][:, :3].astype(np.int64) - 1
         count, piece = rigid.pieces(T, mesh.nv)

@@ -5,7 +5,7 @@ import pytest
 import ngsolve
 
 from ngfracture._ngfracture import ElementAreas
-from ngfracture.fracture import crack
+from ngfracture import fracture
 from crack_util import grid_mesh, vid, fan_mesh, check_invariants, coords
 
 X = [[1.0, 0.0]]   # maximum strain along x: cracks want to run along y
@@ -13,7 +13,7 @@ Y = [[0.0, 1.0]]
 
 
 def split1(mesh, v, d):
-    res = crack.split_vertices(mesh, [v], d)
+    res = fracture.split_vertices(mesh, [v], d)
     check_invariants(mesh, res)
     return res
 
@@ -32,7 +32,7 @@ def test_rule_1_interior_vertex_two_edges():
     m = grid_mesh(4, 4)
     c = vid(4, 2, 2)
     res = split1(m, c, X)
-    assert res.record["rule"][0] == crack.RULE_1
+    assert res.record["rule"][0] == fracture.RULE_1
     assert edge_set(res) == {(c, vid(4, 2, 1)), (c, vid(4, 2, 3))}
     assert res.mesh.nv == m.nv + 1
     assert res.nfragments == 1
@@ -43,7 +43,7 @@ def test_rule_1_interior_vertex_two_edges():
 def test_rule_1_regular_fan():
     m = fan_mesh([30, 90, 150, 210, 270, 330])
     res = split1(m, 0, X)
-    assert res.record["rule"][0] == crack.RULE_1
+    assert res.record["rule"][0] == fracture.RULE_1
     assert edge_set(res) == {(0, 2), (0, 5)}          # the ring vertices at 90 and 270 degrees
 
 
@@ -52,7 +52,7 @@ def test_rule_1a_edges_of_one_triangle_replaced():
     # obtuse triangle, so rule 1a takes the next one (290 deg)
     m = fan_mesh([95, 255, 290, 340, 30, 60])
     res = split1(m, 0, X)
-    assert res.record["rule"][0] == crack.RULE_1 | crack.RULE_1A
+    assert res.record["rule"][0] == fracture.RULE_1 | fracture.RULE_1A
     assert edge_set(res) == {(0, 1), (0, 3)}
     assert res.mesh.nv == m.nv + 1
 
@@ -60,7 +60,7 @@ def test_rule_1a_edges_of_one_triangle_replaced():
 def test_rule_1b_far_ends_on_boundary_split_too():
     m = fan_mesh([30, 90, 150, 210, 270, 330], outer=False)
     res = split1(m, 0, X)
-    assert res.record["rule"][0] == crack.RULE_1 | crack.RULE_1B
+    assert res.record["rule"][0] == fracture.RULE_1 | fracture.RULE_1B
     assert edge_set(res) == {(0, 2), (0, 5)}
     assert res.mesh.nv == m.nv + 3                    # the centre and both far ends
     assert res.nfragments == 2                        # cut through: no single-vertex joint
@@ -71,7 +71,7 @@ def test_rule_2_boundary_vertex_interior_edge():
     m = grid_mesh(4, 4)
     v = vid(4, 2, 0)
     res = split1(m, v, X)
-    assert res.record["rule"][0] == crack.RULE_2
+    assert res.record["rule"][0] == fracture.RULE_2
     assert edge_set(res) == {(v, vid(4, 2, 1))}
     assert res.mesh.nv == m.nv + 1
     assert crack_length(res.mesh) == pytest.approx(2.0, rel=1e-14)
@@ -81,7 +81,7 @@ def test_rule_2a_best_edge_on_boundary_no_split():
     m = grid_mesh(4, 4)
     v = vid(4, 2, 0)
     res = split1(m, v, Y)                             # crack would run along the boundary
-    assert res.record["rule"][0] == crack.RULE_2 | crack.RULE_2A
+    assert res.record["rule"][0] == fracture.RULE_2 | fracture.RULE_2A
     assert len(res.record["edges"]) == 0
     assert res.mesh.nv == m.nv
     assert "crack" not in res.mesh.GetBoundaries()
@@ -91,7 +91,7 @@ def test_rule_2b_far_end_on_boundary():
     m = grid_mesh(4, 1)
     v = vid(4, 2, 0)
     res = split1(m, v, X)
-    assert res.record["rule"][0] == crack.RULE_2 | crack.RULE_2B
+    assert res.record["rule"][0] == fracture.RULE_2 | fracture.RULE_2B
     assert edge_set(res) == {(v, vid(4, 2, 1))}
     assert res.mesh.nv == m.nv + 2
     assert res.nfragments == 2
@@ -105,11 +105,11 @@ def test_tip_propagates_to_boundary():
     res2 = split1(res.mesh, tip, X)
     # the tip's fan is open only along the crack: rule 1 with the crack as one edge;
     # the far end is on the boundary, so the crack reaches it
-    assert res2.record["rule"][0] == crack.RULE_1 | crack.RULE_TIP | crack.RULE_1B
+    assert res2.record["rule"][0] == fracture.RULE_1 | fracture.RULE_TIP | fracture.RULE_1B
     assert edge_set(res2) == {(tip, vid(4, 2, 4))}
     assert res2.nfragments == 1
     res3 = split1(res2.mesh, vid(4, 2, 1), X)
-    assert res3.record["rule"][0] == crack.RULE_1 | crack.RULE_TIP | crack.RULE_1B
+    assert res3.record["rule"][0] == fracture.RULE_1 | fracture.RULE_TIP | fracture.RULE_1B
     assert res3.nfragments == 2
     assert crack_length(res3.mesh) == pytest.approx(8.0, rel=1e-14)
 
@@ -121,7 +121,7 @@ def test_branching_at_tip():
     tip = vid(6, 3, 4)
     d = np.array([[1.0, -1.0]]) / np.sqrt(2)         # crack direction along the diagonal
     res2 = split1(res.mesh, tip, d)
-    assert res2.record["rule"][0] & crack.RULE_TIP
+    assert res2.record["rule"][0] & fracture.RULE_TIP
     assert edge_set(res2) == {(tip, vid(6, 4, 5)), (tip, vid(6, 2, 3))}
     assert res2.mesh.nv == res.mesh.nv + 2
     assert res2.nfragments == 1
@@ -131,18 +131,18 @@ def test_t_junction_and_crossing_cracks():
     n = 6
     m = grid_mesh(n, n)
     col = [vid(n, 3, j) for j in range(n + 1)]
-    res = crack.split_vertices(m, col, X * len(col))
+    res = fracture.split_vertices(m, col, X * len(col))
     check_invariants(m, res)
     assert res.nfragments == 2
     assert crack_length(res.mesh) == pytest.approx(2 * n, rel=1e-14)
     # a horizontal crack from the left boundary meets the vertical one: T-junction
     left = [vid(n, i, 3) for i in range(0, 4)]
-    res2 = crack.split_vertices(res.mesh, left, Y * len(left))
+    res2 = fracture.split_vertices(res.mesh, left, Y * len(left))
     check_invariants(res.mesh, res2)
     assert res2.nfragments == 3
     # continue on the right: the cracks cross
     right = [vid(n, i, 3) for i in range(3, n + 1)]
-    res3 = crack.split_vertices(res2.mesh, right, Y * len(right))
+    res3 = fracture.split_vertices(res2.mesh, right, Y * len(right))
     check_invariants(res2.mesh, res3)
     assert res3.nfragments == 4
     assert crack_length(res3.mesh) == pytest.approx(4 * n, rel=1e-14)
@@ -153,7 +153,7 @@ def test_t_junction_and_crossing_cracks():
 
 def test_rule_flags_match_the_engine():
     from ngfracture import _ngfracture
-    assert _ngfracture.CRACK_RULES == {name: bit for bit, name in crack._RULE_NAMES}
+    assert _ngfracture.CRACK_RULES == {name: bit for bit, name in fracture.RULE_NAMES}
 
 
 def test_copies_split_again():
@@ -162,13 +162,13 @@ def test_copies_split_again():
     n = 6
     m = grid_mesh(n, n)
     col = [vid(n, 3, j) for j in range(n + 1)]
-    res = crack.split_vertices(m, col, X * len(col))
+    res = fracture.split_vertices(m, col, X * len(col))
     mid = vid(n, 3, 3)
     copies = res.record["new_vertices"]
     copy = int(copies[np.flatnonzero(res.parent[copies] == mid)[0]])
     assert copy >= m.nv
     res2 = split1(res.mesh, copy, Y)
-    assert res2.record["rule"][0] & crack.RULE_2
+    assert res2.record["rule"][0] & fracture.RULE_2
     assert len(res2.record["edges"]) == 1
     assert res2.nfragments == 2
     e = tuple(res2.record["edges"][0])
@@ -192,7 +192,7 @@ def test_crack_normals_point_out_of_the_material():
     # divergence theorem on each side of the crack: int_Omega div F = int_bnd F.n with
     # F = (x, 0) gives the area if the crack normals are outward
     m = grid_mesh(4, 4)
-    res = crack.split_vertices(m, [vid(4, 2, j) for j in range(5)], X * 5)
+    res = fracture.split_vertices(m, [vid(4, 2, j) for j in range(5)], X * 5)
     mesh = res.mesh
     n = ngsolve.specialcf.normal(2)
     # fragment number as a P1 field: every vertex lies in exactly one fragment
@@ -224,22 +224,22 @@ def test_first_only_splits_the_first_vertex_that_splits():
     tensors[edge] = [0.0, 3.0, 0.0]      # largest, but along the boundary: rule 2a
     tensors[inner] = [2.0, 0.0, 0.0]     # next: splits (rule 1)
     tensors[other] = [1.5, 0.0, 0.0]     # overstrained too, left for the next pass
-    res = crack.split_by_tensor(m, tensors, 1.0, first_only=True)
+    res = fracture.split_by_tensor(m, tensors, 1.0, first_only=True)
     check_invariants(m, res)
     assert list(res.record["vertex"]) == [edge, inner]
-    assert res.record["rule"][0] == crack.RULE_2 | crack.RULE_2A and res.record["rule"][1] & crack.RULE_1
+    assert res.record["rule"][0] == fracture.RULE_2 | fracture.RULE_2A and res.record["rule"][1] & fracture.RULE_1
     def cut(r):          # the processed vertices that cut edges
         return set(r.record["vertex"][np.diff(r.record["edge_offsets"]) > 0].tolist())
     assert cut(res) == {inner} and np.array_equal(res.record["principal"], [3.0, 2.0])
-    every = crack.split_by_tensor(m, tensors, 1.0)
+    every = fracture.split_by_tensor(m, tensors, 1.0)
     assert set(every.record["vertex"]) == {edge, inner, other} and cut(every) == {inner, other}
     # nothing splittable: the whole order processed, nothing split, the same mesh
-    none = crack.split_by_tensor(m, np.where(np.arange(nv)[:, None] == edge, tensors, 0.0), 1.0, first_only=True)
+    none = fracture.split_by_tensor(m, np.where(np.arange(nv)[:, None] == edge, tensors, 0.0), 1.0, first_only=True)
     assert none.nsplit == 0 and none.mesh is m
 
 
-@pytest.mark.parametrize("enter_deg, rule", [(0.0, crack.RULE_2 | crack.RULE_2A), (24.0, crack.RULE_2 | crack.RULE_2A),
-                                             (30.0, crack.RULE_2 | crack.RULE_2C)])
+@pytest.mark.parametrize("enter_deg, rule", [(0.0, fracture.RULE_2 | fracture.RULE_2A), (24.0, fracture.RULE_2 | fracture.RULE_2A),
+                                             (30.0, fracture.RULE_2 | fracture.RULE_2C)])
 def test_rule_2c_a_crack_from_a_corner_enters_the_body(enter_deg, rule):
     """Corner (0, 0) of the grid: a crack line at 20 degrees to the bottom edge. The best
     edge is that boundary edge (20 degrees off); the only interior edge, the diagonal, is
@@ -247,13 +247,13 @@ def test_rule_2c_a_crack_from_a_corner_enters_the_body(enter_deg, rule):
     m = grid_mesh(4, 4)
     v = vid(4, 0, 0)
     a = np.radians(20.0)
-    res = crack.split_vertices(m, [v], [[-np.sin(a), np.cos(a)]], rules=crack.SplitRules(enter_angle=np.radians(enter_deg)))
+    res = fracture.split_vertices(m, [v], [[-np.sin(a), np.cos(a)]], rules=fracture.SplitRules(enter_angle=np.radians(enter_deg)))
     check_invariants(m, res)
     assert res.record["rule"][0] == rule
-    if rule & crack.RULE_2C:
+    if rule & fracture.RULE_2C:
         assert edge_set(res) == {(v, vid(4, 1, 1))} and res.mesh.nv == m.nv + 1
         assert crack_length(res.mesh) == pytest.approx(2 * np.sqrt(2.0), rel=1e-14)   # both faces
-        assert crack.rule_names(res.record["rule"][0]) == ["2", "2c"]
+        assert fracture.rule_names(res.record["rule"][0]) == ["2", "2c"]
     else:
         assert res.mesh.nv == m.nv
 
@@ -262,12 +262,12 @@ def test_rule_2c_keeps_a_crack_line_along_the_boundary_out():
     """On a straight edge, a crack line along the boundary has its best interior edge 45
     degrees off (the grid) or more: nothing is split for any enter_angle below that."""
     m = grid_mesh(4, 4)
-    res = crack.split_vertices(m, [vid(4, 2, 0)], Y, rules=crack.SplitRules(enter_angle=np.radians(44.0)))
-    assert res.record["rule"][0] == crack.RULE_2 | crack.RULE_2A and res.mesh.nv == m.nv
+    res = fracture.split_vertices(m, [vid(4, 2, 0)], Y, rules=fracture.SplitRules(enter_angle=np.radians(44.0)))
+    assert res.record["rule"][0] == fracture.RULE_2 | fracture.RULE_2A and res.mesh.nv == m.nv
     with pytest.raises(ValueError, match="enter_angle"):
-        crack.SplitRules(enter_angle=np.pi / 2)
+        fracture.SplitRules(enter_angle=np.pi / 2)
     with pytest.raises(TypeError, match="rules must be a SplitRules"):
-        crack.split_vertices(m, [vid(4, 2, 0)], Y, rules="growth")
+        fracture.split_vertices(m, [vid(4, 2, 0)], Y, rules="growth")
 
 
 def test_single_edge_tip_grows_without_forking():
@@ -277,15 +277,15 @@ def test_single_edge_tip_grows_without_forking():
     res = split1(m, vid(6, 3, 3), X)
     tip = vid(6, 3, 4)
     d = np.array([[1.0, -1.0]]) / np.sqrt(2)
-    res2 = crack.split_vertices(res.mesh, [tip], d, rules=crack.GROWTH_RULES)
+    res2 = fracture.split_vertices(res.mesh, [tip], d, rules=fracture.GROWTH_RULES)
     check_invariants(res.mesh, res2)
-    assert res2.record["rule"][0] == crack.RULE_TIP | crack.RULE_TIP1
-    assert crack.rule_names(res2.record["rule"][0]) == ["tip", "tip1"]
+    assert res2.record["rule"][0] == fracture.RULE_TIP | fracture.RULE_TIP1
+    assert fracture.rule_names(res2.record["rule"][0]) == ["tip", "tip1"]
     assert edge_set(res2) == {(tip, vid(6, 4, 5))}
     assert res2.mesh.nv == res.mesh.nv + 1 and res2.nfragments == 1
     assert crack_length(res2.mesh) == pytest.approx(4.0 + 2 * np.sqrt(2.0), rel=1e-14)
     # the same crack line with the other orientation of the direction: the same edge
-    res3 = crack.split_vertices(res.mesh, [tip], -d, rules=crack.GROWTH_RULES)
+    res3 = fracture.split_vertices(res.mesh, [tip], -d, rules=fracture.GROWTH_RULES)
     assert edge_set(res3) == {(tip, vid(6, 4, 5))}
 
 
@@ -294,9 +294,9 @@ def test_single_edge_tip_reaches_the_boundary():
     and the body falls in two, as under the paper's rules."""
     m = grid_mesh(4, 4)
     res = split1(m, vid(4, 2, 2), X)
-    res2 = crack.split_vertices(res.mesh, [vid(4, 2, 3)], X, rules=crack.GROWTH_RULES)
-    assert res2.record["rule"][0] == crack.RULE_TIP | crack.RULE_TIP1 | crack.RULE_1B
+    res2 = fracture.split_vertices(res.mesh, [vid(4, 2, 3)], X, rules=fracture.GROWTH_RULES)
+    assert res2.record["rule"][0] == fracture.RULE_TIP | fracture.RULE_TIP1 | fracture.RULE_1B
     assert edge_set(res2) == {(vid(4, 2, 3), vid(4, 2, 4))}
-    res3 = crack.split_vertices(res2.mesh, [vid(4, 2, 1)], X, rules=crack.GROWTH_RULES)
+    res3 = fracture.split_vertices(res2.mesh, [vid(4, 2, 1)], X, rules=fracture.GROWTH_RULES)
     assert res3.nfragments == 2
     assert crack_length(res3.mesh) == pytest.approx(8.0, rel=1e-14)

@@ -7,7 +7,7 @@ import pytest
 from ngfracture import scenes
 from ngfracture.fracture.fragments import FragmentStatistics
 from ngfracture.geometry.meshio import mesh_to_arrays
-from ngfracture.run.simulation import Simulation
+from ngfracture import Simulation
 
 
 
@@ -67,7 +67,7 @@ def test_encircling_check_on_a_ring_and_a_c_shape():
 
 
 #: the default resolution (slow: 13 minutes on a busy machine) and a coarse one for the
-#: fast suite (about a minute: 48 steps, 107 split vertices, 16 fragments); the issue's
+#: fast suite (about a minute: 48 steps, 107 split vertices, 16 fragments); the required
 #: "more than 20 grains" is for the default scene, the coarse mesh has room for fewer
 DISK_CASES = [pytest.param((0.12, 10), id="coarse"),
               pytest.param((0.06, 20), id="default", marks=pytest.mark.slow)]
@@ -132,20 +132,21 @@ def test_disintegration_falls_apart_on_a_coarse_mesh():
 @pytest.mark.slow
 @pytest.mark.parametrize("maxh", [0.08, 0.06])
 def test_disintegration_many_disjoint_fragments(maxh):
-    """Measured: see the table in docs/verification.md (maxh 0.08 is the scene's default, the paper's
-    "coarse initial mesh": 118 steps, about 5 minutes on a busy machine; 0.06, the disk's
-    resolution: 155 steps, 53 disk pieces, about 20 minutes). Without the diagonal
-    rows at four-way junctions (ngfracture.contact.seams) 0.08 stopped at step 75 (x = 0.00457)
-    with 19 disk pieces; with them but the contact solve's re-linearisations capped at five,
-    step 106 failed seven times (penetration 8.1e-15 against 8e-15, still contracting by 20
-    per update). 0.06 failed at step 33 until the KKT solves refined their solution."""
+    """The one-ring disintegration at maxh 0.08 (the scene's default, the paper's "coarse
+    initial mesh") and 0.06 (the disk's resolution): more than 20 disjoint disk pieces,
+    none around the hole, areas summing to the initial one (measured figures:
+    docs/verification.md, "Whole simulations"). It needs the diagonal rows at four-way
+    junctions (ngfracture.contact.seams; without them 0.08 stops at step 75, x = 0.00457,
+    with 19 disk pieces), up to ten re-linearisations per contact solve (with five, step
+    106 fails with penetration 8.1e-15 against 8e-15, still contracting by 20 per update)
+    and the iterative refinement of the KKT solves (without it 0.06 fails at step 33)."""
     result = Simulation(scenes.disintegration(maxh=maxh, radius=None), pictures="none").run()
     assert result.ok and result.reason == "load_max", result.message
     s = result.summary
     assert s["max_overlap_area"] <= 1e-10 * s["area_initial"]
     stats, a, on_disk = disk_pieces(result)
     assert len(on_disk) > 20
-    # no piece of the disk goes around the hole any more
+    # no piece of the disk goes around the hole
     assert not any(encircles_origin(a.triangles, a.points, np.flatnonzero(stats.fragment == f)) for f in on_disk)
     assert math.fsum(s["fragment_areas"]) == pytest.approx(s["area_initial"], rel=1e-14)
     assert s["area_final"] == s["area_initial"]
@@ -170,10 +171,10 @@ def test_disk_with_a_critical_distance_gives_the_same_cracked_zone_on_two_meshes
     """``disk(radius=0.12)`` on its default mesh (h = r/2) and at half the mesh size
     (h = r/4): radial cracks from the hole that end inside the disk, a total crack length
     and a radius of the cracked zone (the farthest crack tip) within 15 % of each other (the
-    objectivity bound of the plate, docs/criterion.md). The one-ring criterion gives 32 and
-    54 fragments at maxh 0.08 and 0.06. The number of radial cracks is not a converged
-    quantity (cracks that start next to each other may merge). Measured: 8 and 9 cracks,
-    lengths 2.14 and 2.23, cracked zone 0.503 and 0.523, 12 and 60 s."""
+    objectivity bound of the plate, docs/criterion.md). The one-ring criterion's grains
+    multiply when the mesh is refined instead (docs/verification.md). The number of radial
+    cracks is not a converged quantity (cracks that start next to each other may merge).
+    Measured: docs/criterion.md ("Measured: the disk scenes")."""
     runs = []
     for maxh in (0.06, 0.03):
         scene = scenes.disk(maxh=maxh, radius=0.12)

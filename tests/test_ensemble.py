@@ -18,7 +18,7 @@ import pytest
 from conftest import child_env
 
 from ngfracture import scenes
-from ngfracture.studies.ensemble import KILL_HOOK, Ensemble, comparable_report
+from ngfracture.studies.ensemble import Ensemble, comparable_report
 from ngfracture.studies.statistics import fit_fragment_sizes, fragment_size_statistics
 
 FACTORY = functools.partial(scenes.plate, maxh=0.15, weibull_m=8)
@@ -53,12 +53,32 @@ def test_one_and_two_workers_give_the_same_ensemble(reference, tmp_path):
     assert comparable_report(report) == comparable_report(reference)
 
 
-def test_a_killed_worker_has_its_sample_resumed_to_the_same_result(reference, tmp_path, monkeypatch):
-    """The hook SIGKILLs the worker process that first accepts step 6; dask reschedules its
-    sample, which resumes from the sample's checkpoint."""
+def killing_factory(marker):
+    """FACTORY, whose scenes SIGKILL the worker that first builds a problem on a cracked mesh
+    (once: the first to create ``marker``). A closure: dask pickles it by value."""
+    def factory(seed):
+        scene = FACTORY(seed=seed)
+        load = scene.apply_load
+
+        def apply_load(prob, x):
+            if "crack" in prob.mesh.GetBoundaries():
+                try:
+                    os.close(os.open(marker, os.O_CREAT | os.O_EXCL | os.O_WRONLY))
+                except FileExistsError:
+                    pass
+                else:
+                    os.kill(os.getpid(), signal.SIGKILL)
+            load(prob, x)
+        scene.apply_load = apply_load
+        return scene
+    return factory
+
+
+def test_a_killed_worker_has_its_sample_resumed_to_the_same_result(reference, tmp_path):
+    """A worker process is SIGKILLed in the middle of the step of a sample's first crack; dask
+    reschedules the sample, which resumes from its checkpoint."""
     marker = tmp_path / "killed"
-    monkeypatch.setenv(KILL_HOOK, f"{marker}:6")
-    report = Ensemble(FACTORY, SEEDS, out=tmp_path / "ens", workers=2, **OPTIONS).run()
+    report = Ensemble(killing_factory(str(marker)), SEEDS, out=tmp_path / "ens", workers=2, **OPTIONS).run()
     assert marker.exists()
     assert len(report["execution"]["status"]["resumed"]) == 1
     assert comparable_report(report) == comparable_report(reference)

@@ -10,7 +10,7 @@ import pytest
 
 from ngfracture import scenes
 from ngfracture.geometry.meshio import mesh_to_arrays
-from ngfracture.run.simulation import Scene, Simulation, StepControl
+from ngfracture import Scene, Simulation, StepControl
 from ngfracture.mechanics.newton import REASONS
 
 FAULTS = {"nan": (float("nan"), 0.0), "inverted": (0.0, 6e9), "diverged": 0.1}

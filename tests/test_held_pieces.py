@@ -1,10 +1,10 @@
 """Pieces held on their rigid modes (fix_free_modes): a half ring pressed by an expanding core.
 
-The mechanism of issue 5: a piece that contact pushes and nothing else holds. Held only
+The mechanism: a piece that contact pushes and nothing else holds. Held only
 on the modes contact leaves free, it has no equilibrium with compressive contact; held
 on all its modes (the paper's pinned fragments, ``fix_free_modes="all"``) it is pressed
 against its hold. A pressed piece carries internal forces that turn with it, so its
-tangent does not vanish on its rotation (K R != 0): the coarse problem of kkt.py must
+tangent does not vanish on its rotation (K R != 0): the coarse problem of linalg/kkt.py must
 still solve the KKT system exactly.
 """
 import numpy as np
@@ -13,7 +13,8 @@ import pytest
 from netgen.geom2d import SplineGeometry
 
 from ngfracture.contact.solver import ContactSolver
-from ngfracture.linalg.kkt import ConstrainedSolver, to_scipy
+from ngfracture.linalg.kkt import ConstrainedSolver
+from ngfracture.linalg.sparse import to_scipy
 from ngfracture.mechanics.materials import StVenantKirchhoff
 from ngfracture.geometry.meshio import separate_region
 from ngfracture.mechanics.problem import ElasticProblem

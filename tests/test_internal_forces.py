@@ -15,7 +15,7 @@ import scipy.sparse as sp
 
 import ngfracture as nf
 from ngfracture import _ngfracture as _C
-from ngfracture.linalg.kkt import to_scipy
+from ngfracture.linalg.sparse import to_scipy
 from ngfracture.mechanics.problem import ElasticProblem
 from ngfracture.scenes import cored_disk_mesh
 

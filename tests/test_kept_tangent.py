@@ -1,4 +1,4 @@
-"""The factorised tangent a load step keeps for the next one (simulation.KEEP_MIN_DOFS).
+"""The factorised tangent a load step keeps for the next one (run.tangents.KEEP_MIN_DOFS).
 
 A step's increment solve starts from the factorisation of the step before when that one
 contracted well: the same cracks as fresh factorisations to the Newton tolerance, one
@@ -12,33 +12,27 @@ import pyvista as pv
 
 from ngfracture import scenes
 from ngfracture.run import checkpoint
-from ngfracture.linalg import kkt
-from ngfracture.run import simulation
-from ngfracture.linalg.kkt import EliminatedFactor
-from ngfracture.run.simulation import Simulation, StepControl
+from ngfracture.linalg import factor as factor_module
+from ngfracture.run import tangents
+from ngfracture.linalg.factor import EliminatedFactor
+from ngfracture import Simulation, StepControl
 
 
 def counted_run(monkeypatch, scene, keep, **options):
-    """Run ``scene``; returns (result, factorisations, steps started from a kept tangent)."""
-    count = {"factorisations": 0, "kept": 0}
-    factorise, kept_tangent = EliminatedFactor.factorise, Simulation._kept_tangent
+    """Run ``scene``; returns (result, factorisations, accepted steps started from a kept tangent)."""
+    count = {"factorisations": 0}
+    factorise = EliminatedFactor.factorise
 
     def counting_factorise(self):
         count["factorisations"] += not self.factorised
         factorise(self)
 
-    def counting_kept(self, state, prob):
-        tangent = kept_tangent(self, state, prob)
-        count["kept"] += tangent is not None
-        return tangent
-
     with monkeypatch.context() as patch:
         if not keep:
-            patch.setattr(simulation, "KEEP_MIN_DOFS", 10 ** 12)
-        patch.setattr(kkt.EliminatedFactor, "factorise", counting_factorise)
-        patch.setattr(Simulation, "_kept_tangent", counting_kept)
+            patch.setattr(tangents, "KEEP_MIN_DOFS", 10 ** 12)
+        patch.setattr(EliminatedFactor, "factorise", counting_factorise)
         result = Simulation(scene, pictures="none", **options).run()
-    return result, count["factorisations"], count["kept"]
+    return result, count["factorisations"], sum(h["kept_tangent"] for h in result.summary["history"])
 
 
 def final_displacement(result):
@@ -66,8 +60,8 @@ def test_kept_tangent_gives_the_cracks_of_fresh_ones_with_one_factorisation_less
 def test_resume_factorises_the_kept_tangent_again_and_equals_the_uninterrupted_run(monkeypatch, tmp_path):
     """On a small plate, with the thresholds lowered: the kept tangent and the supernodal
     solve, whose rounding depends on the blocks it is given."""
-    monkeypatch.setattr(simulation, "KEEP_MIN_DOFS", 0)
-    monkeypatch.setattr(kkt, "SUPERNODAL_MIN_DOFS", 0)
+    monkeypatch.setattr(tangents, "KEEP_MIN_DOFS", 0)
+    monkeypatch.setattr(factor_module, "SUPERNODAL_MIN_DOFS", 0)
     scene = lambda: scenes.plate(maxh=0.06, radius=None)
     full, part = tmp_path / "full", tmp_path / "part"
     Simulation(scene(), out=full, pictures="none").run()
@@ -91,19 +85,19 @@ def test_a_kept_tangent_that_fails_is_replaced_by_a_fresh_one_and_recorded(monke
     scene = lambda: scenes.plate(maxh=0.06, radius=None)
     control = StepControl(max_retries=0)
     fresh, _, _ = counted_run(monkeypatch, scene(), keep=False, control=control)
-    monkeypatch.setattr(simulation, "KEEP_MIN_DOFS", 0)
-    kept_tangent = Simulation._kept_tangent
+    monkeypatch.setattr(tangents, "KEEP_MIN_DOFS", 0)
+    kept_tangent = tangents.kept_tangent
 
-    def halved(self, state, prob):
+    def halved(state, prob, timings):
         """The kept tangent with half its stiffness: modified Newton oscillates and fails."""
-        tangent = kept_tangent(self, state, prob)
+        tangent = kept_tangent(state, prob, timings)
         if tangent is None:
             return None
         bad = tangent.kept()
         bad.factor = EliminatedFactor(0.5 * tangent.factor.K, tangent.fixed_dofs, tangent.support.pins)
         return bad
 
-    monkeypatch.setattr(Simulation, "_kept_tangent", halved)
+    monkeypatch.setattr(tangents, "kept_tangent", halved)
     result = Simulation(scene(), control, pictures="none").run()
     assert result.ok
     noted = [n for n in result.summary["notes"] if "the tangent kept from the step before failed" in n["note"]]

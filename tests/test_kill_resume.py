@@ -2,8 +2,8 @@
 
 The runs are real processes (``python -c`` calling the CLI's ``main``) killed with
 SIGKILL. One case kills during a checkpoint write: the child announces the write on
-stdout from inside ``os.replace`` (wrapped in the checkpoint module only) and sleeps
-there; the kill lands between the fsync'ed temporary file and the rename.
+stdout from inside ``os.replace`` (wrapped in the atomic writer, for checkpoint files
+only) and sleeps there; the kill lands between the fsync'ed temporary file and the rename.
 The sweep over random moments is marked ``kill_sweep``: a plain ``pytest`` leaves it out,
 the README's test command (and so CI) runs it.
 """
@@ -22,22 +22,23 @@ ARGS = ["run", "plate", "--maxh", "0.06", "--quiet", "--pictures", "none"]
 
 CHILD = """
 import os, sys, time
-from ngfracture.run import checkpoint
+from ngfracture.output import atomic
 from ngfracture.cli import main
 real = os.replace
 slow = int(sys.argv[1])
 class Replace:
     calls = 0
 def replace(src, dst):
-    Replace.calls += 1
-    if Replace.calls == slow:
-        print("WRITING", flush=True)
-        time.sleep(30)
+    if "checkpoint_" in os.path.basename(dst):
+        Replace.calls += 1
+        if Replace.calls == slow:
+            print("WRITING", flush=True)
+            time.sleep(30)
     return real(src, dst)
 if slow > 0:
-    checkpoint.os = type(os)("os_wrapped")
-    checkpoint.os.__dict__.update(os.__dict__)
-    checkpoint.os.replace = replace
+    atomic.os = type(os)("os_wrapped")
+    atomic.os.__dict__.update(os.__dict__)
+    atomic.os.replace = replace
 sys.exit(main(sys.argv[2:]))
 """
 
@@ -89,14 +90,14 @@ def reference(tmp_path_factory):
 
 def test_kill_during_a_checkpoint_write_resumes_to_the_same_result(reference, tmp_path):
     out = tmp_path / "run"
-    proc = _start(out, tmp_path, slow=3)        # the third rename is inside a checkpoint write
+    proc = _start(out, tmp_path, slow=3)        # inside the write of the third checkpoint
     line = proc.stdout.readline()
     assert line.strip() == "WRITING", proc.stderr.read()
     proc.send_signal(signal.SIGKILL)
     proc.wait()
-    assert any(p.name.startswith(".checkpoint_") for p in out.iterdir())   # the half-done write
+    assert any(p.name.startswith(".tmp_ngf_") for p in out.iterdir())   # the half-done write
     _finish(_start(out, tmp_path, resume=True))
-    assert not any(p.name.startswith(".checkpoint_") for p in out.iterdir())
+    assert not any(p.name.startswith(".tmp_ngf_") for p in out.iterdir())
     _compare(out, reference)
 
 

@@ -21,8 +21,9 @@ import scipy.sparse.linalg as spla
 
 import ngfracture as nf
 from ngfracture.contact.solver import ContactSolver
-from ngfracture.linalg import kkt as kkt_module
-from ngfracture.linalg.kkt import ConstrainedSolver, to_scipy
+from ngfracture.linalg import factor as factor_module
+from ngfracture.linalg.kkt import ConstrainedSolver
+from ngfracture.linalg.sparse import to_scipy
 from ngfracture.mechanics.newton import NewtonSolver
 
 from test_contact_fractured import crack_bands, plate_mesh
@@ -88,7 +89,7 @@ def whole_kkt_solution(K, rows, r, du_fixed, h):
 def test_constrained_solve_equals_whole_kkt_solve(contact_state, path, inverse, sparse_schur, monkeypatch):
     """sparse_schur: the Schur complement from sparse triangular solves (the path of large
     meshes, forced here on a small one), no kept columns."""
-    monkeypatch.setattr(kkt_module, "SPARSE_SCHUR_MIN_DOFS", 0 if sparse_schur else 10 ** 9)
+    monkeypatch.setattr(factor_module, "SPARSE_SCHUR_MIN_DOFS", 0 if sparse_schur else 10 ** 9)
     prob, rows, support, result = contact_state
     n_contact = len(result.multipliers)
     assert n_contact > 0 and np.any(result.multipliers < 0)     # pieces pressed together
@@ -107,7 +108,7 @@ def test_constrained_solve_equals_whole_kkt_solve(contact_state, path, inverse, 
 def test_first_solve_made_with_the_columns_saves_a_solve_and_equals_whole_kkt_solve(contact_state, monkeypatch):
     """``first``: the first solve's K^+ q joins the block of the Schur columns; the same
     solution as the whole KKT system (1e-10), one solve of the factorisation less."""
-    monkeypatch.setattr(kkt_module, "SPARSE_SCHUR_MIN_DOFS", 10 ** 9)
+    monkeypatch.setattr(factor_module, "SPARSE_SCHUR_MIN_DOFS", 10 ** 9)
     prob, rows, support, result = contact_state
     K = to_scipy(prob.tangent())
     ndof = prob.fes.ndof
@@ -115,7 +116,7 @@ def test_first_solve_made_with_the_columns_saves_a_solve_and_equals_whole_kkt_so
     du_ref, lam_ref = whole_kkt_solution(K, rows, r, du_fixed, h)
     calls = {}
     for first in (None, (r, du_fixed)):
-        factor = kkt_module.EliminatedFactor(K, rows.fixed_dofs, support.pins)
+        factor = factor_module.EliminatedFactor(K, rows.fixed_dofs, support.pins)
         solve, count = factor.solve, []
         factor.solve = lambda B, solve=solve, count=count: count.append(B.shape) or solve(B)
         kkt = ConstrainedSolver(None, rows.fixed_dofs, rows.C, modes=support.modes, pins=support.pins,
@@ -140,8 +141,8 @@ def test_sparse_schur_complement_and_complementarity_equal_the_columns(contact_s
     h = 1e-3 * rng.standard_normal(rows.C.shape[0])
     solved = {}
     for sparse_schur in (False, True):
-        monkeypatch.setattr(kkt_module, "SPARSE_SCHUR_MIN_DOFS", 0 if sparse_schur else 10 ** 9)
-        factor = kkt_module.EliminatedFactor(K, rows.fixed_dofs, support.pins)
+        monkeypatch.setattr(factor_module, "SPARSE_SCHUR_MIN_DOFS", 0 if sparse_schur else 10 ** 9)
+        factor = factor_module.EliminatedFactor(K, rows.fixed_dofs, support.pins)
         uni = ConstrainedSolver(None, rows.fixed_dofs, rows.C, modes=support.modes, pins=support.pins,
                                 factor=factor, dependent_rows=True)
         contact = np.arange(len(result.multipliers))     # the hold rows stay equalities
@@ -187,12 +188,12 @@ def test_a_cracking_run_takes_the_same_path_with_the_sparse_schur_complement(mon
     steps and split vertices, and crack length, energy and the displacement of the final
     state equal to the rounding of the solves (1e-9 relative)."""
     from ngfracture import scenes
-    from ngfracture.run.simulation import Simulation
+    from ngfracture import Simulation
 
     runs = {}
     for sparse in (False, True):
-        monkeypatch.setattr(kkt_module, "SPARSE_SCHUR_MIN_DOFS", 0 if sparse else 10 ** 9)
-        monkeypatch.setattr(kkt_module, "AUGMENTED_MAX_DOFS", -1)      # every solve on the Schur path
+        monkeypatch.setattr(factor_module, "SPARSE_SCHUR_MIN_DOFS", 0 if sparse else 10 ** 9)
+        monkeypatch.setattr(factor_module, "AUGMENTED_MAX_DOFS", -1)      # every solve on the Schur path
         runs[sparse] = Simulation(scenes.plate(maxh=0.06, radius=None)).run()
     a, b = runs[False], runs[True]
     assert a.ok and b.ok and a.summary["reason"] == b.summary["reason"] == "broken"

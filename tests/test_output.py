@@ -10,8 +10,8 @@ import ngsolve
 import pytest
 import pyvista as pv
 
-from ngfracture.fracture import crack
-from ngfracture.output import vtk as output
+from ngfracture import fracture
+from ngfracture import output
 from ngfracture.fracture.fragments import FragmentStatistics, fragment_ids
 from crack_util import grid_mesh, mesh_from_arrays, coords
 
@@ -20,7 +20,7 @@ from crack_util import grid_mesh, mesh_from_arrays, coords
 def cracked():
     """A 6 x 4 grid pulled along x above the threshold: vertical cracks, several fragments."""
     mesh = grid_mesh(6, 4)
-    res = crack.split_by_tensor(mesh, np.tile([1.0, 0.0, 0.0], (mesh.nv, 1)), 0.5)
+    res = fracture.split_by_tensor(mesh, np.tile([1.0, 0.0, 0.0], (mesh.nv, 1)), 0.5)
     assert res.nfragments > 2 and len(res.crack_segments) > 0
     return res
 
@@ -193,19 +193,19 @@ def test_summary(tmp_path):
     p = tmp_path / "summary.json"
     s = {"fragments": np.int64(7), "areas": np.array([0.5, 0.25]), "ok": np.bool_(True),
          "nested": {"t": np.float32(0.5), "path": tmp_path}, "name": "run"}
-    output.write_summary(p, s)
+    output.write_json(p, s)
     back = json.loads(p.read_text())
     assert back == {"fragments": 7, "areas": [0.5, 0.25], "ok": True,
                     "nested": {"t": 0.5, "path": str(tmp_path)}, "name": "run"}
     with pytest.raises(FileExistsError, match="force=True"):
-        output.write_summary(p, {"other": 1})
+        output.write_json(p, {"other": 1})
     assert json.loads(p.read_text())["fragments"] == 7
-    output.write_summary(p, {"other": 1}, force=True)
+    output.write_json(p, {"other": 1}, force=True)
     assert json.loads(p.read_text()) == {"other": 1}
-    with pytest.raises(ValueError, match=r"summary\['x'\]\[1\] is nan"):
-        output.write_summary(tmp_path / "bad.json", {"x": [1.0, float("nan")]})
-    with pytest.raises(TypeError, match=r"summary\['f'\] is a builtin_function"):
-        output.write_summary(tmp_path / "bad.json", {"f": len})
+    with pytest.raises(ValueError, match=r"bad.json\['x'\]\[1\] is nan"):
+        output.write_json(tmp_path / "bad.json", {"x": [1.0, float("nan")]})
+    with pytest.raises(TypeError, match=r"bad.json\['f'\] is a builtin_function"):
+        output.write_json(tmp_path / "bad.json", {"f": len})
     assert not (tmp_path / "bad.json").exists()
     assert sorted(os.listdir(tmp_path)) == ["summary.json"]      # no temp files left
 

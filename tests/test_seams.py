@@ -7,7 +7,7 @@ adjacent wedges share a facet.
 import numpy as np
 import pytest
 
-from ngfracture.contact.seams import DIAGONAL_RIGHT, _point_ids, find_seams, seam_constraints
+from ngfracture.contact.seams import DIAGONAL_RIGHT, find_seams, point_ids, seam_constraints
 
 
 def junction(angles_deg):
@@ -159,4 +159,4 @@ def test_point_ids_are_the_inverse_of_numpy_unique_rows():
     X[::7] *= -1.0                     # -0.0 where the coordinate was 0
     for Y in (X, X[:1], np.zeros((0, 2))):
         _, reference = np.unique(Y, axis=0, return_inverse=True)
-        assert np.array_equal(_point_ids(Y), reference.ravel())
+        assert np.array_equal(point_ids(Y), reference.ravel())

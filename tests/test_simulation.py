@@ -9,7 +9,8 @@ import pyvista as pv
 from ngfracture import scenes
 from ngfracture.run import checkpoint
 from ngfracture.mechanics.materials import LinearElastic
-from ngfracture.run.simulation import Scene, Simulation, StepControl, crack_length
+from ngfracture import Scene, Simulation, StepControl
+from ngfracture.run.state import crack_length
 
 NOTCH_TIPS = np.array([[0.5, 0.04], [0.5, 0.96]])
 

@@ -7,7 +7,7 @@ import pytest
 import scipy.sparse as sp
 
 import ngfracture as nf
-from ngfracture.linalg import kkt
+from ngfracture.linalg.sparse import to_scipy
 from ngfracture.mechanics import materials
 from conftest import distorted_square_mesh, square_mesh, two_squares_mesh
 
@@ -78,7 +78,7 @@ def test_taylor_consistent_tangent(cls):
     v = rng.standard_normal(prob.fes.ndof)
     vec = prob.u.vec
     vec.FV().NumPy()[:] = u0
-    K = kkt.to_scipy(prob.tangent())
+    K = to_scipy(prob.tangent())
     r0 = prob.out_of_balance()
     remainders = []
     for eps in [1e-2, 5e-3, 2.5e-3, 1.25e-3]:
@@ -98,10 +98,10 @@ def test_out_of_balance_at_the_same_state_is_kept_not_reassembled(cls, monkeypat
     apply = ng.BilinearForm.Apply
     monkeypatch.setattr(ng.BilinearForm, "Apply", lambda form, *args: applied.append(1) or apply(form, *args))
     import ngfracture.mechanics.problem
-    kernel = ngfracture.mechanics.problem._C.InternalForces
-    monkeypatch.setattr(ngfracture.mechanics.problem, "_C", type("C", (), {
+    kernel = ngfracture.mechanics.problem._ext.InternalForces
+    monkeypatch.setattr(ngfracture.mechanics.problem, "_ext", type("C", (), {
         "InternalForces": staticmethod(lambda *args: applied.append(1) or kernel(*args)),
-        "TangentStiffness": ngfracture.mechanics.problem._C.TangentStiffness}))
+        "TangentStiffness": ngfracture.mechanics.problem._ext.TangentStiffness}))
     mesh = distorted_square_mesh(maxh=0.3)
     prob = nf.ElasticProblem(mesh, cls(E=1.0, nu=0.3))
     prob.add_body_force((0.3, -0.2))
@@ -205,7 +205,7 @@ def test_gmres_option_agrees_with_direct():
 
 @pytest.mark.parametrize("inverse", ["superlu", "sparsecholesky"])
 def test_direct_solvers_agree(inverse):
-    """SuperLU (the default up to kkt.SUPERLU_MAX_DOFS) and NGSolve's sparse Cholesky solve
+    """SuperLU (the default up to factor.SUPERLU_MAX_DOFS) and NGSolve's sparse Cholesky solve
     the same Newton steps: the converged states agree to the tolerance of eq. 7."""
     a, b = stretch_problem(nf.StVenantKirchhoff, 0.1), stretch_problem(nf.StVenantKirchhoff, 0.1)
     assert a.solve(tol=1e-11, inverse="umfpack").converged
@@ -216,21 +216,21 @@ def test_direct_solvers_agree(inverse):
 
 
 def test_auto_inverse_picks_by_size(monkeypatch):
-    from ngfracture.linalg import kkt
+    from ngfracture.linalg import factor
     prob = stretch_problem(nf.StVenantKirchhoff, 0.1)
     K = prob.tangent()
-    assert kkt.EliminatedFactor(K, []).inverse == "superlu"
-    monkeypatch.setattr(kkt, "SUPERLU_MAX_DOFS", prob.fes.ndof - 1)
-    assert kkt.EliminatedFactor(K, []).inverse == "sparsecholesky"
+    assert factor.EliminatedFactor(K, []).inverse == "superlu"
+    monkeypatch.setattr(factor, "SUPERLU_MAX_DOFS", prob.fes.ndof - 1)
+    assert factor.EliminatedFactor(K, []).inverse == "sparsecholesky"
 
 
 def test_singular_stiffness_is_reported_by_superlu():
     """A stiffness with a free rigid mode, factorised without a pin: reported, not solved."""
-    from ngfracture.linalg import kkt
+    from ngfracture.linalg import factor
     prob = stretch_problem(nf.LinearElastic, 0.1)
     K = prob.tangent()
-    with pytest.raises(kkt.SingularSystem):
-        f = kkt.EliminatedFactor(K, [], inverse="superlu")      # all dofs free: three rigid modes
+    with pytest.raises(factor.SingularSystem):
+        f = factor.EliminatedFactor(K, [], inverse="superlu")      # all dofs free: three rigid modes
         f.solve(np.random.default_rng(0).standard_normal(prob.fes.ndof))
 
 
@@ -286,7 +286,7 @@ def test_general_rows_on_a_supported_body(square):
     assert abs(C @ u - 0.01)[0] < 1e-15
     # reference: the whole saddle-point system handed to a sparse LU
     rows = prob.assemble_constraints()
-    K = kkt.to_scipy(prob.tangent())
+    K = to_scipy(prob.tangent())
     G = sp.csr_matrix((np.ones(rows.fixed_dofs.size), (np.arange(rows.fixed_dofs.size), rows.fixed_dofs)),
                       shape=(rows.fixed_dofs.size, prob.fes.ndof))
     B = sp.vstack([G, sp.csr_matrix(C)])

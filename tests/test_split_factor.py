@@ -1,4 +1,4 @@
-"""The factorisation carried across vertex splits (split_factor.BorderedFactor).
+"""The factorisation carried across vertex splits (linalg.bordered.BorderedFactor, imported here as split_factor).
 
 After a crack pass the KKT system of the split mesh is solved through the factorisation of
 the mesh before the pass, bordered by the new vertices' dofs. With the split mesh's
@@ -17,14 +17,15 @@ import numpy as np
 import pytest
 
 import ngfracture as nf
-from ngfracture.linalg import kkt as kkt_module
+from ngfracture.linalg import factor as factor_module
 from ngfracture import _ngfracture, scenes
 from ngfracture.linalg import bordered as split_factor
 from ngfracture.contact.solver import ContactSolver
-from ngfracture.fracture.crack import split_by_tensor
-from ngfracture.linalg.kkt import ConstrainedSolver, EliminatedFactor
-from ngfracture.run.simulation import Simulation
-from ngfracture.mechanics.newton import _base_pins
+from ngfracture.fracture import split_by_tensor
+from ngfracture.linalg.factor import EliminatedFactor
+from ngfracture.linalg.kkt import ConstrainedSolver
+from ngfracture import Simulation
+from ngfracture.mechanics.tangent import base_pins
 
 from test_contact_fractured import crack_bands, plate_mesh
 from test_kkt_paths import random_kkt_load, whole_kkt_solution
@@ -87,11 +88,11 @@ def test_bordered_solve_equals_whole_kkt_solve_in_contact(split_in_contact, spar
     of the base plus the border's rank-m term (forced on this small mesh); SuperLU's factors
     solved by the supernodal L D L^T solver (the plates' path, forced here); and a base
     factorised by NGSolve's sparse Cholesky (the large meshes' solver)."""
-    monkeypatch.setattr(kkt_module, "SPARSE_SCHUR_MIN_DOFS", 0 if sparse_schur else 10 ** 9)
-    monkeypatch.setattr(kkt_module, "SPARSE_SCHUR_MIN_ROWS", 0)
+    monkeypatch.setattr(factor_module, "SPARSE_SCHUR_MIN_DOFS", 0 if sparse_schur else 10 ** 9)
+    monkeypatch.setattr(factor_module, "SPARSE_SCHUR_MIN_ROWS", 0)
     prob, lineage = split_in_contact
     if inverse != "superlu":
-        monkeypatch.setattr(kkt_module, "SUPERNODAL_MIN_DOFS", 0)
+        monkeypatch.setattr(factor_module, "SUPERNODAL_MIN_DOFS", 0)
         base = lineage.base
         other = EliminatedFactor(base.K, base.fixed_dofs, base.pins,
                                  inverse="superlu" if inverse == "supernodal" else inverse)
@@ -101,7 +102,7 @@ def test_bordered_solve_equals_whole_kkt_solve_in_contact(split_in_contact, spar
     else:
         assert lineage.base._ldl is False                 # below SUPERNODAL_MIN_DOFS: SuperLU's solve
     rows = prob.assemble_constraints()
-    support = _base_pins(prob.support(rows), lineage.base, prob.fes.ndof)
+    support = base_pins(prob.support(rows), lineage.base, prob.fes.ndof)
     factor = split_factor.BorderedFactor.build(lineage, prob, rows.fixed_dofs, support.pins)
     assert factor is not None and len(factor._border) > 0
     assert rows.C.shape[0] > 0
@@ -120,7 +121,7 @@ def test_tangent_of_the_split_mesh_at_the_carried_state_is_the_base_tangent(spli
     rounding of the sums."""
     prob, lineage = split_in_contact
     rows = prob.assemble_constraints()
-    support = _base_pins(prob.support(rows), lineage.base, prob.fes.ndof)
+    support = base_pins(prob.support(rows), lineage.base, prob.fes.ndof)
     factor = split_factor.BorderedFactor.build(lineage, prob, rows.fixed_dofs, support.pins)
     base = lineage.base
     A = base.K[base.factor_free][:, base.factor_free]
@@ -133,7 +134,7 @@ def test_small_mesh_border_beyond_capacity_or_new_fragment_takes_a_fresh_factori
                                                                                       monkeypatch):
     prob, lineage = split_in_contact
     rows = prob.assemble_constraints()
-    support = _base_pins(prob.support(rows), lineage.base, prob.fes.ndof)
+    support = base_pins(prob.support(rows), lineage.base, prob.fes.ndof)
     assert split_factor.BorderedFactor.build(lineage, prob, rows.fixed_dofs, support.pins) is not None
     monkeypatch.setattr(split_factor, "MIN_BASE_DOFS", np.count_nonzero(lineage.base.factor_free) + 1)
     assert split_factor.BorderedFactor.build(lineage, prob, rows.fixed_dofs, support.pins) is None
@@ -249,7 +250,7 @@ def test_a_singular_border_gives_way_to_a_fresh_factorisation_and_is_recorded(mo
     run with fresh factorisations (the same split vertices, crack length to 1e-9), and the
     summary records the fallback."""
     def singular(self, rhs):
-        raise kkt_module.SingularSystem("the border of 2 split dofs is singular (forced)")
+        raise factor_module.SingularSystem("the border of 2 split dofs is singular (forced)")
 
     runs = {}
     monkeypatch.setattr(split_factor.BorderedFactor, "_base_solve", singular)
@@ -271,7 +272,7 @@ def test_two_factors_built_from_one_lineage_do_not_share_columns(split_in_contac
     1e-10) in either order."""
     prob, lineage = split_in_contact
     rows = prob.assemble_constraints()
-    support = _base_pins(prob.support(rows), lineage.base, prob.fes.ndof)
+    support = base_pins(prob.support(rows), lineage.base, prob.fes.ndof)
     first = split_factor.BorderedFactor.build(lineage, prob, rows.fixed_dofs, support.pins)
     first.solve(np.ones(prob.fes.ndof))
     same_mesh = split_factor.lineage(first, None, np.arange(prob.mesh.nv))

@@ -7,7 +7,7 @@ import pytest
 
 from ngfracture import scenes
 from ngfracture.fracture import strength
-from ngfracture.run.simulation import Simulation, StepControl
+from ngfracture import Simulation, StepControl
 
 
 @pytest.mark.parametrize("m", [3.0, 6.0])

@@ -1,4 +1,4 @@
-"""Stress cases of the simulation driver (issue 6): a critical strain of 1e-12, thread
+"""Stress cases of the simulation driver: a critical strain of 1e-12, thread
 counts 1 and 2, and two identical runs.
 
 Measured (netgen/NGSolve of this checkout):
@@ -29,7 +29,7 @@ import pyvista as pv
 from ngfracture import scenes
 from ngfracture.fracture.fragments import FragmentStatistics
 from ngfracture.geometry.meshio import mesh_from_arrays
-from ngfracture.run.simulation import Simulation, StepControl
+from ngfracture import Simulation, StepControl
 
 
 # -- critical strain 1e-12 ---------------------------------------------------------------------
@@ -90,7 +90,7 @@ import numpy as np
 import ngsolve as ng
 from ngfracture import scenes
 from ngfracture.mechanics.problem import ElasticProblem
-from ngfracture.run.simulation import Simulation
+from ngfracture import Simulation
 n = int(sys.argv[1])
 ng.SetNumThreads(n)
 ElasticProblem.PARALLEL_MIN_DOFS = 0          # assemble in the TaskManager on a small mesh

@@ -1,4 +1,4 @@
-"""The supernodal L D L^T solve with SuperLU's factors (_ngfracture.SupernodalLDL, kkt).
+"""The supernodal L D L^T solve with SuperLU's factors (_ngfracture.SupernodalLDL, linalg.factor).
 
 Checked against SuperLU's own solve and against the matrix: a backward error at rounding
 level (|A x - b| below 1e-14 (|A| |x| + |b|), infinity norms), the same solution as
@@ -12,7 +12,7 @@ import scipy.sparse.linalg as spla
 
 from ngfracture import _ngfracture as ext
 from ngfracture import scenes
-from ngfracture.linalg import kkt
+from ngfracture.linalg import factor as factor_module, triangular
 from ngfracture.mechanics.problem import ElasticProblem
 
 
@@ -23,13 +23,13 @@ def plate_factor():
     scene.apply_load(prob, scene.dx)
     rows = prob.assemble_constraints()
     support = prob.support(rows)
-    factor = kkt.EliminatedFactor(prob.tangent(), rows.fixed_dofs, support.pins)
+    factor = factor_module.EliminatedFactor(prob.tangent(), rows.fixed_dofs, support.pins)
     factor.factorise()
     return factor
 
 
 def supernodal(lu):
-    lower, _, pivots = kkt.factor_arrays(lu)
+    lower, _, pivots = triangular.factor_arrays(lu)
     return ext.SupernodalLDL(lu.shape[0], *lower, pivots, lu.perm_r.astype(np.int64))
 
 
@@ -45,7 +45,7 @@ def test_solves_like_superlu_with_a_rounding_level_backward_error(k):
     assert np.array_equal(lu.perm_r, lu.perm_c)            # diagonal pivots: U = D L^T
     ldl = supernodal(lu)
     n = lu.shape[0]
-    assert n >= kkt.SUPERNODAL_MIN_DOFS and 0 < ldl.supernodes < n / 2   # real supernodes
+    assert n >= factor_module.SUPERNODAL_MIN_DOFS and 0 < ldl.supernodes < n / 2   # real supernodes
     A = factor._factorised_block()
     rng = np.random.default_rng(k)
     B = rng.standard_normal(n) if k == 1 else np.asfortranarray(rng.standard_normal((n, k)))
@@ -75,7 +75,7 @@ def test_the_factor_takes_the_supernodal_solve_from_its_size_on(monkeypatch):
     factor = plate_factor()
     x = factor.solve(np.ones(factor.ndof))
     assert isinstance(factor._ldl, ext.SupernodalLDL)
-    monkeypatch.setattr(kkt, "SUPERNODAL_MIN_DOFS", 10 ** 9)
+    monkeypatch.setattr(factor_module, "SUPERNODAL_MIN_DOFS", 10 ** 9)
     own = plate_factor()
     x_ref = own.solve(np.ones(own.ndof))
     assert own._ldl is False
@@ -86,7 +86,7 @@ def test_the_sparse_schur_complement_after_a_supernodal_solve_is_that_of_full_so
     """The sparse Schur path (Gilbert-Peierls on L) and the supernodal solve read the same
     factor arrays: a Schur complement made before a solve, and one of new rows after it,
     equal C K^+ C^T from full solves to rounding."""
-    monkeypatch.setattr(kkt, "SPARSE_SCHUR_MIN_DOFS", 0)
+    monkeypatch.setattr(factor_module, "SPARSE_SCHUR_MIN_DOFS", 0)
     factor = plate_factor()
     free = np.flatnonzero(factor.factor_free)
     rng = np.random.default_rng(2)

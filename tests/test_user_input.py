@@ -9,7 +9,8 @@ from ngfracture import scenes
 from ngfracture.contact import solver as contact_solver
 from ngfracture.contact.solver import ContactSolver
 from ngfracture.linalg.qp import QPError
-from ngfracture.run.simulation import PHASES, Scene, Simulation, StepControl
+from ngfracture import Scene, Simulation, StepControl
+from ngfracture.run.timings import PHASES
 from ngfracture.mechanics.newton import NewtonSolver
 from test_contact_solve import pressed_blocks
 
@@ -151,14 +152,14 @@ def test_a_complementarity_problem_that_raises_is_a_recorded_note(monkeypatch):
 
 def test_solver_notes_reach_history_and_summary(monkeypatch, tmp_path):
     """A note of a contact solve is in its step's history and in summary['notes']."""
-    import ngfracture.run.simulation as simulation
+    import ngfracture.run.step as step_module
 
     class Noting(ContactSolver):
         def solve(self, warm=(), lineage=None, start=None):
             result = super().solve(warm, lineage, start)
             result.notes.append("a note")
             return result
-    monkeypatch.setattr(simulation, "ContactSolver", Noting)
+    monkeypatch.setattr(step_module, "ContactSolver", Noting)
     scene = scenes.disk(maxh=0.3, radius=None)             # separate bodies: contact from the first step
     result = Simulation(scene, StepControl(max_steps=2), out=tmp_path, pictures="none").run()
     s = result.summary

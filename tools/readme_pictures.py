@@ -12,7 +12,7 @@ import sys
 from pathlib import Path
 
 from ngfracture import scenes
-from ngfracture.run.simulation import Simulation
+from ngfracture import Simulation
 
 ROOT = Path(__file__).resolve().parent.parent
 

@@ -18,7 +18,7 @@
 # It illustrates how to:
 #
 # - look at the crack criterion: the nodal principal strain against the critical strain,
-# - split overstrained vertices by hand with `ngfracture.fracture.crack`,
+# - split overstrained vertices by hand with `ngfracture.fracture`,
 # - run a whole simulation under load control (`Simulation`, `StepControl`),
 # - read `summary.json`: steps, increments, energies, fragments, timings,
 # - look at the result (the PNG the run writes, or the VTK files in PyVista/ParaView).
@@ -33,8 +33,8 @@ import numpy as np
 
 import ngfracture as nf
 from ngfracture import scenes
-from ngfracture.fracture import crack
-from ngfracture.run.simulation import Simulation, StepControl
+from ngfracture import fracture
+from ngfracture import Simulation, StepControl
 
 # %% [markdown]
 # ## The scene
@@ -78,7 +78,7 @@ scene.apply_load(prob, 1e-4)
 status = prob.solve(fix_free_modes=True)   # the vertical translation is held by a multiplier row
 assert status.converged, status.message
 
-values, directions = crack.principal(crack.vertex_strain(mesh, prob.u))
+values, directions = fracture.principal(fracture.vertex_strain(mesh, prob.u))
 ratio = values / scene.critical
 over = np.flatnonzero(ratio > 1)
 print("largest principal strain / critical:", ratio.max().round(3), "; overstrained vertices:", over)
@@ -95,13 +95,13 @@ assert len(over) > 0 and np.all(np.abs(P[over, 0] - 0.5) < 0.1)   # at the notch
 # %% [markdown]
 # ## One crack pass by hand
 #
-# `crack.crack_step` splits every overstrained vertex along the mesh edges most
+# `fracture.crack_step` splits every overstrained vertex along the mesh edges most
 # orthogonal to its maximum strain direction (the paper's rules 1 and 2) and carries
 # the displacement exactly to the new mesh: the triangles and their coordinates stay,
 # split vertices get copies. The crack faces are a boundary named `crack`.
 
 # %%
-new_mesh, new_u, result = crack.crack_step(mesh, prob.u, critical=scene.critical)
+new_mesh, new_u, result = fracture.crack_step(mesh, prob.u, critical=scene.critical)
 print("processed", len(result.record["vertex"]), "vertices, created", result.nsplit, "new ones;",
       result.nfragments, "fragment(s); boundaries", sorted(set(new_mesh.GetBoundaries())))
 assert new_mesh.ne == mesh.ne and result.nsplit > 0
@@ -188,13 +188,13 @@ plt.show()
 # The paper's criterion averages the strain over the triangles around a vertex. At the
 # notch tip the strain is singular, so the finer the mesh there, the earlier the first
 # crack: the result has no limit under refinement. The critical-distance criterion
-# (`StrainCriterion(critical, radius=r)`, docs/criterion.md) judges the stress at a
+# (`Criterion(critical, radius=r, material=glass)`, docs/criterion.md) judges the stress at a
 # material distance `r` from the tip instead, and converges. Both on the same meshes,
 # linear elasticity at unit extension (the measure is linear in the load, so the
 # first-crack extension is the critical strain over the largest measure):
 
 # %%
-from ngfracture.fracture.crack import StrainCriterion, principal
+from ngfracture.fracture import Criterion, principal
 from ngfracture.mechanics.materials import LinearElastic
 from ngfracture.mechanics.problem import ElasticProblem
 
@@ -208,9 +208,10 @@ for h in (r / 2, r / 4, r / 8):
     prob.add_dirichlet("left", -0.5, component="x")
     prob.add_dirichlet("right", 0.5, component="x")
     assert prob.solve(fix_free_modes=True).converged   # u_y free: the vertical translation held
-    x_init = [critical / principal(crit.vertex_tensor(mesh, prob.u))[0].max()
-              for crit in (StrainCriterion(critical, "linear"),
-                           StrainCriterion(critical, "linear", radius=r, material=glass))]
+    # the overstrain is 1 where a vertex cracks, so the first crack is at 1 / its largest value
+    x_init = [1.0 / principal(crit.overstrain(mesh, prob.u))[0].max()
+              for crit in (Criterion(critical, measure="linear"),
+                           Criterion(critical, radius=r, material=glass, measure="linear"))]
     print(f"{h:12.5f} {x_init[0]:16.3e} {x_init[1]:25.4e}")
     levels.append(x_init)
 assert abs(levels[2][1] / levels[1][1] - 1) < 0.03     # converged within 3 %
@@ -219,7 +220,7 @@ assert levels[2][0] < 0.8 * levels[1][0]                 # still falling
 # %% [markdown]
 # The one-ring extension falls by about 1/sqrt(2) per halving of h; the
 # critical-distance one changes by less than 1 %. Its toughness follows from the
-# critical strain and r: `ngfracture.fracture.crack.toughness(critical, r, E)` is
+# critical strain and r: `ngfracture.fracture.toughness(critical, r, E)` is
 # `E critical sqrt(2 pi r)`.
 #
 # ## A whole run with the critical distance

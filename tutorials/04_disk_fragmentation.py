@@ -35,10 +35,10 @@ import numpy as np
 import ngfracture as nf
 from ngfracture import scenes
 from ngfracture.contact.solver import ContactSolver
-from ngfracture.fracture.crack import vertex_displacement
+from ngfracture.fracture import vertex_displacement
 from ngfracture.fracture.fragments import FragmentStatistics
-from ngfracture.output.vtk import plot_fragment_sizes
-from ngfracture.run.simulation import Simulation
+from ngfracture.output.pictures import plot_fragment_sizes
+from ngfracture import Simulation
 
 # %% [markdown]
 # ## Two bodies
@@ -130,10 +130,11 @@ plt.show()
 # ## The default: a critical distance
 #
 # The paper's grains are as small as the mesh allows: their number grows when the mesh
-# is refined (docs/criterion.md). `ngfracture run disk` judges cracks at a critical
+# is refined (docs/verification.md). `ngfracture run disk` judges cracks at a critical
 # distance r = 0.12 instead (maxh 0.06, the expansion 50 times the first-crack
-# estimate; about 12 s): radial cracks grow from the hole and stop inside the ring, and a
-# mesh twice as fine gives the same cracked zone. The picture below is that run's
+# estimate; run times in docs/performance.md): radial cracks grow from the hole and stop
+# inside the ring, and a mesh twice as fine gives the same cracked zone
+# (docs/criterion.md). The picture below is that run's
 # `final.png` (made by `tools/readme_pictures.py`). Under it, the distribution of the
 # coarse run's fragment areas, which `plot_fragment_sizes` draws for any run:
 

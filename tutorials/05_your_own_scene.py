@@ -38,7 +38,7 @@ from netgen.geom2d import SplineGeometry
 
 import ngfracture as nf
 from ngfracture.fracture.fragments import FragmentStatistics
-from ngfracture.run.simulation import Scene, Simulation, StepControl
+from ngfracture import Scene, Simulation, StepControl
 
 # %% [markdown]
 # ## Geometry and mesh
@@ -72,10 +72,12 @@ print(mesh.ne, "triangles; regions", mesh.GetMaterials(), "; boundaries", sorted
 # a multiplier row on the unheld rigid mode (and does the same for every fragment that
 # breaks off).
 #
-# This scene cracks by the paper's one-ring criterion (no `radius`). `Scene(...,
-# radius=r)` judges the stress at a critical distance r instead, as the built-in scenes
-# do (docs/criterion.md): then the mesh should be at most r/4 where cracks run, and the
-# results converge under refinement.
+# This scene cracks by the paper's one-ring criterion (neither `radius` nor `toughness`),
+# so `Simulation` warns that its cracks depend on the mesh (`MeshDependentCriterion`).
+# `Scene(..., radius=r)` judges the stress at a critical distance r instead, as the
+# built-in scenes do, and `Scene(..., toughness=K_c)` takes r from a fracture toughness,
+# r = (K_c / (E critical))^2 / (2 pi) (docs/criterion.md): then the mesh should be at most
+# r/4 where cracks run, and the results converge under refinement.
 
 # %%
 materials = {"glass": nf.StVenantKirchhoff(E=70e9, nu=0.22, plane="stress"),

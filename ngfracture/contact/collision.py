@@ -41,11 +41,37 @@ from .. import _ngfracture as _ext
 
 __all__ = [
     "orient2d", "boundary_edge_mask", "candidate_mask", "broad_phase_pairs",
-    "detect_collisions", "triangles_collide", "current_coordinates",
+    "detect_collisions", "triangles_collide", "current_coordinates", "as_array", "check_tol",
+    "check_tris",
 ]
 
 
-def _as_array(a, name, dtype, ncols=None):
+def as_array(a, name, dtype, ncols=None):
+    """``a`` as a C-contiguous array of the given type, checked for its number of columns.
+
+    Parameters
+    ----------
+    a : array_like
+        The input.
+    name : str
+        Its name, for the error messages.
+    dtype : numpy.dtype or type
+        The element type wanted.
+    ncols : int, optional
+        If given, ``a`` must be two-dimensional with that many columns.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``a`` itself when it already is such an array, else a converted copy.
+
+    Raises
+    ------
+    TypeError
+        If ``a`` cannot be converted to ``dtype``.
+    ValueError
+        If ``ncols`` is given and the shape is not (n, ncols).
+    """
     try:
         arr = np.ascontiguousarray(a, dtype=dtype)
     except (TypeError, ValueError) as err:
@@ -55,7 +81,25 @@ def _as_array(a, name, dtype, ncols=None):
     return arr
 
 
-def _check_tol(tol, name="tol"):
+def check_tol(tol, name="tol"):
+    """A precision threshold (a length) as a float, checked to be finite and >= 0.
+
+    Parameters
+    ----------
+    tol : float
+        The threshold.
+    name : str
+        Its name, for the error message.
+
+    Returns
+    -------
+    float
+
+    Raises
+    ------
+    ValueError
+        If ``tol`` is not a finite number >= 0.
+    """
     if not np.isscalar(tol) or not np.isfinite(tol) or tol < 0:
         raise ValueError(f"{name} must be a finite number >= 0, got {tol!r}")
     return float(tol)
@@ -81,12 +125,12 @@ def current_coordinates(coords, displacement=None):
     ValueError
         If a shape is wrong or a coordinate or displacement is not finite.
     """
-    X = _as_array(coords, "coords", np.float64, 2)
+    X = as_array(coords, "coords", np.float64, 2)
     if not np.isfinite(X).all():
         raise ValueError("coords contains NaN or inf")
     if displacement is None:
         return X.copy()
-    U = _as_array(displacement, "displacement", np.float64, 2)
+    U = as_array(displacement, "displacement", np.float64, 2)
     if U.shape != X.shape:
         raise ValueError(f"displacement must have the shape of coords {X.shape}, got {U.shape}")
     if not np.isfinite(U).all():
@@ -107,15 +151,35 @@ def _check_shapes(coords, displacement, tris):
         raise ValueError("displacement must have the shape of coords")
 
 
-def _check_tris(tris, nv):
-    T = _as_array(tris, "tris", np.int32, 3)
+def check_tris(tris, nv):
+    """Triangles as an int32 array (nt, 3), checked to hold vertex indices in [0, nv).
+
+    Parameters
+    ----------
+    tris : array_like, shape (nt, 3)
+        Vertex indices of the triangles.
+    nv : int
+        Number of vertices.
+
+    Returns
+    -------
+    numpy.ndarray of int32, shape (nt, 3)
+
+    Raises
+    ------
+    TypeError
+        If ``tris`` cannot be converted to integers.
+    ValueError
+        On a wrong shape or an index out of range.
+    """
+    T = as_array(tris, "tris", np.int32, 3)
     if T.size and (T.min() < 0 or T.max() >= nv):
         raise ValueError(f"tris holds vertex indices outside [0, {nv})")
     return T
 
 
 def _check_edges(boundary_edges, nv):
-    E = _as_array(boundary_edges, "boundary_edges", np.int64, 2)
+    E = as_array(boundary_edges, "boundary_edges", np.int64, 2)
     if E.size and (E.min() < 0 or E.max() >= nv):
         raise ValueError(f"boundary_edges holds vertex indices outside [0, {nv})")
     return E
@@ -180,7 +244,7 @@ def boundary_edge_mask(tris, boundary_edges, nv=None):
         If a shape is wrong, an index is out of range, or a boundary edge is not an edge
         of any triangle with that triangle on its left (wrong orientation).
     """
-    T = _as_array(tris, "tris", np.int64, 3)
+    T = as_array(tris, "tris", np.int64, 3)
     if nv is None:
         nv = int(T.max()) + 1 if T.size else 0
     if T.size and (T.min() < 0 or T.max() >= nv):
@@ -229,7 +293,7 @@ def candidate_mask(tris, boundary_edges, nv=None):
 
 
 def _pairs(coords, displacement, tris, candidates, fragment, tol, narrow):
-    tol = _check_tol(tol)
+    tol = check_tol(tol)
     _check_shapes(coords, displacement, tris)
     nt = np.shape(tris)[0]
     cand = np.asarray(candidates)
@@ -240,7 +304,7 @@ def _pairs(coords, displacement, tris, candidates, fragment, tol, narrow):
     if np.count_nonzero(cand) < 2:
         return np.zeros((0, 2), dtype=np.int32)         # nothing can collide: no work
     x = current_coordinates(coords, displacement)
-    T = _check_tris(tris, x.shape[0])
+    T = check_tris(tris, x.shape[0])
     frag = None
     if fragment is not None:
         frag = np.ascontiguousarray(fragment, dtype=np.int32)
@@ -325,7 +389,7 @@ def detect_collisions(coords, displacement, tris, candidates=None, boundary_edge
             _check_shapes(coords, displacement, tris)
             return np.zeros((0, 2), dtype=np.int32)     # no crack, no boundary: no work
         nv = np.shape(coords)[0]
-        candidates = candidate_mask(_check_tris(tris, nv), boundary_edges, nv)
+        candidates = candidate_mask(check_tris(tris, nv), boundary_edges, nv)
     return _pairs(coords, displacement, tris, candidates, fragment, tol, narrow=True)
 
 
@@ -353,10 +417,10 @@ def triangles_collide(x, tris, pairs, tol=0.0):
     ValueError, TypeError
         On wrong shapes or types, non-finite positions, indices out of range, tol < 0.
     """
-    tol = _check_tol(tol)
+    tol = check_tol(tol)
     X = current_coordinates(x)
-    T = _check_tris(tris, X.shape[0])
-    P = _as_array(pairs, "pairs", np.int32, 2)
+    T = check_tris(tris, X.shape[0])
+    P = as_array(pairs, "pairs", np.int32, 2)
     if P.size and (P.min() < 0 or P.max() >= T.shape[0]):
         raise ValueError(f"pairs holds triangle indices outside [0, {T.shape[0]})")
     return _ext.TrianglesCollide(X, T, P, tol)

@@ -1,10 +1,10 @@
-"""Node-to-segment contact constraints and redundancy removal (paper section 3.2).
+"""Node-to-segment contact constraints (paper section 3.2): selection, gap linearisation.
 
 Pipeline for one (predicted) configuration::
 
     pairs = collision.detect_collisions(X, U, tris, boundary_edges=E, tol=tol)
     cs = select_contacts(X, U, tris, E, pairs, tol=tol)       # rules 1-4, eq. 13/14
-    keep = independent_rows(cs.C, fixed_dofs=dirichlet_dofs)  # pivoted QR
+    keep = independent_rows(cs.C, fixed_dofs=dirichlet_dofs)  # pivoted QR (redundancy.py)
     C, g = cs.C[keep], cs.g[keep]
 
 or :func:`contact_constraints` for all of it. Where two lips coincide in the reference
@@ -69,15 +69,15 @@ from dataclasses import dataclass
 import functools
 
 import numpy as np
-import scipy.linalg as sla
 import scipy.sparse as sp
-from scipy.sparse.csgraph import connected_components, reverse_cuthill_mckee
 
 from .. import _ngfracture as _ext
-from .collision import (_as_array, _check_tol, _check_tris, boundary_edge_mask,
-                        current_coordinates, detect_collisions)
+from .collision import (as_array, boundary_edge_mask, check_tol, check_tris, current_coordinates,
+                        detect_collisions)
+from .redundancy import independent_rows
 
-__all__ = ["ContactConstraints", "select_contacts", "gap_rows", "independent_rows",
+__all__ = ["ContactConstraints", "no_constraints", "select_contacts", "gap_rows", "gap_offset",
+           "relinearise_node_to_segment", "reachable", "independent_rows",
            "contact_constraints"]
 
 
@@ -176,7 +176,19 @@ class ContactConstraints:
         return ContactConstraints(*(getattr(self, f)[rows] for f in _ROW_FIELDS), nv=self.nv)
 
 
-def _no_constraints(nv):
+def no_constraints(nv):
+    """No rows, for a mesh of nv vertices.
+
+    Parameters
+    ----------
+    nv : int
+        Number of vertices (C has 2 nv columns).
+
+    Returns
+    -------
+    ContactConstraints
+        Zero rows, with arrays of the types :func:`select_contacts` gives.
+    """
     e = np.zeros(0, dtype=np.int32)
     f = np.zeros(0)
     return ContactConstraints(slave=e, a=e, c=e, master_tri=e, slave_tri=e, pair=e, xi=f,
@@ -217,7 +229,7 @@ def gap_rows(coords, slave, a, c, xi, normal):
     nv = X.shape[0]
     slave, a, c = (np.asarray(v, dtype=np.int64).ravel() for v in (slave, a, c))
     xi = np.asarray(xi, dtype=np.float64).ravel()
-    n = _as_array(normal, "normal", np.float64, 2)
+    n = as_array(normal, "normal", np.float64, 2)
     m = len(slave)
     if not (len(a) == len(c) == len(xi) == n.shape[0] == m):
         raise ValueError("slave, a, c, xi and normal must have the same length")
@@ -226,7 +238,7 @@ def gap_rows(coords, slave, a, c, xi, normal):
     for name, v in (("slave", slave), ("a", a), ("c", c)):
         if m and (v.min() < 0 or v.max() >= nv):
             raise ValueError(f"{name} holds vertex indices outside [0, {nv})")
-    return _gap_matrix(slave, a, c, xi, n, nv), _gap_offset(X, slave, a, c, xi, n)
+    return _gap_matrix(slave, a, c, xi, n, nv), gap_offset(X, slave, a, c, xi, n)
 
 
 def _gap_weights(xi):
@@ -246,8 +258,25 @@ def _gap_matrix(slave, a, c, xi, n, nv):
     return C
 
 
-def _gap_offset(X, slave, a, c, xi, n):
-    """g of :func:`gap_rows`, for arrays already checked."""
+def gap_offset(X, slave, a, c, xi, n):
+    """g of :func:`gap_rows` (the gap at u = 0), for arrays already checked.
+
+    Parameters
+    ----------
+    X : numpy.ndarray, shape (nv, 2)
+        Reference vertex coordinates.
+    slave, a, c : numpy.ndarray of int, shape (m,)
+        Slave vertex and master edge end points.
+    xi : numpy.ndarray, shape (m,)
+        Weight of x_a in the projection point.
+    n : numpy.ndarray, shape (m, 2)
+        Unit normals.
+
+    Returns
+    -------
+    numpy.ndarray, shape (m,)
+        n . (X_b - xi X_a - (1 - xi) X_c).
+    """
     verts = np.stack([slave, a, c], axis=1)
     pos = np.einsum("ij,ijk->ik", _gap_weights(xi), X[verts])      # X_b - xi X_a - (1-xi) X_c
     return np.einsum("ij,ij->i", pos, n)
@@ -278,10 +307,8 @@ def select_contacts(coords, displacement, tris, boundary_edges, pairs, tol=0.0,
         g at the predicted state unchanged (the projection point moves along the
         segment, perpendicular to n) and turns the two opposite rows between nearly
         coincident crack-lip nodes into exact duplicates. Without it they are
-        near-duplicates, with singular values spread down to 1e-16 (measured on the
-        benchmark scene), which no rank threshold separates cleanly; with 1e-3 the kept
-        rows still had sigma_min 1e-10 and multipliers of 1e9 in a repeated
-        detect-and-solve loop, with 1e-2 the loop converged (see
+        near-duplicates with singular values spread down to rounding, which no rank
+        threshold separates cleanly (the values compared are in ``docs/contact.md``; see
         test_repeated_linearised_solves_converge). 0 disables it.
 
     Returns
@@ -295,15 +322,15 @@ def select_contacts(coords, displacement, tris, boundary_edges, pairs, tol=0.0,
         On wrong shapes, non-finite input, indices out of range, tol < 0 or angle_tol
         outside [0, pi/2].
     """
-    tol = _check_tol(tol)
+    tol = check_tol(tol)
     if not np.isscalar(angle_tol) or not (0 <= angle_tol <= np.pi / 2):
         raise ValueError(f"angle_tol must be in [0, pi/2], got {angle_tol!r}")
     if not np.isscalar(xi_snap) or not (0 <= xi_snap < 0.5):
         raise ValueError(f"xi_snap must be in [0, 0.5), got {xi_snap!r}")
     X = current_coordinates(coords)
     x = current_coordinates(coords, displacement)
-    T = _check_tris(tris, x.shape[0])
-    P = _as_array(pairs, "pairs", np.int32, 2)
+    T = check_tris(tris, x.shape[0])
+    P = as_array(pairs, "pairs", np.int32, 2)
     if P.size and (P.min() < 0 or P.max() >= T.shape[0]):
         raise ValueError(f"pairs holds triangle indices outside [0, {T.shape[0]})")
     if np.any(P[:, 0] == P[:, 1]):
@@ -326,187 +353,69 @@ def select_contacts(coords, displacement, tris, boundary_edges, pairs, tol=0.0,
         slave=ids[:, 0], a=ids[:, 1], c=ids[:, 2], master_tri=ids[:, 3],
         slave_tri=ids[:, 4], pair=ids[:, 5], xi=geo[:, 0], normal=geo[:, 1:3].copy(),
         dist=geo[:, 3], angle=geo[:, 4],
-        g=_gap_offset(X, ids[:, 0], ids[:, 1], ids[:, 2], geo[:, 0], geo[:, 1:3]), nv=X.shape[0])
+        g=gap_offset(X, ids[:, 0], ids[:, 1], ids[:, 2], geo[:, 0], geo[:, 1:3]), nv=X.shape[0])
 
 
-def _unit_rows(M):
-    """(row, column, value) of the nonzeros of a CSR matrix, each row scaled to unit norm."""
-    row = np.repeat(np.arange(M.shape[0], dtype=np.int64), np.diff(M.indptr))
-    nz = M.data != 0
-    row, col, val = row[nz], M.indices[nz].astype(np.int64), M.data[nz]
-    norms = np.sqrt(np.bincount(row, weights=val * val, minlength=M.shape[0]))
-    return row, col, val / norms[row]
+def relinearise_node_to_segment(cs, X, U):
+    """The rows of cs with normal and projection of the master edge at X + U (eq. 13, 14).
 
-
-def independent_rows(C, fixed_dofs=None, G=None, rtol=1e-8, method="auto", dense_limit=256):
-    """A maximal set of rows of C, linearly independent and independent of the Dirichlet rows.
-
-    Rows are scaled to unit norm, columns fixed by Dirichlet conditions are eliminated
-    (``fixed_dofs``) or the span of general Dirichlet rows ``G`` is projected out, and a
-    column-pivoted QR of the remaining C^T decides (C++: Businger-Golub pivoting on a
-    modified Gram-Schmidt QR with reorthogonalisation; single-threaded on purpose, as
-    threaded LAPACK on these small blocks was 10 to 50 times slower on a loaded machine).
-    The work splits into the connected components of the rows' sparsity graph (rows
-    sharing a dof, through C or G), each a dense QR restricted to its nonzero columns;
-    single rows need no QR. Exact duplicates, the three-body node-to-node redundancy of
-    the paper's Fig. 5 and rows implied by the Dirichlet rows are all removed this way.
-    Cost per component: O(k r n) for k rows, rank r, n columns.
+    Rows snapped to a node (xi = 0 or 1) stay node-to-node; the normal keeps its side.
 
     Parameters
     ----------
-    C : scipy.sparse matrix or array_like, shape (m, ndof)
-        Constraint rows.
-    fixed_dofs : array_like of int, optional
-        Dofs fixed by Dirichlet conditions (rows e_d of the Dirichlet block).
-    G : scipy.sparse matrix or array_like, shape (p, ndof), optional
-        General Dirichlet / multi-point rows that are kept in any case.
-    rtol : float
-        Rank threshold on |R_kk| for unit-norm rows: a row within rtol (relative) of the
-        span of the kept rows is dropped; its constraint then holds up to about rtol
-        times the displacement. Smaller values keep nearly dependent rows and make the
-        multipliers blow up like 1 / sigma_min.
-    method : {"auto", "pivoted", "banded"}
-        "pivoted": the column-pivoted QR on every component. "banded": for components
-        without G rows, a sparse alternative: greedy selection in reverse Cuthill-McKee
-        order by a banded Givens QR of C^T (|R_jj| > rtol keeps row j). It is not
-        pivoted and not rank-revealing: every kept row is > rtol away from the span of
-        the rows kept before it, yet the kept set can be nearly singular when singular
-        values are spread below ~1e-8 (measured: sigma_min 4e-16 at rtol 1e-10 on
-        unsnapped near-duplicate rows; with xi_snap both methods agree). Fine for
-        exact duplicates and Fig. 5 cycles. "auto": pivoted for components of at most
-        dense_limit rows, banded above (the pivoted QR costs O(k r n) per component:
-        14 s for one 1285-row component).
-    dense_limit : int
-        Component size up to which "auto" uses the pivoted QR.
+    cs : ContactConstraints
+        Node-to-segment rows (slave, master edge a -> c, previous xi and normal).
+    X, U : numpy.ndarray, shape (nv, 2)
+        Reference vertex coordinates and vertex displacements (current = X + U).
 
     Returns
     -------
-    numpy.ndarray of int64
-        Indices of the kept rows, ascending. Pivoting picks the largest residual and,
-        among residuals equal to 1e-12 relative, the lowest index: duplicates keep their
-        first occurrence.
-
-    Raises
-    ------
-    ValueError
-        On shapes that do not match, dof indices out of range, non-finite entries or
-        rtol <= 0.
+    ContactConstraints
+        The same rows in the same order, with xi (clipped to [0, 1]), unit normal, dist
+        (signed distance at X + U), C and g recomputed; slave, a, c, triangles, pair and
+        angle kept. ``cs`` itself when it is empty.
     """
-    C = sp.csr_matrix(C, dtype=np.float64)
-    m, ndof = C.shape
-    if not np.isfinite(C.data).all():
-        raise ValueError("C contains NaN or inf")
-    if not (np.isscalar(rtol) and np.isfinite(rtol) and rtol > 0):
-        raise ValueError(f"rtol must be a positive number, got {rtol!r}")
-    if G is not None:
-        G = sp.csr_matrix(G, dtype=np.float64)
-        if G.shape[1] != ndof:
-            raise ValueError(f"G must have {ndof} columns like C, got {G.shape[1]}")
-        if not np.isfinite(G.data).all():
-            raise ValueError("G contains NaN or inf")
-    if fixed_dofs is not None:
-        fixed = np.asarray(fixed_dofs, dtype=np.int64).ravel()
-        if fixed.size and (fixed.min() < 0 or fixed.max() >= ndof):
-            raise ValueError(f"fixed_dofs holds dofs outside [0, {ndof})")
-    if method not in ("auto", "pivoted", "banded"):
-        raise ValueError(f"method must be 'auto', 'pivoted' or 'banded', got {method!r}")
-    if m == 0:
-        return np.zeros(0, dtype=np.int64)
-
-    # Plain arrays instead of scipy operations: each of those costs a millisecond of
-    # overhead, and this runs in every contact round (measured: 16 ms a call on a
-    # 2k-triangle plate, now a few). Rows scaled to unit norm, fixed dofs dropped,
-    # columns renumbered to the ones the rows touch.
-    C = C.copy()
-    C.sum_duplicates()
-    row, col, val = _unit_rows(C)
-    if fixed_dofs is not None and fixed.size:
-        is_fixed = np.zeros(ndof, dtype=bool)
-        is_fixed[fixed] = True
-        keep = ~is_fixed[col]
-        row, col, val = row[keep], col[keep], val[keep]               # eliminate fixed dofs
-    if G is not None and G.shape[0]:
-        G = G.copy()
-        G.sum_duplicates()
-        grow, gcol, gval = _unit_rows(G)
-        p = G.shape[0]
-    else:
-        grow = gcol = np.zeros(0, dtype=np.int64)
-        gval = np.zeros(0)
-        p = 0
-    used, cols = np.unique(np.concatenate([col, gcol]), return_inverse=True)
-    col, gcol = cols[:len(col)], cols[len(col):]
-    n = len(used)
-
-    # Components of the bipartite graph rows (C then G) -- dofs.
-    nodes = m + p + n
-    graph = sp.csr_matrix((np.ones(len(col) + len(gcol), dtype=np.int8),
-                           (np.concatenate([row, m + grow]), m + p + np.concatenate([col, gcol]))),
-                          shape=(nodes, nodes))
-    _, labels = connected_components(graph, directed=False)
-    lab_c, lab_g = labels[:m], labels[m:m + p]
-
-    # Rows that vanished after eliminating fixed dofs depend on the Dirichlet rows.
-    rem_norm = np.sqrt(np.bincount(row, weights=val * val, minlength=m))
-    alive = np.flatnonzero(rem_norm > rtol)
-    Ca = sp.csr_matrix((val, (row, col)), shape=(m, n))[alive]
-    Ca.sort_indices()
-    Gn = sp.csr_matrix((gval, (grow, gcol)), shape=(p, n))
-    Gn.sort_indices()
-    if _clearly_independent(Ca, Gn, rtol, lab_c[alive], lab_g):
-        return alive.astype(np.int64)
-    position = np.zeros(len(alive), dtype=np.int64)
-    if method != "pivoted" and len(alive):
-        # processing order for the banded QR: reverse Cuthill-McKee of the row graph
-        pattern = Ca.copy()
-        pattern.data = np.ones_like(pattern.data)
-        order = reverse_cuthill_mckee(sp.csr_matrix(pattern @ pattern.T), symmetric_mode=True)
-        position[order] = np.arange(len(alive))
-    code = {"auto": 0, "pivoted": 1, "banded": 2}[method]
-    kept = _ext.IndependentRowsSparse(
-        n, Ca.indptr.astype(np.int64), Ca.indices.astype(np.int32), Ca.data,
-        lab_c[alive].astype(np.int32), position, Gn.indptr.astype(np.int64),
-        Gn.indices.astype(np.int32), Gn.data, lab_g.astype(np.int32), float(rtol), code,
-        int(dense_limit))
-    return alive[kept].astype(np.int64)
+    if len(cs) == 0:
+        return cs
+    x = X + U
+    e = x[cs.c] - x[cs.a]
+    length2 = np.einsum("ij,ij->i", e, e)
+    n = np.column_stack([e[:, 1], -e[:, 0]]) / np.sqrt(length2)[:, None]
+    n *= np.where(np.einsum("ij,ij->i", n, cs.normal) < 0, -1.0, 1.0)[:, None]
+    t = np.einsum("ij,ij->i", x[cs.slave] - x[cs.a], e) / length2
+    xi = np.where((cs.xi == 0.0) | (cs.xi == 1.0), cs.xi, np.clip(1.0 - t, 0.0, 1.0))
+    dist = np.einsum("ij,ij->i", x[cs.slave] - xi[:, None] * x[cs.a] - (1 - xi)[:, None] * x[cs.c], n)
+    return ContactConstraints(cs.slave, cs.a, cs.c, cs.master_tri, cs.slave_tri, cs.pair, xi, n,
+                              dist, cs.angle, gap_offset(X, cs.slave, cs.a, cs.c, xi, n), nv=len(X))
 
 
-def _clearly_independent(C, G, rtol, labels_c, labels_g, limit=1500):
-    """True if every row of [G; C] is farther than rtol from the span of all the others.
+def reachable(cs, U, tol):
+    """Rows whose penetration the motion can explain.
 
-    Then any QR of the rows, pivoted or not, has |R_kk| >= sigma_min > rtol and keeps them
-    all, so the pivoted QR can be skipped: a Cholesky factorisation of the Gram matrix
-    minus (rtol^2 + rounding) I succeeds when sigma_min^2 exceeds that shift. The usual
-    case in a contact round (measured on the disintegrating disk: 165 rows in one
-    component joined by 84 hold rows over 1714 dofs, 0.33 s of pivoted QR a call, 45 % of
-    the run; the Cholesky of the 249 x 249 Gram matrix takes milliseconds). Rows with a
-    dependence fall through to the QR, which decides which to drop. Tried only where the
-    QR would cost more (sum over the components of rows^2 x columns above rows^3 of the
-    test: many small components, as along the cuts of benchmarks/contact.py, are cheap to
-    QR, and there a failed test only added time), not above ``limit`` rows, and not where
-    rtol^2 is within ten times the rounding of the test.
+    The reference mesh has no overlap, so a slave node cannot be deeper behind a master
+    segment than it has moved relative to that segment (plus the threshold). Deeper
+    "penetrations" come from picking the wrong way out near crack tips and corners;
+    imposing them would tear the mesh (inverted elements), so they are dropped.
+
+    Parameters
+    ----------
+    cs : ContactConstraints
+        Candidate rows, with ``dist`` at the current configuration.
+    U : numpy.ndarray, shape (nv, 2)
+        Vertex displacements.
+    tol : float
+        Detection threshold (a length) added to the relative motion.
+
+    Returns
+    -------
+    numpy.ndarray of bool, shape (len(cs),)
+        True where -dist <= |u_slave - xi u_a - (1 - xi) u_c| + tol.
     """
-    M = sp.vstack([G, C]).tocsr()
-    k = M.shape[0]
-    if k == 0 or k > limit:
-        return k == 0
-    labels = np.concatenate([labels_g, labels_c]).astype(np.int64)
-    rows_per = np.bincount(labels).astype(float)
-    pairs = np.unique(np.repeat(labels, np.diff(M.indptr)) * M.shape[1] + M.indices)
-    columns_per = np.bincount(pairs // M.shape[1], minlength=len(rows_per))
-    if np.sum(rows_per ** 2 * columns_per) < float(k) ** 3:
-        return False
-    gram = (M @ M.T).toarray()
-    # backward error of forming and factorising the Gram matrix: a few k eps |Gram|
-    rounding = 4 * k * np.finfo(float).eps * np.abs(gram).sum(axis=1).max()
-    if rtol ** 2 < 10 * rounding:
-        return False
-    gram[np.diag_indices(k)] -= rtol ** 2 + rounding
-    try:
-        sla.cholesky(gram, lower=True, check_finite=False)
-    except np.linalg.LinAlgError:
-        return False
-    return True
+    if len(cs) == 0:
+        return np.zeros(0, dtype=bool)
+    xi = cs.xi[:, None]
+    rel = U[cs.slave] - xi * U[cs.a] - (1.0 - xi) * U[cs.c]
+    return -cs.dist <= np.linalg.norm(rel, axis=1) + tol
 
 
 def contact_constraints(coords, displacement, tris, boundary_edges, fragment=None,
@@ -540,7 +449,7 @@ def contact_constraints(coords, displacement, tris, boundary_edges, fragment=Non
     pairs = detect_collisions(coords, displacement, tris, candidates=candidates,
                               boundary_edges=boundary_edges, fragment=fragment, tol=tol)
     if len(pairs) == 0:
-        return _no_constraints(np.shape(coords)[0])     # no work without collisions
+        return no_constraints(np.shape(coords)[0])     # no work without collisions
     cs = select_contacts(coords, displacement, tris, boundary_edges, pairs, tol=tol,
                          angle_tol=angle_tol, xi_snap=xi_snap)
     if len(cs) == 0:

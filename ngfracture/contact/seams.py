@@ -11,10 +11,9 @@ Node-to-segment selection (paper rules 1-4, :mod:`ngfracture.contact.rows`) is i
 at zero gap every lip node is at once a slave of the other lip and an end of its master
 segments, both lips offer a master with a different normal (at a kink), and which one wins
 depends on rounding in the predicted configuration. The choice flips from one linearisation
-to the next and the active set cycles (measured: 20 rounds on a plate with a crack across,
-rows 27 to 31 in a period-4 cycle). Across a seam we therefore use node-to-node rows between
-twins, identified by the node pair and the facet, so the set of candidate rows is the same in
-every round of a solve:
+to the next and the active set cycles (``docs/contact.md``). Across a seam we therefore use
+node-to-node rows between twins, identified by the node pair and the facet, so the set of
+candidate rows is the same in every round of a solve:
 
 * one row per facet end: g = n_f . (x_b2 - x_b) >= 0 for twins b, b2 (b the lower
   vertex number), n_f the unit normal of facet f pointing from b's lip to b2's. At a straight node the rows of its
@@ -38,8 +37,8 @@ Junctions: where a point is split into three or more copies (cracks meet, a crac
 a split interface), each copy owns a wedge of the full angle around the point, and a copy
 pair shares at most one facet. For small relative motion r = x_j - x_i of two copies, r
 must stay outside wedge i and -r outside wedge j; the facet rows above state that only in
-part (measured: 3.3e-10 overlap of 2.0 on a zigzag crack pressed by 1e-3, every
-overlapping pair at a three-copy point). Where one wedge of a pair is reflex (wider than
+part (the overlap they leave is all at three-copy points, ``docs/contact.md``). Where one
+wedge of a pair is reflex (wider than
 pi), the other copy must stay in its complement, a convex cone: one row per edge of the
 reflex wedge (exact; the edges shared as facets already have their row), identified by
 (copy, copy, edge) and built at the prediction like the facet rows.
@@ -52,17 +51,17 @@ inside K): one row, frozen for the solve like the other seam rows and identified
 (copy, copy, side of K) so that re-linearisation keeps the choice. Exact while r stays
 on that side; the pieces may slide along the chosen edge both ways and separate freely
 (`tests/test_seams.py`: shear along a crack through a cross junction in either
-direction). Tried before and removed: one row across the separating line of widest
-margin (a normal anywhere between K's edge normals; one strictly between them blocks
-sliding along either crack one way), and tutorial 5's beam and the disk stopped early.
+direction). One row across the separating line of widest margin (a normal anywhere
+between K's edge normals) would not do: one strictly between them blocks sliding along
+either crack one way (``docs/contact.md``).
 """
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from .rows import ContactConstraints, _gap_offset
+from .rows import ContactConstraints, gap_offset
 
-__all__ = ["Seams", "find_seams", "seam_constraints", "KINK_ANGLE", "SLIP"]
+__all__ = ["Seams", "find_seams", "seam_constraints", "point_ids", "KINK_ANGLE", "SLIP"]
 
 #: facets meeting at a larger angle (radians) get a row each at their common node
 KINK_ANGLE = 1e-6
@@ -120,7 +119,7 @@ def find_seams(points, segments):
     """
     X = np.ascontiguousarray(points, dtype=np.float64)
     S = np.asarray(segments, dtype=np.int64).reshape(-1, 2)
-    copy_id = _point_ids(X)
+    copy_id = point_ids(X)
     n = int(copy_id.max(initial=-1)) + 1
     a = b = np.zeros(0, dtype=np.int64)
     if len(S):
@@ -141,10 +140,22 @@ def find_seams(points, segments):
                  edge_rows=edge_rows, diagonal=diagonal)
 
 
-def _point_ids(X):
-    """Number of every point among the distinct points, in lexicographic (x, y) order: the
-    inverse of ``np.unique(X, axis=0)``, by one lexsort (np.unique sorts rows as records,
-    four times slower)."""
+def point_ids(X):
+    """Number of every point among the distinct points, in lexicographic (x, y) order.
+
+    The inverse of ``np.unique(X, axis=0, return_inverse=True)``, by one lexsort (np.unique
+    sorts rows as records, which is slower); -0.0 and 0.0 are one point.
+
+    Parameters
+    ----------
+    X : numpy.ndarray, shape (nv, 2)
+        Points.
+
+    Returns
+    -------
+    numpy.ndarray of int64, shape (nv,)
+        Equal for bitwise equal points (up to the sign of zero), numbered from 0.
+    """
     order = np.lexsort((X[:, 1], X[:, 0]))
     Xs = X[order]
     new = np.ones(len(X), dtype=np.int64)
@@ -355,4 +366,4 @@ def _rows(X, x, master, slave, normal):
     dist = np.einsum("ij,ij->i", x[slave] - x[master], normal) if m else np.zeros(0)
     return ContactConstraints(slave=slave, a=master, c=master, master_tri=none, slave_tri=none,
                               pair=none, xi=np.ones(m), normal=normal, dist=dist, angle=np.zeros(m),
-                              g=_gap_offset(X, slave, master, master, np.ones(m), normal), nv=len(X))
+                              g=gap_offset(X, slave, master, master, np.ones(m), normal), nv=len(X))

@@ -1,69 +1,28 @@
 """Equilibrium with frictionless unilateral contact between pieces (paper eq. 8-14).
 
-A primal-dual active set around the Newton solver, in the paper's predict-and-correct
-manner:
+An active set around the Newton solver, in the paper's predict-and-correct manner:
 
-    1. solve without contact rows (free pieces held on their rigid modes): the prediction;
-       a solve given the active rows of the solve before (``warm``: the previous crack pass
-       or load step) imposes those instead and skips the prediction;
-    2. candidate rows (eq. 13, 14), each identified by a key (its nodes and facet):
-       - across seams, where two lips coincide in the reference configuration (crack
-         faces from node splitting, interfaces from ``meshio.separate_region``),
-         node-to-node rows between twins, chosen once at the prediction
-         (:mod:`ngfracture.contact.seams`: one row per straight node, one per facet at a kink);
-       - elsewhere, node-to-segment rows of the paper's rules 1-4 (:mod:`ngfracture.contact.rows`)
-         found at the current configuration; a row stays a candidate while it is active
-         or found again, rows of a twin against its own seam are left out;
-       every candidate is re-linearised at the configuration of the last solve, so the
-       set update judges the gaps of that configuration;
-    3. active set update, for every candidate row (semismooth Newton for the
-       complementarity function min(-lambda, g) of eq. 8, Hintermueller-Ito-Kunisch):
-       an active row stays while its multiplier compresses (lambda <= 0 up to rounding,
-       compression is lambda <= 0 as the paper's p_N <= 0); an inactive row enters when
-       its linearised gap is below -``penetration_tol``. Rows that depend on others are
-       dropped by the pivoted QR (``contact.independent_rows``);
-    4. if the set equals the one of the last solve and no row penetrates by more than
-       ``penetration_tol``, stop; a settled set that still penetrates is solved again with
-       its rows linearised here (an update; at most ``max_updates``); if the update of 3
-       revisits a set imposed before, or has not settled after ``pdas_rounds`` rounds,
-       replace it by the exact solution of the linear complementarity problem of the
-       linearisation (:meth:`ContactSolver._complementarity`); impose the set as
-       equalities C u + g = 0 (eq. 12), solve, and go to 2.
-
-Why keys: the active set used to be re-selected from scratch at every linearisation. On
-coincident lips every node is at once a slave of the other lip and an end of its master
-segments, both lips offer masters with different normals, and rounding decides; the choice
-flipped between rounds and the set cycled (measured: 20 rounds, 27 to 31 rows in a cycle of
-4, on a plate cracked across). With rows identified by their nodes (and facet) the candidate
-set is fixed for a seam, and the primal-dual update settles in a few rounds (measured: 2 to 7).
-
-Why re-linearise every round: with each row frozen where it was found until the set settled,
-a settled set was only the start of a fixed point of updates (re-linearise, solve, look
-again), each of which could change the set again; on pieces that move by a good part of the
-detection threshold in a step this took 12 to 14 solves per contact solve (the
-disintegrating disk) and gave up on a pinwheel of four quarters sliding by a tenth of the
-mesh size. Re-linearised every round, set and geometry settle together: 5 to 7 solves on the
-disk, and the pinwheel converges up to a third of the mesh size (tests/test_contact_fractured.py).
-A row whose gap at the new configuration is the same to a hundredth of ``penetration_tol``
-under both linearisations keeps its old one, bit for bit, and with it its cached column of
-the Schur complement: the lips that did not move cost no solve (:func:`_refreshed`).
-Where re-linearising stops reducing the penetration at a settled set (rows sliding over a
-kink), the rows are frozen from then on and the plain fixed point of updates decides, and
-fails with reason "penetration" when it does not contract.
-
-Why the complementarity problem: the primal-dual update converges when the response of
-the gaps to the contact forces, S = C K^-1 C^T, is an M-matrix; nearly parallel rows at a
-kink (two facet rows of one node pair) are far from it, and it cycled (measured on the disk
-scene at maxh 0.1: period 4 between 58 and 63 rows, multipliers -1.86e6 and +1.83e6 on two
-rows of one node pair). The complementarity problem with S positive definite has one
-solution, found in finitely many steps (:mod:`ngfracture.linalg.qp`); it costs a dense QP on the
-candidate rows, so it is used only where the cheap update fails.
+1. solve without contact rows (free pieces held on their rigid modes): the prediction.
+   A solve given the active rows of the solve before (``warm``: the previous crack pass
+   or load step) imposes those instead and skips the prediction;
+2. update the candidate rows at the configuration of the last solve and choose the active
+   set among them (:class:`~ngfracture.contact.active_set.ActiveSet`: seam and
+   node-to-segment rows identified by keys, the primal-dual update, and the linear
+   complementarity problem where that cycles, solved here through the factorised
+   tangent of the Newton solves);
+3. if the set is the one of the last solve, judge it by its rows re-linearised at that
+   solution: converged when none penetrates by more than ``penetration_tol``; else solve
+   again with the rows linearised there (an update, at most ``max_updates``), or fail with
+   reason "penetration" when the updates do not contract;
+4. impose the set as equalities C u + g = 0 (eq. 12), solve, and go to 2.
 
 At the end the Kuhn-Tucker conditions of eq. 8 hold to the solver tolerance for the rows
 linearised at the solution: g_N >= -``penetration_tol``, lambda <= 0, lambda g_N = 0 (active
 rows have g_N = 0, inactive ones carry no force). What overlap remains is that of the
-polygonal lips between the rows' nodes, of second order in the last update.
+polygonal lips between the rows' nodes, of second order in the last update. The
+measurements behind these choices are in ``docs/contact.md``.
 """
+import functools
 import math
 import numbers
 import time
@@ -72,15 +31,19 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 
-from . import rows as contact
-from .collision import detect_collisions
-from ..fracture.crack import vertex_displacement
+from .active_set import ActiveSet, Geometry, max_penetration
+from ..fracture.strain import vertex_displacement
 from ..geometry.meshio import boundary_only
-from .seams import KINK_ANGLE, find_seams, seam_constraints
-from ..linalg.kkt import SingularSystem, single_threaded_blas
+from .seams import KINK_ANGLE, find_seams
+from ..linalg.factor import SingularSystem
+from ..linalg.sparse import single_threaded_blas
 from ..linalg.qp import QPError
-from ..mechanics.newton import NewtonSolver, SavedTangent, SolveStatus, check_solve_options
+from ..mechanics.newton import NewtonSolver, SolveStatus, check_solve_options
+from ..mechanics.tangent import SavedTangent
 
+__all__ = ["ContactResult", "ContactSolver", "space_columns", "LABEL"]
+
+#: label of the problem's constraint rows that the contact solve owns
 LABEL = "contact"
 
 
@@ -113,7 +76,7 @@ class ContactResult:
         after ``max_updates`` of them (``max_penetration`` says how much).
     rounds : int
         Detect-and-solve rounds.
-    constraints : contact.ContactConstraints
+    constraints : ngfracture.contact.rows.ContactConstraints
         The active constraints at the end: seam rows (master_tri = -1, a = c the master
         twin, slave its twin) and node-to-segment rows.
     multipliers : numpy.ndarray
@@ -131,7 +94,8 @@ class ContactResult:
     history : list of (int, float)
         Active rows and max_penetration at the start of every round.
     updates : int
-        Re-linearisations of the rows at a settled solution (see ContactSolver).
+        Re-linearisations of the rows at a settled solution (see ``max_updates`` of
+        ContactSolver).
     lcp : int
         Rounds whose set was chosen by the complementarity problem (after a cycle).
     notes : list of str
@@ -142,9 +106,9 @@ class ContactResult:
         Sorted keys of the active rows of a converged solve: ("s", lower twin, higher
         twin, kind) for seam rows, ("n", slave, a, c) for node-to-segment rows. The next
         solve can start from them (``ContactSolver.solve(warm=...)``).
-    tangent : solver.SavedTangent or None
+    tangent : ngfracture.mechanics.tangent.SavedTangent or None
         The factorisation the solve ended with (the lineage of a mesh split from this
-        one, split_factor.lineage).
+        one, ``linalg.bordered.lineage``).
     """
     status: SolveStatus
     converged: bool = False
@@ -166,32 +130,6 @@ class ContactResult:
         return self.converged
 
 
-def _refreshed(old, fresh, U, limit):
-    """The rows of ``fresh`` (re-linearised at U), except where the gap at U of the row in
-    ``old`` (same order, same keys) differs from the fresh one by at most ``limit``: those
-    keep their old linearisation, bit for bit, and with it their cached Schur column
-    (kkt.EliminatedFactor.columns). Rows of lips that did not move are all of these; the
-    final test of a settled set judges freshly linearised rows whatever was kept."""
-    u = U.T.ravel()
-    drift = np.abs((fresh.C @ u + fresh.g) - (old.C @ u + old.g))
-    keep = drift <= limit
-    if keep.all():
-        return old
-    if not keep.any():
-        return fresh
-    kept, renewed = np.flatnonzero(keep), np.flatnonzero(~keep)
-    rows = contact.ContactConstraints.stack([old.subset(kept), fresh.subset(renewed)])
-    return rows.subset(np.argsort(np.concatenate([kept, renewed])))
-
-
-def _space_columns(C, nv, n):
-    """Map contact columns comp*nv + v (P1 layout) to the space's comp*n + v."""
-    C = sp.csr_matrix(C)
-    cols = C.indices
-    mapped = np.where(cols < nv, cols, cols - nv + n)
-    return sp.csr_matrix((C.data, mapped, C.indptr), shape=(C.shape[0], 2 * n))
-
-
 class ContactSolver:
     """Newton solves with an active set of seam and node-to-segment contact constraints.
 
@@ -207,32 +145,28 @@ class ContactSolver:
         Detect-and-solve rounds before giving up with reason "active_set".
     rank_tol : float
         Rows closer than this (relative) to the span of the kept rows are dropped as
-        redundant. Measured on cracked plates: near-duplicate lip rows at 1e-6 made the
-        Schur complement so ill-conditioned (1e12) that Newton stalled at 5e-10.
+        redundant. A smaller value keeps near-duplicate lip rows, which make the Schur
+        complement so ill-conditioned that Newton stalls.
     max_updates : int
         Solves of a settled active set again at most. A row linearised at the last solve
         (eq. 13/14) still lets the next solution overlap to second order in that solve's
-        motion (measured 1.6e-9 of the area on the plate scene, from a free one-triangle
-        fragment sliding along its seams). When the gaps at the solution penetrate by more
-        than penetration_tol, the set is solved again with its rows linearised there (same
-        rows, current normals and projections). This fixed point contracts fast where the
-        step is small enough (measured: a factor 20 to 500 per update on the
-        disintegration disk). Once the rows are frozen (see the module docstring), an
-        update that does not reduce the penetration, or ``max_updates`` of them, end the
-        solve with reason "penetration".
+        motion. When the gaps at the solution penetrate by more than penetration_tol, the
+        set is solved again with its rows linearised there (same rows, current normals and
+        projections); this fixed point contracts fast where the step is small enough. Once
+        the rows are frozen (see :mod:`ngfracture.contact.active_set`), an update that does
+        not reduce the penetration, or ``max_updates`` of them, end the solve with reason
+        "penetration".
     kink_angle : float
         Seam facets meeting at a larger angle (radians, in the reference configuration)
-        get a row each at their common node (see :mod:`ngfracture.contact.seams`). The default
-        (1e-6) keeps every kink: the exact non-penetration of the polygonal lips. A large
-        value (pi) gives one row with the mean normal per node: overlap first order in
-        the slip (measured 100 to 1100 times more on a zigzag crack), and a body held only by
-        contact on a faceted circle then has a nearly free rotation (measured: the
-        Newton solve did not converge).
+        get a row each at their common node (see :mod:`ngfracture.contact.seams`). The
+        default (1e-6) keeps every kink: the exact non-penetration of the polygonal lips. A
+        large value (pi) gives one row with the mean normal per node: overlap first order
+        in the slip, and a body held only by contact on a faceted circle then has a nearly
+        free rotation, on which Newton does not converge.
     pdas_rounds : int
         Rounds of the primal-dual update before the set is chosen by the complementarity
-        problem (also chosen so at once when the update revisits a set). Measured: the update
-        settles in 2 to 7 rounds where it converges; on kinked lips pressed obliquely it
-        wandered for 20 rounds.
+        problem (also chosen so at once when the update revisits a set). Where the update
+        converges, it settles within a few rounds (``docs/contact.md``).
     **solve_options
         Passed to ``problem.solve`` (method, tol, maxit, ...); ``fix_free_modes`` is True
         (free pieces are held on the rigid modes contact leaves free) unless given as "all"
@@ -282,18 +216,21 @@ class ContactSolver:
         self.options["fix_free_modes"] = "all" if self.options.get("fix_free_modes") == "all" else True
 
     def _geometry(self):
-        """Mesh arrays, fragment per triangle, and the fixed dofs (all, and in the P1 layout).
+        """The geometry of the rounds, and the fixed dofs in the space's layout.
 
         None of it changes while the problem is solved on one mesh: computed once per solve.
         """
         prob = self.problem
         arrays = boundary_only(prob.arrays)   # no bonded-interface segments
         _, comp = prob.fragments()
-        fragment = comp[arrays.triangles[:, 0]]
         nv, n = prob.mesh.nv, prob.fes.ndof // 2
         fixed = prob.assemble_constraints().fixed_dofs
         v, c = fixed % n, fixed // n
-        return arrays, fragment, fixed, (c * nv + v)[v < nv]
+        holds = self._held_modes()
+        geometry = Geometry(arrays=arrays, fragment=comp[arrays.triangles[:, 0]],
+                            seams=find_seams(arrays.points, arrays.segments), fixed=(c * nv + v)[v < nv],
+                            holds=holds)
+        return geometry, fixed
 
     def _held_modes(self):
         """With fix_free_modes "all", the rows that hold the pieces, in the P1 layout (else None).
@@ -309,21 +246,6 @@ class ContactSolver:
         keep = v < nv          # the modes live on the vertex dofs
         return sp.csr_matrix((modes.data[keep], (modes.row[keep], (c * nv + v)[keep])), shape=(modes.shape[0], 2 * nv))
 
-    def _relinearised(self, pool, n_seam, seam_keys, seams, X, U):
-        """The rows of pool (seam rows first) linearised at X + U, in the same order."""
-        # both sides of every diagonal pair: the side chosen at the prediction is found by key
-        fresh_seams, k = seam_constraints(seams, X, U, kink_angle=self.kink_angle, choose=False)
-        where = {("s",) + tuple(r): i for i, r in enumerate(k.tolist())}
-        # a seam row whose twins slid too far for a fresh one keeps its old linearisation
-        present = [i for i, key in enumerate(seam_keys) if key in where]
-        missing = [i for i, key in enumerate(seam_keys) if key not in where]
-        seam_rows = contact.ContactConstraints.stack([
-            fresh_seams.subset(np.array([where[seam_keys[i]] for i in present], dtype=np.int64)),
-            pool.subset(np.array(missing, dtype=np.int64))])
-        seam_rows = seam_rows.subset(np.argsort(np.array(present + missing, dtype=np.int64)))
-        n2s = relinearise_node_to_segment(pool.subset(np.arange(n_seam, len(pool))), X, U)
-        return contact.ContactConstraints.stack([seam_rows, n2s])
-
     def _contact_offset(self):
         offset = 0
         for C, _, label in self.problem.constraints.rows:
@@ -332,43 +254,33 @@ class ContactSolver:
             offset += C.shape[0]
         return offset
 
-    def _node_to_segment(self, arrays, fragment, U, seams, matched, timings):
-        """Rules 1-4 rows at X + U that the seams do not cover, with their keys."""
-        X, T, E = arrays.points, arrays.triangles, arrays.segments
-        t0 = time.perf_counter()
-        pairs = detect_collisions(X, U, T, boundary_edges=E, fragment=fragment, tol=self.tol)
-        timings["collision"] += time.perf_counter() - t0
-        if len(pairs) == 0:
-            return contact._no_constraints(len(X)), []
-        cs = contact.select_contacts(X, U, T, E, pairs, tol=self.tol)
-        keep = reachable(cs, U, self.tol)
-        # a twin of a seam talks to the other lip through its seam rows only
-        cid = seams.copy_id
-        seam_edge = np.array([(min(a, c), max(a, c)) in seams.seam_edge
-                              for a, c in zip(cs.a.tolist(), cs.c.tolist())], dtype=bool)
-        own = (cid[cs.a] == cid[cs.slave]) | (cid[cs.c] == cid[cs.slave])
-        keep &= ~(matched[cs.slave] & (seam_edge | own))
-        cs = cs.subset(np.flatnonzero(keep))
-        keys = [("n",) + k for k in zip(cs.slave.tolist(), cs.a.tolist(), cs.c.tolist())]
-        return cs, keys
+    def _impose(self, rows):
+        """Make ``rows`` (P1 layout) the problem's contact rows, as equalities C u + g = 0."""
+        prob = self.problem
+        prob.constraints.clear_rows(LABEL)
+        if len(rows):
+            prob.constraints.add_rows(space_columns(rows.C, prob.mesh.nv, prob.fes.ndof // 2), -rows.g, label=LABEL)
 
-    def _complementarity(self, pool, candidates, fixed, nv, n, tangent, result):
+    def _complementarity(self, rows, candidates, tangent, result):
         """The candidate rows closed in the exact solution of the linearised contact problem.
 
         With the tangent of the Newton solves the gaps respond linearly to the contact
         forces, g(lam) = q - S lam (S = C K^-1 C^T through the same constrained solver, so
         single-dof rows and the coarse problem of free modes count): a linear
         complementarity problem, which the dual active-set method solves in finitely many
-        steps (see :meth:`kkt.ConstrainedSolver.solve_unilateral`). Candidates may be linearly
-        dependent: at a junction five rows bound the relative motion of three copies (4
-        dofs), and dropping one as dependent would drop its inequality (measured: it came
-        back penetrated by 4e-6 and the set cycled). Returns pool indices, an independent
-        set, or None if the problem cannot be solved (then the primal-dual update goes on).
+        steps (see :meth:`kkt.ConstrainedSolver.solve_unilateral`). Candidates may be
+        linearly dependent: at a junction five rows bound the relative motion of three
+        copies (4 dofs), and dropping one as dependent would drop its inequality. Closed
+        rows are those that press and those that touch without force: the latter place
+        pieces that no force holds where the solution has them (else their modes are
+        frozen). Returns indices among ``candidates`` (of ``rows``), or None if the problem
+        cannot be solved (recorded in ``result.notes``; the primal-dual update goes on).
         """
         t0 = time.perf_counter()
         prob = self.problem
         prob.constraints.clear_rows(LABEL)
-        prob.constraints.add_rows(_space_columns(pool.C[candidates], nv, n), -pool.g[candidates], label=LABEL)
+        prob.constraints.add_rows(space_columns(rows.C[candidates], prob.mesh.nv, prob.fes.ndof // 2),
+                                  -rows.g[candidates], label=LABEL)
         offset = self._contact_offset()
         options = {k: v for k, v in self.options.items() if k != "load_steps"}
         try:
@@ -383,16 +295,11 @@ class ContactSolver:
             prob.constraints.clear_rows(LABEL)
             result.timings["solve"] += time.perf_counter() - t0
         result.lcp += 1
-        # the rows that press and those that touch without force: the latter place pieces
-        # that no force holds where the solution has them (else their modes are frozen);
-        # dependent ones hold with the others, as equalities they would make K singular
-        choice = candidates[closed[offset:offset + len(candidates)]]
-        return choice[contact.independent_rows(pool.C[choice], fixed_dofs=fixed, G=self._holds,
-                                               rtol=self.rank_tol)] if len(choice) else choice
+        return candidates[closed[offset:offset + len(candidates)]]
 
     def _newton(self, result, tangent, increment_scale=None):
-        """One Newton solve with the current rows; later rounds pass the first solve's first
-        increment (they correct that solve: eq. 7 is judged against the step, not the correction)."""
+        """One Newton solve with the current rows, recorded in ``result``; later rounds pass
+        the first solve's first increment (see :meth:`_rounds`)."""
         t0 = time.perf_counter()
         status = self.problem.solve(tangent=tangent, increment_scale=increment_scale, **self.options)
         result.status = status
@@ -420,12 +327,12 @@ class ContactSolver:
             changes: the set still has to settle and pass the same tests. A warm start that
             fails is followed by the plain path from the same start (recorded in
             ``notes``). Empty: the plain predict-and-correct path.
-        lineage : split_factor.Lineage, optional
+        lineage : ngfracture.linalg.bordered.Lineage, optional
             The problem's mesh was split from a solved one: its solves start from that
-            factorisation, bordered by the split (see solver.SavedTangent).
-        start : solver.SavedTangent, optional
+            factorisation, bordered by the split (see mechanics.tangent.SavedTangent).
+        start : ngfracture.mechanics.tangent.SavedTangent, optional
             A factorised tangent of this mesh to start from (the solve before at another
-            load, simulation.py); each start takes it afresh (``SavedTangent.kept``).
+            load, run/tangents.py); each start takes it afresh (``SavedTangent.kept``).
 
         Returns
         -------
@@ -445,7 +352,7 @@ class ContactSolver:
         if result.converged:
             return result
         # rows of the pass before can hold a shattered piece in a nearly singular way
-        # (measured: a plate at critical strain 1e-12); the plain path decides then
+        # (docs/contact.md); the plain path decides then
         prob.u.vec.FV().NumPy()[:] = u
         prob.load_factor.Set(load)
         plain = self._solve(set(), uncracked, lineage, start)
@@ -474,125 +381,45 @@ class ContactSolver:
                 result.converged, result.reason = True, "converged"
                 return result
         t0 = time.perf_counter()
-        arrays, fragment, fixed_all, fixed = self._geometry()
-        self._holds = self._held_modes()
-        seams = find_seams(arrays.points, arrays.segments)
-        nv, n = prob.mesh.nv, prob.fes.ndof // 2
+        geometry, fixed = self._geometry()
+        active = ActiveSet(geometry, self.tol, self.penetration_tol, kink_angle=self.kink_angle,
+                           rank_tol=self.rank_tol, pdas_rounds=self.pdas_rounds, max_updates=self.max_updates,
+                           warm=warm)
         result.timings["contact"] += time.perf_counter() - t0
-        seam_rows, seam_keys = None, []
-        n2s, n2s_keys = contact._no_constraints(nv), []
-        lam = {}     # the rows imposed in the last solve (by key) and their multipliers
-        imposed = set()                         # every set imposed so far
-        tried = set()                           # every row imposed so far
-        exact = False                           # the complementarity problem chooses the set
-        force_scale = 0.0                       # the largest force of any round so far
-        last_penetration = np.inf               # at the last re-linearisation
-        moving = True        # rows re-linearised every round (until that stops contracting)
+        return self._rounds(active, result, tangent, scale, fixed)
+
+    def _rounds(self, active, result, tangent, scale, fixed):
+        """The rounds of :meth:`_solve`: update the candidates, choose, judge, impose, solve.
+
+        ``scale`` is the first increment of the first solve (None before it: later solves
+        correct that one, and eq. 7 is judged against the step, not the correction);
+        ``fixed`` are the fixed dofs, whose reactions are a force scale of the multipliers.
+        """
+        prob = self.problem
+        complementarity = functools.partial(self._complementarity, tangent=tangent, result=result)
         for rnd in range(1, self.max_rounds + 1):
             result.rounds = rnd
             t0 = time.perf_counter()
             U = vertex_displacement(prob.u)
-            at_U = None      # the rows of the last round, all linearised at U (when made)
-            if seam_rows is None:
-                # built once, at the predicted configuration, and frozen for this solve
-                seam_rows, k = seam_constraints(seams, arrays.points, U, kink_angle=self.kink_angle)
-                seam_keys = [("s",) + tuple(r) for r in k.tolist()]
-                matched = np.zeros(nv, dtype=bool)
-                matched[seam_rows.slave] = matched[seam_rows.a] = True
-            elif moving and result.status is not None:
-                # every row at the configuration just solved: the gaps the set update
-                # judges are those of this configuration, to second order in the last step
-                old = contact.ContactConstraints.stack([seam_rows, n2s])
-                at_U = self._relinearised(old, len(seam_keys), seam_keys, seams, arrays.points, U)
-                fresh = _refreshed(old, at_U, U, 0.01 * self.penetration_tol)
-                seam_rows = fresh.subset(np.arange(len(seam_keys)))
-                n2s = fresh.subset(np.arange(len(seam_keys), len(fresh)))
-            # node-to-segment rows: a row keeps the linearisation it was found with while
-            # it is active or detected again; new ones are linearised here
-            found, found_keys = self._node_to_segment(arrays, fragment, U, seams, matched, result.timings)
-            known, found_set = set(n2s_keys), set(found_keys)
-            old = [i for i, k in enumerate(n2s_keys) if k in lam or k in found_set]
-            new = [i for i, k in enumerate(found_keys) if k not in known]
-            n2s = contact.ContactConstraints.stack([n2s.subset(old), found.subset(new)])
-            n2s_keys = [n2s_keys[i] for i in old] + [found_keys[i] for i in new]
-            pool = contact.ContactConstraints.stack([seam_rows, n2s])
-            keys = seam_keys + n2s_keys
-            gap = pool.C @ U.T.ravel() + pool.g
-            # primal-dual active set: an active row stays while it pushes (lambda <= 0),
-            # an inactive one enters when its node penetrates
-            want = np.array([(lam[k] <= 0.0) if k in lam else (g < -self.penetration_tol or k in warm)
-                             for k, g in zip(keys, gap)], dtype=bool)
-            warm = set()     # a warm row that the solve releases is judged like any other
-            want = np.flatnonzero(want)
-            kept = want[contact.independent_rows(pool.C[want], fixed_dofs=fixed, G=self._holds, rtol=self.rank_tol)] \
-                if want.size else want
-            dependent = np.setdiff1d(want, kept)
-            other = np.setdiff1d(np.arange(len(keys)), dependent)
-            penetration = float(max(0.0, -gap[other].min(initial=0.0)))
+            candidates = active.update(U, result.timings)
+            want, kept, other = active.primal_dual(candidates)
+            penetration = max_penetration(candidates.gap, other)
             result.history.append((len(kept), penetration))
             result.timings["contact"] += time.perf_counter() - t0
-            # settled: the set of the last solve again (none yet when started warm)
-            settled = result.status is not None and set(keys[i] for i in kept) == set(lam)
-            if moving and not settled:
-                last_penetration = np.inf     # the contraction is judged at one set only
-            if not settled and (exact or rnd > self.pdas_rounds or frozenset(keys[i] for i in kept) in imposed):
-                # the update revisits a set: it cycles (rows with a response that is no
-                # M-matrix, e.g. nearly parallel rows at a kink). From here on the set is
-                # the exact solution of the complementarity problem of the linearisation.
-                exact = True
-                # candidates: the rows the update wants and every row imposed before
-                candidates = np.union1d(want, np.array([i for i, k in enumerate(keys) if k in tried], dtype=np.int64))
-                choice = self._complementarity(pool, candidates, fixed, nv, n, tangent, result)
-                if choice is not None and set(keys[i] for i in choice) != set(lam):
-                    kept = choice
-            imposed.add(frozenset(keys[i] for i in kept))
-            tried.update(keys[i] for i in kept)
+            kept, settled = active.choose(candidates, want, kept, rnd, complementarity)
             if settled:
-                # settled for the rows as linearised; re-linearised at the solution, their
-                # gaps are the true ones of this configuration
                 t0 = time.perf_counter()
-                if at_U is None:
-                    fresh = self._relinearised(pool, len(seam_keys), seam_keys, seams, arrays.points, U)
-                else:
-                    # the rows of the last round were re-linearised at this U when the round
-                    # began (a row re-linearised twice at one U is the same, bit for bit):
-                    # only the rows found in this round are new
-                    fresh = contact.ContactConstraints.stack([
-                        at_U.subset(np.concatenate([np.arange(len(seam_keys)),
-                                                    len(seam_keys) + np.array(old, dtype=np.int64)])),
-                        relinearise_node_to_segment(found.subset(new), arrays.points, U)])
-                gap = fresh.C @ U.T.ravel() + fresh.g
-                penetration = float(max(0.0, -gap[other].min(initial=0.0)))
+                verdict, penetration, candidates = active.settle(candidates, other, U)
                 result.timings["contact"] += time.perf_counter() - t0
-                result.max_penetration = penetration
-                if penetration <= self.penetration_tol:
-                    result.converged, result.reason = True, "converged"
-                    result.active_keys = sorted(lam)
+                result.max_penetration, result.updates = penetration, active.updates
+                if verdict != "update":
+                    if verdict == "converged":
+                        result.converged, result.active_keys = True, sorted(active.multipliers)
+                    result.reason = verdict
                     return result
-                if moving and penetration >= last_penetration and result.updates < self.max_updates:
-                    # re-linearising every round went round in circles at this set: from
-                    # here on the rows stay as linearised now, and the plain fixed point of
-                    # updates at a settled set decides (and fails when it does not contract)
-                    moving = False
-                elif result.updates == self.max_updates or penetration >= last_penetration:
-                    # the linearisations do not converge to a state without overlap (large
-                    # relative motion for one solve): a failure, which a caller cures with
-                    # a smaller step, not an overlap passed off as a solution
-                    result.reason = "penetration"
-                    return result
-                last_penetration = penetration
-                # a geometric fixed point: solve again with the rows linearised here
-                # (the overlap falls from second to fourth order in the displacement)
-                result.updates += 1
-                pool = _refreshed(pool, fresh, U, 0.01 * self.penetration_tol)
-                seam_rows = pool.subset(np.arange(len(seam_keys)))
-                n2s = pool.subset(np.arange(len(seam_keys), len(keys)))
-            cs = pool.subset(kept)
-            cs.dist = gap[kept]
-            prob.constraints.clear_rows(LABEL)
-            if len(cs):
-                # active: the linearised gap closes, C u + g = 0
-                prob.constraints.add_rows(_space_columns(cs.C, nv, n), -cs.g, label=LABEL)
+            cs = candidates.rows.subset(kept)
+            cs.dist = candidates.gap[kept]
+            self._impose(cs)
             status = self._newton(result, tangent, scale)
             scale = status.first_increment if scale is None else scale
             if not status.converged:
@@ -600,165 +427,32 @@ class ContactSolver:
                 return result
             offset = self._contact_offset()
             multipliers = status.multipliers[offset:offset + len(cs)]
-            # adhesive beyond rounding: relative to the largest force the constraints carried
-            # in any round of this solve. A set that lets the pieces drift apart carries no
-            # force at all; its multipliers are rounding noise of either sign, and measured
-            # against themselves they made the set cycle (tutorial 5's broken beam).
-            r = tangent.residual[2]     # the out-of-balance where the solve ended
-            force_scale = max(force_scale, float(np.abs(multipliers).max(initial=0.0)),
-                              float(np.linalg.norm(r[fixed_all])))
-            rounded = np.where(np.abs(multipliers) <= 1e-10 * force_scale, 0.0, multipliers)
-            result.released += int(np.count_nonzero(rounded > 0))
-            lam = {keys[i]: x for i, x in zip(kept.tolist(), rounded.tolist())}
+            reaction = float(np.linalg.norm(tangent.residual[2][fixed]))  # out-of-balance where the solve ended
+            result.released += active.record(candidates.keys, kept, multipliers, reaction)
             result.constraints, result.multipliers = cs, multipliers
             result.max_penetration = penetration
         result.reason = "active_set"
         return result
 
 
-def relinearise_node_to_segment(cs, X, U):
-    """The rows of cs with normal and projection of the master edge at X + U (eq. 13, 14).
-
-    Rows snapped to a node (xi = 0 or 1) stay node-to-node; the normal keeps its side.
+def space_columns(C, nv, n):
+    """Contact rows with their columns moved from the P1 layout to the space's layout.
 
     Parameters
     ----------
-    cs : contact.ContactConstraints
-        Node-to-segment rows (slave, master edge a -> c, previous xi and normal).
-    X, U : numpy.ndarray, shape (nv, 2)
-        Reference vertex coordinates and vertex displacements (current = X + U).
+    C : scipy.sparse matrix, shape (m, 2 nv)
+        Rows in the P1 layout: the dof of component comp of vertex v is comp * nv + v.
+    nv : int
+        Number of vertices.
+    n : int
+        Dofs per component of the space (``fes.ndof // 2``; n >= nv, the vertex dofs first).
 
     Returns
     -------
-    contact.ContactConstraints
-        The same rows in the same order, with xi (clipped to [0, 1]), unit normal, dist
-        (signed distance at X + U), C and g recomputed; slave, a, c, triangles, pair and
-        angle kept. ``cs`` itself when it is empty.
+    scipy.sparse.csr_matrix, shape (m, 2 n)
+        The same rows, column comp * nv + v moved to comp * n + v.
     """
-    if len(cs) == 0:
-        return cs
-    x = X + U
-    e = x[cs.c] - x[cs.a]
-    length2 = np.einsum("ij,ij->i", e, e)
-    n = np.column_stack([e[:, 1], -e[:, 0]]) / np.sqrt(length2)[:, None]
-    n *= np.where(np.einsum("ij,ij->i", n, cs.normal) < 0, -1.0, 1.0)[:, None]
-    t = np.einsum("ij,ij->i", x[cs.slave] - x[cs.a], e) / length2
-    xi = np.where((cs.xi == 0.0) | (cs.xi == 1.0), cs.xi, np.clip(1.0 - t, 0.0, 1.0))
-    dist = np.einsum("ij,ij->i", x[cs.slave] - xi[:, None] * x[cs.a] - (1 - xi)[:, None] * x[cs.c], n)
-    return contact.ContactConstraints(cs.slave, cs.a, cs.c, cs.master_tri, cs.slave_tri, cs.pair, xi, n,
-                                      dist, cs.angle, contact._gap_offset(X, cs.slave, cs.a, cs.c, xi, n),
-                                      nv=len(X))
-
-
-def reachable(cs, U, tol):
-    """Rows whose penetration the motion can explain.
-
-    The reference mesh has no overlap, so a slave node cannot be deeper behind a master
-    segment than it has moved relative to that segment (plus the threshold).  Deeper
-    "penetrations" come from picking the wrong way out near crack tips and corners;
-    imposing them would tear the mesh (measured: inverted elements), so they are dropped.
-
-    Parameters
-    ----------
-    cs : contact.ContactConstraints
-        Candidate rows, with ``dist`` at the current configuration.
-    U : numpy.ndarray, shape (nv, 2)
-        Vertex displacements.
-    tol : float
-        Detection threshold (a length) added to the relative motion.
-
-    Returns
-    -------
-    numpy.ndarray of bool, shape (len(cs),)
-        True where -dist <= |u_slave - xi u_a - (1 - xi) u_c| + tol.
-    """
-    if len(cs) == 0:
-        return np.zeros(0, dtype=bool)
-    xi = cs.xi[:, None]
-    rel = U[cs.slave] - xi * U[cs.a] - (1.0 - xi) * U[cs.c]
-    return -cs.dist <= np.linalg.norm(rel, axis=1) + tol
-
-
-def overlap_area(x, triangles, pairs):
-    """Total area of the intersections of the given triangle pairs (convex clipping).
-
-    Parameters
-    ----------
-    x : numpy.ndarray (nv, 2)
-        Current vertex positions.
-    triangles : numpy.ndarray (ne, 3)
-        Counter-clockwise triangles.
-    pairs : numpy.ndarray (k, 2)
-        Triangle pairs to intersect.
-
-    Returns
-    -------
-    float
-    """
-    total = 0.0
-    for i, j in np.asarray(pairs, dtype=np.int64).reshape(-1, 2):
-        # relative to a vertex of the pair: areas from coordinates far from the origin
-        # would carry the rounding of their products (2e-8 at 1e4), not of the overlap
-        origin = x[triangles[j][0]]
-        poly = [tuple(p) for p in x[triangles[i]] - origin]
-        clip = x[triangles[j]] - origin
-        if _signed_area(clip) < 0:
-            clip = clip[::-1]
-        for k in range(3):
-            a, b = clip[k], clip[(k + 1) % 3]
-            poly = _clip_half_plane(poly, a, b)
-            if not poly:
-                break
-        if len(poly) >= 3:
-            total += abs(_signed_area(np.array(poly)))
-    return total
-
-
-def _signed_area(p):
-    p = np.asarray(p)
-    return 0.5 * float(np.sum(p[:, 0] * np.roll(p[:, 1], -1) - np.roll(p[:, 0], -1) * p[:, 1]))
-
-
-def _clip_half_plane(poly, a, b):
-    """Sutherland-Hodgman: the part of poly left of the directed line a -> b."""
-    def side(p):
-        return (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0])
-    out = []
-    for k in range(len(poly)):
-        p, q = poly[k], poly[(k + 1) % len(poly)]
-        sp_, sq = side(p), side(q)
-        if sp_ >= 0:
-            out.append(p)
-        if sp_ * sq < 0:
-            t = sp_ / (sp_ - sq)
-            out.append((p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1])))
-    return out
-
-
-def fragment_overlap_area(problem):
-    """Total overlap area between triangles of the current configuration (0 if none).
-
-    Pairs are those of ``detect_collisions`` with tol = 0 on the true boundary segments
-    (interiors overlapping; mesh neighbours in one fragment excepted), their intersection
-    areas summed by :func:`overlap_area`.
-
-    Parameters
-    ----------
-    problem : ElasticProblem
-        Its mesh, fragments and displacement; only the vertex values of the displacement
-        count (straight-sided triangles).
-
-    Returns
-    -------
-    float
-        Area, in the square of the mesh's length unit.
-    """
-    arrays = boundary_only(problem.arrays)
-    U = vertex_displacement(problem.u)
-    _, comp = problem.fragments()
-    fragment = comp[arrays.triangles[:, 0]]
-    pairs = detect_collisions(arrays.points, U, arrays.triangles, boundary_edges=arrays.segments,
-                              fragment=fragment, tol=0.0)
-    if len(pairs) == 0:
-        return 0.0
-    return overlap_area(arrays.points + U, arrays.triangles, pairs)
+    C = sp.csr_matrix(C)
+    cols = C.indices
+    mapped = np.where(cols < nv, cols, cols - nv + n)
+    return sp.csr_matrix((C.data, mapped, C.indptr), shape=(C.shape[0], 2 * n))

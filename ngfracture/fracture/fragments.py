@@ -1,6 +1,6 @@
 """Fragment statistics: a post-processing object on top of a mesh (cf. Akantu's FragmentManager).
 
-    stats = FragmentStatistics(result.mesh, result.fragment)   # after crack.split_by_tensor / crack_step
+    stats = FragmentStatistics(result.mesh, result.fragment)   # after split.split_by_tensor / crack_step
     stats.count, stats.areas, stats.centroids, stats.total_area
 
 Everything is measured in the reference configuration (the mesh coordinates): splitting
@@ -24,7 +24,7 @@ def fragment_ids(mesh):
     """Fragment number of every triangle: connected components through shared vertices.
 
     Numbered by their smallest triangle (fragment 0 holds triangle 0), as in
-    :class:`ngfracture.fracture.crack.SplitResult`.
+    :class:`ngfracture.fracture.split.SplitResult`.
 
     Parameters
     ----------

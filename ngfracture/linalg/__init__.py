@@ -1,6 +1,9 @@
 """Sparse linear algebra of the constrained solves.
 
-kkt       the KKT solve of paper eq. 3 / 12: elimination, Schur complement, augmented matrix
-bordered  a factorisation carried across the vertex splits of crack passes
-qp        the exact convex QP of the contact complementarity problem
+sparse      scipy and NGSolve sparse matrices, the thread settings of the solves
+factor      K^+: the factorisations of the stiffness (SuperLU, sparse Cholesky, GMRES), thresholds
+triangular  the C++ triangular solves with SuperLU's factors (supernodal, sparse reach)
+kkt         the KKT solve of paper eq. 3 / 12: elimination, Schur complement, augmented matrix
+bordered    a factorisation carried across the vertex splits of crack passes
+qp          the exact convex QP of the contact complementarity problem
 """

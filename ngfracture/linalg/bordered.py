@@ -28,7 +28,7 @@ fragment, a split on a constrained boundary with a free parent) take a fresh
 factorisation instead (:func:`BorderedFactor.build` returns None), as does a small mesh
 (``MIN_BASE_DOFS``), where a factorisation is cheaper than the bookkeeping. A border that
 its first solve finds singular (S_d; no case is known where build accepts one) makes the
-solve start again with the split mesh's own factorisation (solver.NewtonSolver.solve,
+solve start again with the split mesh's own factorisation (mechanics.newton.NewtonSolver.solve,
 recorded in its notes).
 """
 import time
@@ -38,14 +38,11 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 
-from .kkt import EliminatedFactor, FactorBase, SingularSystem
+from .factor import EliminatedFactor, FactorBase, SingularSystem
 
 #: below this many factorised dofs a split mesh is factorised afresh: a factorisation costs
 #: about as much as the bordered solves' bookkeeping, and a fresh tangent saves Newton
-#: iterations where contact moves pieces far (measured one run after the other: the
-#: paper's disk, 2k dofs, 51 s fresh against 57 s bordered; its disintegrating disk, 1.1k
-#: dofs, 48 against 47 s; the default plate, 2.9k dofs, linear algebra 1.2 to 1.4 s
-#: fresh against 0.66 to 0.73 s bordered)
+#: iterations where contact moves pieces far. docs/solvers.md, "Bordered factorisation"
 MIN_BASE_DOFS = 2500
 
 #: free dofs of the vertices created since the base factorisation beyond which a split mesh
@@ -82,7 +79,7 @@ class Lineage:
 
     Attributes
     ----------
-    base : kkt.EliminatedFactor
+    base : factor.EliminatedFactor
         The factorisation of the mesh the chain of splits started from.
     state : numpy.ndarray
         The base mesh's displacement at which that tangent was assembled.
@@ -146,12 +143,12 @@ def lineage(factor, state, parent):
 
     Parameters
     ----------
-    factor : kkt.EliminatedFactor, BorderedFactor or None
+    factor : factor.EliminatedFactor, BorderedFactor or None
         The factorisation the last solve on the mesh before the split used.
     state : numpy.ndarray or None
         For an EliminatedFactor, the displacement its tangent was assembled at.
     parent : numpy.ndarray of int
-        ``crack.SplitResult.parent``: for every vertex of the split mesh, the vertex it copies.
+        ``split.SplitResult.parent``: for every vertex of the split mesh, the vertex it copies.
 
     Returns
     -------
@@ -183,7 +180,7 @@ def _lifted(state, parent):
 class BorderedFactor(FactorBase):
     """K~^+ of a split mesh through the factorisation of its base (see the module docstring).
 
-    Made by :meth:`build`. The interface of kkt.EliminatedFactor that ConstrainedSolver
+    Made by :meth:`build`. The interface of factor.EliminatedFactor that kkt.ConstrainedSolver
     uses: ``solve``, ``columns``, ``schur`` (when the base has the sparse Schur path),
     ``corrected_modes``, ``matches``.
 
@@ -257,8 +254,7 @@ class BorderedFactor(FactorBase):
         self.K, self.ndof = K, K.shape[0]
         self.fixed_dofs, self.pins, self.free, self.factor_free = fixed_dofs, pins, free, factor_free
         self.inverse = base.inverse
-        self._columns = {}
-        self._checked = False
+        super().__init__()
         nv, nvb = self.ndof // 2, base.ndof // 2
         n_base = np.count_nonzero(base.factor_free)
         position = -np.ones(base.ndof, dtype=np.int64)
@@ -352,7 +348,7 @@ class BorderedFactor(FactorBase):
 
         Entries of B at fixed dofs and pins are ignored; X is zero there. The first solve
         with a nonzero right-hand side must solve its own system (relative residual below
-        1e-6), as kkt.EliminatedFactor's does.
+        1e-6), as factor.EliminatedFactor's does.
 
         Parameters
         ----------
@@ -389,8 +385,7 @@ class BorderedFactor(FactorBase):
             X[self._dofs] = XF
             if not np.all(np.isfinite(X)):
                 raise SingularSystem("the bordered factorisation produced NaN/inf")
-            if not self._checked:
-                self._check(B, X)
+            self.check_solution(B, X)
         self.seconds += time.perf_counter() - t0
         return X[:, 0] if single else X
 

@@ -12,8 +12,7 @@ Used by the contact solver for the linear complementarity problem of one lineari
 (:meth:`ngfracture.linalg.kkt.ConstrainedSolver.solve_unilateral`): a few hundred unknowns. The
 QR factorisation of the working set is updated by Givens rotations when a constraint
 enters or leaves (scipy.linalg.qr_insert / qr_delete), O(n k) per step for k active
-constraints. It was recomputed at every step before: 73 % of the run time of the
-disintegrating disk's late steps (4400 factorisations of 0.12 s in five load steps).
+constraints, instead of a factorisation per step (docs/solvers.md, "The contact QP").
 """
 import numpy as np
 import scipy.linalg as sla
@@ -93,38 +92,8 @@ def convex_qp(H, c, A_eq, b_eq, A_in, b_in, tol=1e-12, max_steps=None):
             j_new = int(np.argmin(miss)) if len(miss) else -1
             if j_new < 0 or miss[j_new] >= -level:
                 break
-        n_new = sign[j_new] * N[:, j_new]
-        miss_new = sign[j_new] * (A[j_new] @ x - b[j_new])
-        u_new = 0.0
-        while True:
-            if active:
-                projection = Q.T @ n_new
-                r = sla.solve_triangular(R, projection)
-                w = n_new - Q @ projection
-            else:
-                r, w = np.zeros(0), n_new
-            # the largest dual step before an active inequality's multiplier reaches zero
-            t_dual, k_drop = np.inf, -1
-            for k, (j, uk, rk) in enumerate(zip(active, u, r)):
-                if j >= p and rk > 0 and uk / rk < t_dual:
-                    t_dual, k_drop = uk / rk, k
-            ww = float(w @ w)
-            t_full = -miss_new / ww if ww > (1e-14 * np.linalg.norm(n_new)) ** 2 else np.inf
-            t = min(t_dual, t_full)
-            if not np.isfinite(t):
-                raise Infeasible(f"constraint {j_new} cannot hold together with the working set")
-            if np.isfinite(t_full):
-                x = x + t * sla.solve_triangular(L.T, w, lower=False)
-                miss_new += t * ww
-            u = [uk - t * rk for uk, rk in zip(u, r)]
-            u_new += t
-            if t == t_full:
-                Q, R = _append_column(Q, R, n_new)
-                active.append(j_new)
-                u.append(u_new)
-                break
-            Q, R = sla.qr_delete(Q, R, k_drop, 1, which="col", check_finite=False)
-            del active[k_drop], u[k_drop]
+        x, u, Q, R = _enter(j_new, sign[j_new] * N[:, j_new], sign[j_new] * (A[j_new] @ x - b[j_new]),
+                            x, u, active, Q, R, L, p)
     else:
         raise QPError(f"convex_qp: no solution in {max_steps} steps")
     mult = np.zeros(len(b))
@@ -132,6 +101,44 @@ def convex_qp(H, c, A_eq, b_eq, A_in, b_in, tol=1e-12, max_steps=None):
     active_in = np.zeros(len(b) - p, dtype=bool)
     active_in[[j - p for j in active if j >= p]] = True
     return x, mult[:p], mult[p:], active_in
+
+
+def _enter(j_new, n_new, miss_new, x, u, active, Q, R, L, p):
+    """Dual steps until constraint ``j_new`` (its vector n_new in the metric of H, its miss)
+    enters the working set, dropping the inequalities whose multipliers reach zero on the
+    way. ``active`` is changed in place; returns the new (x, u, Q, R).
+
+    Raises Infeasible if the constraint cannot hold together with the working set."""
+    u_new = 0.0
+    while True:
+        if active:
+            projection = Q.T @ n_new
+            r = sla.solve_triangular(R, projection)
+            w = n_new - Q @ projection
+        else:
+            r, w = np.zeros(0), n_new
+        # the largest dual step before an active inequality's multiplier reaches zero
+        t_dual, k_drop = np.inf, -1
+        for k, (j, uk, rk) in enumerate(zip(active, u, r)):
+            if j >= p and rk > 0 and uk / rk < t_dual:
+                t_dual, k_drop = uk / rk, k
+        ww = float(w @ w)
+        t_full = -miss_new / ww if ww > (1e-14 * np.linalg.norm(n_new)) ** 2 else np.inf
+        t = min(t_dual, t_full)
+        if not np.isfinite(t):
+            raise Infeasible(f"constraint {j_new} cannot hold together with the working set")
+        if np.isfinite(t_full):
+            x = x + t * sla.solve_triangular(L.T, w, lower=False)
+            miss_new += t * ww
+        u = [uk - t * rk for uk, rk in zip(u, r)]
+        u_new += t
+        if t == t_full:
+            Q, R = _append_column(Q, R, n_new)
+            active.append(j_new)
+            u.append(u_new)
+            return x, u, Q, R
+        Q, R = sla.qr_delete(Q, R, k_drop, 1, which="col", check_finite=False)
+        del active[k_drop], u[k_drop]
 
 
 def _append_column(Q, R, column):

@@ -1,6 +1,6 @@
 """Linear constraints on the displacement: the rows G u = b of the paper's eq. 3.
 
-Two kinds of rows are kept apart because they are solved differently (see kkt.py):
+Two kinds of rows are kept apart because they are solved differently (see linalg/kkt.py):
 
 * single-dof rows ``u[dof] = value``: Dirichlet and gliding conditions on named
   boundaries and point constraints on single vertices.  They are eliminated

@@ -20,12 +20,12 @@ import scipy.sparse as sp
 
 from . import rigid
 from .constraints import ConstraintRows
-from ..linalg.kkt import ConstrainedSolver, EliminatedFactor, SingularSystem, single_threaded_blas
 from ..linalg.bordered import BorderedFactor
+from ..linalg.factor import LINEAR_SOLVERS, EliminatedFactor, SingularSystem
+from ..linalg.kkt import ConstrainedSolver
+from ..linalg.sparse import single_threaded_blas
 
 METHODS = ("modified", "full")
-#: linear solvers of the Newton step (kkt.ConstrainedSolver)
-LINEAR_SOLVERS = ("direct", "gmres")
 #: direct solvers: "auto" and scipy's "superlu", or an NGSolve inverse (one not compiled
 #: into the installed NGSolve still fails at the first factorisation, naming itself)
 INVERSES = ("auto", "superlu", "sparsecholesky", "umfpack", "pardiso", "pardisospd", "mumps",
@@ -150,156 +150,6 @@ class SolveStatus:
         return self
 
 
-class SavedTangent:
-    """A factorised tangent kept for further solves at the same load (contact rounds).
-
-    The paper's modified Newton factorises the tangent once per load step; a contact
-    round, which only changes the general rows, is not a new load step. A solve given an
-    empty SavedTangent leaves its last factorisation here (modified Newton, or any method
-    on a linear model, whose tangent is constant); a solve given a filled one for the same
-    fixed dofs uses it instead of assembling and factorising, and rebuilds only the Schur
-    complement of its general rows (the augmented factorisation of kkt.py is for fresh
-    tangents, which are solved once). Its rigid modes and pins stay those of the
-    configuration the tangent was assembled at (kkt.py corrects them for K R != 0).
-
-    A SavedTangent made with a ``lineage`` (the problem's mesh was split from a solved one,
-    split_factor.py) starts with the factorisation of the mesh before the split, bordered
-    by the split's dofs, where the fixed dofs and pins carry over. One made by
-    :meth:`kept` or :meth:`assembled_at` starts with a factorisation of the same mesh from
-    an earlier state (a load step before, simulation.py).
-
-    Parameters
-    ----------
-    lineage : split_factor.Lineage, optional
-
-    Attributes
-    ----------
-    fixed_dofs : numpy.ndarray or None
-    support : rigid.Support or None
-    factor : kkt.EliminatedFactor, split_factor.BorderedFactor or None
-    state : numpy.ndarray or None
-        The displacement the EliminatedFactor's tangent was assembled at.
-    residual : (numpy.ndarray, float, numpy.ndarray) or None
-        (u, load factor, out-of-balance there) at the end of the last solve: the next solve
-        at the same state starts from it without assembling it again.
-    contraction : float or None
-        How fast the converged modified-Newton solves with this tangent contracted: the
-        largest ratio of the last two increments over those that took three iterations or
-        more (None: no such solve yet; a solve of fewer iterations gives no estimate).
-    lineage : split_factor.Lineage or None
-    """
-
-    def __init__(self, lineage=None):
-        self.fixed_dofs = self.support = self.factor = self.state = self.residual = None
-        self.contraction = None
-        self.lineage = lineage
-
-    def forget(self):
-        """Empty it, lineage included: the next solve factorises its own tangent."""
-        self.__init__()
-
-    def kept(self):
-        """A new SavedTangent with this one's factorisation, for solves at another load.
-
-        Returns
-        -------
-        SavedTangent
-            The same fixed dofs, support, factorisation (an EliminatedFactor without the
-            results kept from its solves, ``without_caches``) and state; no residual, no
-            contraction, no lineage.
-        """
-        other = SavedTangent()
-        other.fixed_dofs, other.support, other.state = self.fixed_dofs, self.support, self.state
-        other.factor = self.factor.without_caches() if isinstance(self.factor, EliminatedFactor) else self.factor
-        return other
-
-    @classmethod
-    def assembled_at(cls, problem, state, rows):
-        """The factorised tangent of ``problem`` at the displacement ``state``, as a solve
-        that started there with these rows would have made it (its support taken at
-        ``state``, the default direct solver): the same factorisation bit for bit.
-
-        Parameters
-        ----------
-        problem : ElasticProblem
-        state : numpy.ndarray
-            A displacement of the problem's space.
-        rows : ConstraintRows
-            Constraints with the fixed dofs it is factorised for (only those are used).
-
-        Returns
-        -------
-        SavedTangent
-
-        Raises
-        ------
-        SingularSystem
-            If the factorisation fails.
-        """
-        support = problem.support(rows, state)
-        saved = cls()
-        saved.fixed_dofs, saved.support, saved.state = rows.fixed_dofs, support, np.array(state, dtype=float)
-        saved.factor = EliminatedFactor(problem.tangent(state), rows.fixed_dofs, support.pins)
-        saved.factor.factorise()
-        return saved
-
-    def carry_over(self, problem, fixed_dofs, support):
-        """Take the bordered factorisation of the lineage for this solve, if it applies.
-
-        The support's pins are replaced by the base's where these resolve the same modes
-        about as well (the pivoted QR of rigid.analyse_support chooses among equally good
-        dofs by rounding: a translation's pin wanders from split to split).
-
-        Parameters
-        ----------
-        problem : ElasticProblem
-        fixed_dofs : numpy.ndarray of int
-        support : rigid.Support
-            Of the solve on ``problem``.
-
-        Returns
-        -------
-        bool
-            True if a factorisation and the support to solve with are now saved for
-            these fixed dofs.
-        """
-        if self.factor is not None or self.lineage is None:
-            return False
-        support = _base_pins(support, self.lineage.base, problem.fes.ndof)
-        factor = BorderedFactor.build(self.lineage, problem, fixed_dofs, support.pins)
-        if factor is None:
-            return False
-        self.fixed_dofs, self.support, self.factor = fixed_dofs, support, factor
-        return True
-
-    def holds(self, fixed_dofs):
-        """True if a tangent is saved and it was factorised for exactly these fixed dofs.
-
-        Parameters
-        ----------
-        fixed_dofs : numpy.ndarray of int
-            Fixed dofs of the solve that wants to reuse it (compared in order).
-
-        Returns
-        -------
-        bool
-            False for an empty SavedTangent.
-        """
-        return self.fixed_dofs is not None and np.array_equal(self.fixed_dofs, fixed_dofs)
-
-
-def _base_pins(support, base, ndof):
-    """``support`` with the base factorisation's pins (same vertices and components) if they
-    resolve its modes within a factor 10 of its own pins' smallest singular value."""
-    nvb, nv = base.ndof // 2, ndof // 2
-    pins = base.pins // nvb * nv + base.pins % nvb
-    if len(pins) != len(support.pins) or np.array_equal(pins, support.pins) or not len(pins):
-        return support
-    own = np.linalg.svd(support.modes[support.pins].toarray(), compute_uv=False)
-    other = np.linalg.svd(support.modes[pins].toarray(), compute_uv=False)
-    return rigid.Support(support.modes, pins, support.unheld) if other.min() >= 0.1 * own.min() else support
-
-
 class _Timer:
     def __init__(self, timings, phase):
         self.timings, self.phase = timings, phase
@@ -339,7 +189,7 @@ class NewtonSolver:
         Maximum iterations per load step.
     linear_solver : {"direct", "gmres"}
     inverse : str
-        Direct solver: "auto", "superlu" or an NGSolve name (see kkt.ConstrainedSolver).
+        Direct solver: "auto", "superlu" or an NGSolve name (see linalg.kkt.ConstrainedSolver).
     divergence_factor : float
         An increment this many times larger than the first one means divergence.
     fix_free_modes : bool or "all"
@@ -348,8 +198,8 @@ class NewtonSolver:
         "all": fix every rigid mode that the single-dof rows leave free, also those that
         general rows (contact) hold: every piece without Dirichlet support is held like the
         paper's pinned fragments, and contact presses it against its hold.
-    tangent : SavedTangent, optional
-        Reuse its factorisation, or leave this solve's in it (see SavedTangent).
+    tangent : tangent.SavedTangent, optional
+        Reuse its factorisation, or leave this solve's in it (see mechanics.tangent).
 
     Raises
     ------
@@ -395,7 +245,7 @@ class NewtonSolver:
             Failures (floating body, singular system, NaN, divergence, inverted element,
             no convergence) are reported here, not raised; on failure the displacement and
             the load factor are those of the last converged load step. A solve through a
-            factorisation carried across a crack pass (split_factor.BorderedFactor) that
+            factorisation carried across a crack pass (linalg.bordered.BorderedFactor) that
             finds it singular is made again with the split mesh's own factorisation,
             recorded in ``notes``.
 
@@ -469,7 +319,7 @@ class NewtonSolver:
         values (with the saved tangent if it holds, as :meth:`solve` would use it), with the
         general rows ``unilateral`` (indices into the assembled general rows) as C du >= h,
         lam <= 0, complementary: a linear complementarity problem solved exactly
-        (:meth:`kkt.ConstrainedSolver.solve_unilateral`). The state is not changed. The
+        (:meth:`linalg.kkt.ConstrainedSolver.solve_unilateral`). The state is not changed. The
         rows may be linearly dependent (distinct inequalities can be dependent vectors);
         the closed ones then hold together, and a caller imposing them as equalities
         should keep an independent subset.
@@ -537,20 +387,17 @@ class NewtonSolver:
                               np.concatenate([rows.g, extra @ u]), rows.labels + ["free modes"])
 
     def _load_step(self, rows, support, target_fixed, target_rows, status, factor=None):
-        """One load step; returns the last factorisation (None if there was none)."""
+        """One load step (eq. 3 to 7): iterate until :meth:`_converged` or a failure, which
+        ``status`` records; returns the last factorisation (None if the step failed)."""
         prob = self.problem
         u = prob.u.vec.FV().NumPy()
-        timings = status.timings
         free = np.ones(u.size, dtype=bool)
         free[rows.fixed_dofs] = False
         du_fixed = np.zeros(u.size)
-        kkt = None
-        du0 = None
-        prev = np.inf
-        growing = 0
-        with _Timer(timings, "residual"):
+        given, kkt = factor, None
+        du0, prev, growing = None, np.inf, 0
+        with _Timer(status.timings, "residual"):
             r = self._out_of_balance()
-        given = factor
         for k in range(self.maxit):
             if not np.all(np.isfinite(r)):
                 status.fail("nan", f"the residual is NaN/inf at iteration {k}")
@@ -558,35 +405,17 @@ class NewtonSolver:
             du_fixed[:] = 0.0
             du_fixed[rows.fixed_dofs] = target_fixed - u[rows.fixed_dofs]   # eq. 6
             h = target_rows - rows.C @ u
-            if kkt is None or (self.method == "full" and given is None):
-                try:
-                    if given is None:
-                        with _Timer(timings, "assemble"):
-                            K = prob.tangent()
-                        # not inside prob.threads(): the factorisation runs on one thread (kkt.py)
-                        with _Timer(timings, "factorize"):
-                            factor = EliminatedFactor(K, rows.fixed_dofs, support.pins, self.linear_solver,
-                                                      self.inverse)
-                    # a tangent factorised for one solve (full Newton) takes its rows into one
-                    # factorisation of the augmented matrix; one kept over iterations and
-                    # contact rounds builds Schur columns once and reuses them (docs/solvers.md)
-                    path = "auto" if self.method == "full" and given is None else "schur"
-                    with _Timer(timings, "factorize"):
-                        kkt = ConstrainedSolver(None, rows.fixed_dofs, rows.C, modes=support.modes,
-                                                pins=support.pins, factor=factor, path=path,
-                                                first=(r, du_fixed))
-                except SingularSystem as err:
-                    status.fail("singular", str(err))
-                    return None
             try:
-                with _Timer(timings, "solve"), prob.threads():
+                if kkt is None or (self.method == "full" and given is None):
+                    kkt, factor = self._linear_system(rows, support, given, (r, du_fixed), status.timings)
+                with _Timer(status.timings, "solve"), prob.threads():
                     du, status.multipliers = kkt.solve(r, du_fixed, h)
-                if k == 0:
-                    # the force scale of the step: out-of-balance plus the pull of the prescribed values
-                    force_scale = kkt.last_load_norm
             except SingularSystem as err:
                 status.fail("singular", str(err))
                 return None
+            if k == 0:
+                # the force scale of the step: out-of-balance plus the pull of the prescribed values
+                force_scale = kkt.load_norm(r, du_fixed)
             if not np.all(np.isfinite(du)):
                 status.fail("nan", f"the increment is NaN/inf at iteration {k}")
                 return None
@@ -598,36 +427,16 @@ class NewtonSolver:
                 du0 = max(norm, self.increment_scale)
             ratio = norm / du0 if du0 > 0 else 0.0
             status.increment_history.append(ratio)
-            with _Timer(timings, "residual"):
+            with _Timer(status.timings, "residual"):
                 r = prob.out_of_balance()
             # out-of-balance with the constraint forces of the general rows included
-            res_norm = float(np.linalg.norm((r - rows.C.T @ status.multipliers)[free]))
-            status.residual_history.append(res_norm)
-            with _Timer(timings, "checks"):
+            status.residual_history.append(float(np.linalg.norm((r - rows.C.T @ status.multipliers)[free])))
+            with _Timer(status.timings, "checks"):
                 inverted = prob.inverted_elements() if prob.nonlinear else None
             if inverted:
                 status.fail("inverted_element", inverted)
                 return None
-            # eq. 7; for the linear model one step is exact, and a residual at rounding level
-            # proves it without a second solve
-            exact = not prob.nonlinear and res_norm <= self.tol * force_scale
-            # below the rounding of u itself eq. 7 cannot improve (an already converged start)
-            rounding = norm <= 64 * np.finfo(float).eps * np.linalg.norm(u)
-            # a stall at the rounding floor: the increment has stopped falling, three orders
-            # below anything physical (measured: modified Newton with many contact rows
-            # stagnated at 9.8e-10 for 60 iterations and the disintegration run stopped)
-            hist = status.increment_history
-            stalled = ratio < 1e3 * self.tol and len(hist) >= 4 and ratio >= min(hist[-4:-1])
-            # modified Newton contracts linearly: the last ratio estimates the next ones
-            rho = norm / prev if self.method == "modified" and k >= 2 and prev > 0 else 1.0
-            contracted = rho < 0.5 and rho / (1.0 - rho) * ratio < self.tol
-            if ratio < self.tol or norm == 0.0 or exact or rounding or stalled or contracted:
-                status.converged, status.reason = True, "converged"
-                status.message = f"stalled at relative increment {ratio:.1e}" if stalled and ratio >= self.tol else ""
-                if self.tangent is not None:
-                    self.tangent.residual = (u.copy(), prob.load_factor.Get(), r)
-                    if self.method == "modified" and k >= 2:
-                        self.tangent.contraction = max(self.tangent.contraction or 0.0, rho)
+            if self._converged(status, k, norm, prev, force_scale, r):
                 return factor
             if not np.isfinite(ratio) or ratio > self.divergence_factor:
                 status.fail("diverged", f"increment grew to {ratio:.2e} times the first one")
@@ -639,3 +448,52 @@ class NewtonSolver:
                 return None
         status.fail("max_iterations", f"no convergence in {self.maxit} iterations "
                                       f"(last relative increment {status.increment_history[-1]:.2e})")
+
+    def _linear_system(self, rows, support, given, first, timings):
+        """(ConstrainedSolver, factorisation) of an iteration: on ``given``, or on a fresh
+        factorisation of the tangent at the current iterate.
+
+        A tangent factorised for one solve (full Newton) takes its rows into one
+        factorisation of the augmented matrix; one kept over iterations and contact rounds
+        builds Schur columns once and reuses them (docs/solvers.md). Raises SingularSystem."""
+        factor = given
+        if given is None:
+            with _Timer(timings, "assemble"):
+                K = self.problem.tangent()
+            # not inside prob.threads(): the factorisation runs on one thread (linalg.factor)
+            with _Timer(timings, "factorize"):
+                factor = EliminatedFactor(K, rows.fixed_dofs, support.pins, self.linear_solver, self.inverse)
+        path = "auto" if self.method == "full" and given is None else "schur"
+        with _Timer(timings, "factorize"):
+            kkt = ConstrainedSolver(None, rows.fixed_dofs, rows.C, modes=support.modes, pins=support.pins,
+                                    factor=factor, path=path, first=first)
+        return kkt, factor
+
+    def _converged(self, status, k, norm, prev, force_scale, r):
+        """Whether iterate k (increment ``norm``, the one before ``prev``) ends the load step:
+        eq. 7 or one of the stops of the class docstring. If so, ``status`` and the saved
+        tangent record it (with the out-of-balance ``r`` at the converged state)."""
+        prob = self.problem
+        u = prob.u.vec.FV().NumPy()
+        hist = status.increment_history
+        ratio = hist[-1]
+        # eq. 7; for the linear model one step is exact, and a residual at rounding level
+        # proves it without a second solve
+        exact = not prob.nonlinear and status.residual_history[-1] <= self.tol * force_scale
+        # below the rounding of u itself eq. 7 cannot improve (an already converged start)
+        rounding = norm <= 64 * np.finfo(float).eps * np.linalg.norm(u)
+        # a stall at the rounding floor: the increment has stopped falling, three orders
+        # below anything physical (docs/solvers.md, "Newton's stopping rules")
+        stalled = ratio < 1e3 * self.tol and len(hist) >= 4 and ratio >= min(hist[-4:-1])
+        # modified Newton contracts linearly: the last ratio estimates the next ones
+        rho = norm / prev if self.method == "modified" and k >= 2 and prev > 0 else 1.0
+        contracted = rho < 0.5 and rho / (1.0 - rho) * ratio < self.tol
+        if not (ratio < self.tol or norm == 0.0 or exact or rounding or stalled or contracted):
+            return False
+        status.converged, status.reason = True, "converged"
+        status.message = f"stalled at relative increment {ratio:.1e}" if stalled and ratio >= self.tol else ""
+        if self.tangent is not None:
+            self.tangent.residual = (u.copy(), prob.load_factor.Get(), r)
+            if self.method == "modified" and k >= 2:
+                self.tangent.contraction = max(self.tangent.contraction or 0.0, rho)
+        return True

@@ -3,7 +3,7 @@
 A piece (connected component) whose rigid-body modes are not all fixed by
 single-dof rows makes the eliminated stiffness K_ff singular.  If general rows
 (contact, rigid-mode rows) fix the remaining modes, the KKT system is still
-regular; kkt.py then factorises K with a few extra "pins" (one dof per unheld
+regular; linalg/kkt.py then factorises K with a few extra "pins" (one dof per unheld
 mode) and restores the modes through a small coarse problem.  If nothing fixes
 them, the body floats and the solve is refused with a message naming it.
 

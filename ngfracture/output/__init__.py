@@ -1,5 +1,17 @@
-"""What a run writes: VTK time series, pictures, summaries.
+"""What a run writes: VTK time series, pictures, JSON, all through one atomic writer.
 
-vtk     VTK time series and crack edges, headless PNG, fragment-size plot, summary JSON
-vtkxml  VTK XML files (.vtu, .vtp) from numpy arrays, without VTK
+atomic      files written atomically (temporary file, fsync, rename): bytes, JSON
+vtk         a mesh and its fields as VTK data (pyvista objects or numpy arrays)
+vtkxml      VTK XML files (.vtu, .vtp) from numpy arrays, without VTK
+timeseries  ``TimeSeriesWriter``: one .vtu and one .vtp per step, .pvd collections
+pictures    ``final.png`` of the deformed pieces and the fragment-size plot, headless
+
+The public names of these modules are re-exported here.
 """
+from .atomic import *      # noqa: F401,F403
+from .vtk import *         # noqa: F401,F403
+from .timeseries import *  # noqa: F401,F403
+from .pictures import *    # noqa: F401,F403
+from . import atomic as _atomic, pictures as _pictures, timeseries as _timeseries, vtk as _vtk
+
+__all__ = list(_atomic.__all__) + list(_vtk.__all__) + list(_timeseries.__all__) + list(_pictures.__all__)

@@ -2,10 +2,9 @@
 
 A checkpoint is one ``.npz`` file holding named numpy arrays plus a JSON header
 (format name and version, ngfracture version, user metadata) and a SHA-256 digest
-of everything else.  Writing goes to a temporary file in the same folder, is
-flushed and fsync'ed, then renamed over the final name (atomic on POSIX), and the
-folder is fsync'ed; a run killed at any moment leaves either the old or the new
-file, never half of one.  The newest ``keep`` checkpoints are kept.
+of everything else.  Writing goes through :func:`ngfracture.output.atomic.write_file`
+(a temporary file in the same folder, fsync, rename, fsync of the folder); a run killed at
+any moment leaves either the old or the new file, never half of one.  The newest ``keep`` checkpoints are kept.
 
 Reading refuses, with a message naming the file, anything truncated, altered
 (digest mismatch), foreign (not an ngfracture checkpoint) or of another format
@@ -13,13 +12,13 @@ version; ``latest`` names the previous valid checkpoint in that message.
 """
 import hashlib
 import json
-import os
 import re
-import tempfile
 import zipfile
 from pathlib import Path
 
 import numpy as np
+
+from ..output.atomic import write_file
 
 FORMAT = "ngfracture-checkpoint"
 FORMAT_VERSION = 1
@@ -90,22 +89,7 @@ def write(folder, step, arrays, meta, keep=2):
     payload["header"] = np.frombuffer(header_bytes, dtype=np.uint8)
     payload["digest"] = np.frombuffer(_digest(payload, b"").encode(), dtype=np.uint8)
     target = path_for(folder, step)
-    fd, tmp = tempfile.mkstemp(prefix=".checkpoint_", suffix=".tmp", dir=folder)
-    try:
-        with os.fdopen(fd, "wb") as f:
-            np.savez(f, **payload)
-            f.flush()
-            os.fsync(f.fileno())
-        os.replace(tmp, target)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
-    dir_fd = os.open(folder, os.O_RDONLY)
-    try:
-        os.fsync(dir_fd)
-    finally:
-        os.close(dir_fd)
+    write_file(target, lambda tmp: np.savez(tmp, **payload), force=True)
     for old in list_checkpoints(folder)[:-keep]:
         old.unlink()
     return target

@@ -9,7 +9,7 @@ starts runs by name use these three functions:
   value converted by the type of the parameter's default.
 
 A scene file is a Python file that defines ``scene(**params)`` returning a
-:class:`ngfracture.run.simulation.Scene`; every parameter needs a default, so that the file
+:class:`ngfracture.run.scene.Scene`; every parameter needs a default, so that the file
 runs without any ``--set``.
 """
 import ast

@@ -24,7 +24,6 @@ in x); St Venant-Kirchhoff at strains ~1e-4 departs from it by that order.
 """
 import json
 import os
-import signal
 import sys
 import time
 from dataclasses import dataclass, field
@@ -32,11 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["Ensemble", "SceneFactory", "run_sample", "sample_record", "sample_directory", "KILL_HOOK"]
-
-#: environment variable of a test hook: "MARKER:STEP" kills the worker process running a
-#: sample when it accepts step STEP, once (the first to create MARKER)
-KILL_HOOK = "NGFRACTURE_TEST_KILL_WORKER"
+__all__ = ["Ensemble", "SceneFactory", "run_sample", "sample_record", "sample_directory"]
 
 FORMAT = "ngfracture-ensemble"
 
@@ -135,23 +130,6 @@ def _finished_summary(directory, parameters):
     return summary
 
 
-def _kill_hook():
-    """The test hook of :data:`KILL_HOOK`, or None."""
-    spec = os.environ.get(KILL_HOOK)
-    if not spec:
-        return None
-    marker, step = spec.rsplit(":", 1)
-
-    def hook(info):
-        if info["step"] >= int(step):
-            try:
-                os.close(os.open(marker, os.O_CREAT | os.O_EXCL | os.O_WRONLY))
-            except FileExistsError:
-                return
-            os.kill(os.getpid(), signal.SIGKILL)
-    return hook
-
-
 def run_sample(scene_factory, seed, index, out, options):
     """One sample, in a worker: finished -> read; checkpoint -> resume; else a fresh run.
 
@@ -174,10 +152,11 @@ def run_sample(scene_factory, seed, index, out, options):
     import ngsolve
     ngsolve.SetNumThreads(1)        # one thread per worker process: results do not depend on it
     from ..run import checkpoint
-    from ..run.simulation import Simulation, StepControl, _jsonish
+    from ..run.simulation import Simulation, StepControl
+    from ..run.state import json_round_trip
     scene = scene_factory(seed=seed)
     directory = sample_directory(out, index)
-    summary = _finished_summary(directory, _jsonish(scene.parameters))
+    summary = _finished_summary(directory, json_round_trip(scene.parameters))
     status = "skipped"
     if summary is None:
         resume = directory.exists() and bool(checkpoint.list_checkpoints(directory))
@@ -185,7 +164,7 @@ def run_sample(scene_factory, seed, index, out, options):
         sim = Simulation(scene, control=control, out=directory, resume=resume, force=not resume,
                          pictures=options.get("pictures", "none"),
                          checkpoint_every=options.get("checkpoint_every", 1),
-                         contact=options.get("contact", "auto"), progress=_kill_hook())
+                         contact=options.get("contact", "auto"))
         summary = sim.run().summary
         status = "resumed" if resume else "run"
     record = sample_record(summary, index, seed)
@@ -318,7 +297,8 @@ class Ensemble:
 
     def _request(self):
         """What defines the ensemble: scene, its base parameters, seeds, options (checked once here)."""
-        from ..run.simulation import Scene, StepControl, _jsonish
+        from ..run.simulation import Scene, StepControl
+        from ..run.state import json_round_trip
         try:
             scene = self.scene_factory(seed=self.seeds[0])
         except TypeError as err:
@@ -336,7 +316,7 @@ class Ensemble:
                              f"not differ")
         options = {"control": self.control, "contact": self.contact, "pictures": self.pictures,
                    "checkpoint_every": self.checkpoint_every}
-        return _jsonish({"format": FORMAT, "scene": scene.name, "parameters": _base_parameters(scene.parameters),
+        return json_round_trip({"format": FORMAT, "scene": scene.name, "parameters": _base_parameters(scene.parameters),
                          "seeds": self.seeds, "options": options})
 
     def _saved_request(self):
@@ -363,7 +343,7 @@ class Ensemble:
             The content of ensemble.json.
         """
         from distributed import Client, LocalCluster, as_completed
-        from ..output.vtk import write_summary
+        from ..output.atomic import write_json
         t0 = time.perf_counter()
         cluster = None
         if client is None:
@@ -374,7 +354,7 @@ class Ensemble:
         try:
             t_started = time.perf_counter()
             self.out.mkdir(parents=True, exist_ok=True)
-            write_summary(self.out / "ensemble_request.json", self.request, force=True)
+            write_json(self.out / "ensemble_request.json", self.request, force=True)
             options = self.request["options"]
             futures = [client.submit(run_sample, self.scene_factory, seed, i, str(self.out), options,
                                      key=f"ngfracture-sample-{self.out.resolve()}-{i}-{seed}", pure=False)
@@ -410,7 +390,7 @@ class Ensemble:
         report["pictures"] = plot_ensemble(report, self.out)
         report["execution"]["report_seconds"] = time.perf_counter() - t_samples
         report["execution"]["wall_seconds"] = time.perf_counter() - t0
-        write_summary(self.out / "ensemble.json", report, force=True)
+        write_json(self.out / "ensemble.json", report, force=True)
         return report
 
     def _show(self, done, total):

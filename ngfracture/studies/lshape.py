@@ -249,11 +249,25 @@ def default_grading(order):
     ValueError
         If order is not an integer >= 1.
     """
-    _check_int("order", order, 1)
+    check_int("order", order, 1)
     return float(math.ceil(order / singular_exponent()))
 
 
-def _check_int(name, value, minimum):
+def check_int(name, value, minimum):
+    """Refuse anything but an integer >= ``minimum`` (bools too), naming it.
+
+    Parameters
+    ----------
+    name : str
+        The value's name in the message.
+    value : object
+    minimum : int
+
+    Raises
+    ------
+    ValueError
+        Not an integer, or below ``minimum``.
+    """
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < minimum:
         raise ValueError(f"{name} must be an integer >= {minimum}, got {value!r}")
 
@@ -310,7 +324,7 @@ def mesh_hierarchy(levels, h0=0.5, gamma=1.0):
     ValueError
         On bad ``levels``, ``h0`` or ``gamma``.
     """
-    _check_int("levels", levels, 1)
+    check_int("levels", levels, 1)
     _check_h0(h0)
     if not (isinstance(gamma, (int, float)) and math.isfinite(gamma) and gamma >= 1.0):
         raise ValueError(f"grading exponent gamma must be a finite number >= 1, got {gamma!r}")
@@ -345,7 +359,7 @@ def lshape_mesh(level=0, h0=0.5, gamma=1.0):
     ValueError
         On bad ``level``, ``h0`` or ``gamma``.
     """
-    _check_int("level", level, 0)
+    check_int("level", level, 0)
     mesh = None
     for mesh in mesh_hierarchy(level + 1, h0, gamma):
         pass

@@ -233,7 +233,7 @@ def plot_ensemble(report, folder):
     dict of str -> str
         Picture name -> file name.
     """
-    from ..output.vtk import _atomic_bytes
+    from ..output.atomic import write_bytes
     import io
     done = [s for s in report["samples"] if s.get("ok")]
     pictures = {}
@@ -241,7 +241,7 @@ def plot_ensemble(report, folder):
     def save(fig, name):
         buf = io.BytesIO()
         fig.savefig(buf, format="png", dpi=110)
-        _atomic_bytes(folder / name, buf.getvalue(), True)
+        write_bytes(folder / name, buf.getvalue(), force=True)
         pictures[name.split(".")[0]] = name
 
     sizes = report["fragment_sizes"]

@@ -174,6 +174,29 @@ def fit_rate(h, err, last=3):
     return float(np.polyfit(np.log(h), np.log(err), 1)[0])
 
 
+def _checked_study(order, levels, variant, model, mesh, gamma, solver):
+    """The options of :func:`lshape_study` checked; returns the grading exponent to use."""
+    lshape.check_int("order", order, 1)
+    lshape.check_int("levels", levels, 2)
+    dirichlet_boundaries(variant)
+    if model not in MODELS:
+        raise ValueError(f"model must be one of {MODELS}, got {model!r}")
+    if mesh not in MESHES:
+        raise ValueError(f"mesh must be one of {MESHES}, got {mesh!r}")
+    if solver not in SOLVERS:
+        raise ValueError(f"solver must be one of {SOLVERS}, got {solver!r}")
+    if solver == "plain" and model != "linear":
+        raise ValueError(f"the plain NGSolve solve is linear elasticity only; model {model!r} "
+                         "needs solver='ngfracture'")
+    if mesh == "uniform":
+        if gamma is not None and gamma != 1.0:
+            raise ValueError("gamma is only used with mesh='graded'")
+        gamma = 1.0
+    elif gamma is None:
+        gamma = lshape.default_grading(order)
+    return gamma
+
+
 def lshape_study(order, levels, variant="dirichlet", model="linear", mesh="uniform",
                  E=1e5, nu=0.3, h0=0.5, gamma=None, solver=DEFAULT_SOLVER, plane="strain"):
     """Convergence study of the L-shape problem (paper section 4.1, eq. 15).
@@ -220,24 +243,7 @@ def lshape_study(order, levels, variant="dirichlet", model="linear", mesh="unifo
     RuntimeError
         If ``solver="ngfracture"`` and the elasticity core is unavailable or fails.
     """
-    lshape._check_int("order", order, 1)
-    lshape._check_int("levels", levels, 2)
-    dirichlet_boundaries(variant)
-    if model not in MODELS:
-        raise ValueError(f"model must be one of {MODELS}, got {model!r}")
-    if mesh not in MESHES:
-        raise ValueError(f"mesh must be one of {MESHES}, got {mesh!r}")
-    if solver not in SOLVERS:
-        raise ValueError(f"solver must be one of {SOLVERS}, got {solver!r}")
-    if solver == "plain" and model != "linear":
-        raise ValueError(f"the plain NGSolve solve is linear elasticity only; model {model!r} "
-                         "needs solver='ngfracture'")
-    if mesh == "uniform":
-        if gamma is not None and gamma != 1.0:
-            raise ValueError("gamma is only used with mesh='graded'")
-        gamma = 1.0
-    elif gamma is None:
-        gamma = lshape.default_grading(order)
+    gamma = _checked_study(order, levels, variant, model, mesh, gamma, solver)
     sol = lshape.LShapeSolution(E, nu, plane)
     rows = []
     for level, m in enumerate(lshape.mesh_hierarchy(levels, h0, gamma)):

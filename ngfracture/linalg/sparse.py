@@ -1,0 +1,103 @@
+"""Sparse matrices between NGSolve and scipy, and the thread settings of the solves.
+
+The solves take NGSolve's matrices into scipy (:func:`to_scipy`) and scipy's into NGSolve
+for its direct solvers (:func:`to_ngsolve`). Their dense algebra runs on one BLAS thread
+(:func:`single_threaded_blas`) and NGSolve's factorisations on one thread
+(:func:`reproducible_threads`), for speed on small matrices and for results that repeat to
+the last bit; the measurements are in docs/solvers.md ("Threads").
+"""
+import contextlib
+
+import numpy as np
+import ngsolve as ng
+import scipy.sparse as sp
+
+
+def to_scipy(mat):
+    """A sparse matrix as a scipy CSR matrix.
+
+    Parameters
+    ----------
+    mat : ngsolve.SparseMatrix or scipy.sparse matrix
+        A real sparse matrix; an NGSolve one is copied (``mat.CSR()`` gives its values,
+        column indices and row pointers), a scipy CSR one returned as it is.
+
+    Returns
+    -------
+    scipy.sparse.csr_matrix, shape (mat.height, mat.width)
+        The same entries, including explicitly stored zeros; an NGSolve matrix's arrays
+        are copied, so later changes to ``mat`` do not show in it.
+    """
+    if sp.issparse(mat):
+        return sp.csr_matrix(mat)
+    vals, cols, rows = mat.CSR()
+    return sp.csr_matrix((np.array(vals), np.array(cols), np.array(rows)), shape=(mat.height, mat.width))
+
+
+def to_ngsolve(mat):
+    """A scipy sparse matrix as an NGSolve sparse matrix (for NGSolve's direct solvers).
+
+    Parameters
+    ----------
+    mat : scipy.sparse matrix
+        Real, square or not.
+
+    Returns
+    -------
+    ngsolve.la.SparseMatrixd
+        The same entries (duplicates summed).
+    """
+    coo = sp.coo_matrix(mat)
+    return ng.la.SparseMatrixd.CreateFromCOO(coo.row.astype(np.int64), coo.col.astype(np.int64),
+                                             coo.data, coo.shape[0], coo.shape[1])
+
+
+_blas = None     # threadpoolctl's view of the loaded BLAS libraries, made at first use
+
+
+@contextlib.contextmanager
+def single_threaded_blas():
+    """One BLAS thread for the small dense algebra of the solves (usable as a decorator).
+
+    Schur complements, the QP of the contact solve, the Gram and rank tests are dense
+    matrices of a few hundred rows, where OpenBLAS' threads only wait for each other, and
+    on a busy machine much longer (docs/solvers.md, "Threads"). One thread also makes the
+    dense results independent of the core count. The previous limits are restored on
+    leaving (threadpoolctl, which finds numpy's and scipy's BLAS).
+
+    Yields
+    ------
+    None
+        The body runs with every loaded BLAS limited to one thread.
+    """
+    global _blas
+    if _blas is None:
+        from threadpoolctl import ThreadpoolController
+        _blas = ThreadpoolController()
+    with _blas.limit(limits=1, user_api="blas"):
+        yield
+
+
+@contextlib.contextmanager
+def reproducible_threads():
+    """One NGSolve thread while factorising, for results that repeat to the last bit.
+
+    NGSolve's sparse Cholesky factorises in parallel with a summation order that varies
+    between runs, so that two factorisations of the same matrix can give solutions that
+    differ in the last bit, enough to change a crack pattern or a resumed run; with one
+    thread it is bitwise reproducible, and no slower on two cores (docs/solvers.md,
+    "Threads"). Must be entered outside a TaskManager context (its thread count is fixed
+    when it starts).
+
+    Yields
+    ------
+    None
+        The body of the ``with`` block runs with ``ngsolve.SetNumThreads(1)``; the previous
+        thread count is restored on leaving it, also when it raises.
+    """
+    before = ng.GetNumThreads()
+    ng.SetNumThreads(1)
+    try:
+        yield
+    finally:
+        ng.SetNumThreads(before)

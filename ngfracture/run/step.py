@@ -1,0 +1,481 @@
+"""One load step, from an accepted state (mesh, displacement, load parameter x).
+
+    1. x_try = x + dx; solve at x_try (modified Newton; contact once there are cracks
+       or separate bodies; free fragments held on their rigid modes);
+    2. find the overstrained vertices and split them (one crack pass);
+       if the pass split more than ``max_new_cracks`` vertices and dx can still be
+       cut: go back to the saved state and retry with dx * cut;
+    3. relax at fixed x_try: solve on the split mesh, split again, until a pass
+       splits nothing (the energy release through crack formation);
+    4. accept: the new state and its history record; after ``grow_after`` steps in a
+       row without a crack, dx = min(dx * grow, dx_max).
+
+Each stage returns a record (:mod:`ngfracture.run.records`); a failed solve raises
+``StepFailed``. A failure sends the step back to the saved state: an increment solve that
+started from the tangent kept from the step before is made again with a tangent of its
+own; with modified Newton, the next retry solves the same attempt with full Newton (the
+tangent factorised at the start of a solve can be too far from the state that new
+contact rows impose); then a failure of the increment solve is retried with the same
+target in twice as many Newton load steps (the load path does not change), a failure at
+fixed load after a split with dx * cut; after ``max_retries`` failures the step gives up.
+
+Where the paper is vague:
+
+* A "crack" in the step-control rule is a split vertex (a new crack-face node) of the
+  first pass after the increment; cracks that run at fixed load during relaxation
+  are the physical answer to that load and are not limited.
+* External work is the trapezoidal sum of reaction forces times the increments of
+  the prescribed displacements; relaxation at fixed load does no work, so
+  work - elastic energy is the energy released by cracking.
+"""
+import time
+
+import numpy as np
+
+from ..contact.solver import ContactSolver
+from ..fracture.fragments import FragmentStatistics
+from ..fracture.split import GROWTH_RULES, PAPER_RULES, split_by_tensor, transfer_vertex_field
+from ..linalg import bordered
+from ..mechanics.tangent import SavedTangent
+from ..mechanics.problem import ElasticProblem
+from .loadpath import load_path_cut, prescribed_increment
+from .records import AcceptedStep, Attempt, CrackPass, Equilibrium, StepFailed, StepLog, StepOutcome, TooManyCracks
+from .state import State, crack_length, round_trip
+from . import tangents
+
+__all__ = ["LoadStep"]
+
+
+def _merged(notes, more):
+    """``notes`` followed by those of ``more`` not in it yet, in order."""
+    out = list(notes)
+    out.extend(n for n in more if n not in out)
+    return out
+
+
+class LoadStep:
+    """The stages of a load step for one scene, criterion and step control.
+
+    Holds only its configuration; every stage takes what it works on as arguments and
+    returns a record.
+
+    Parameters
+    ----------
+    scene : Scene
+    control : StepControl
+        Resolved (``StepControl.resolved``).
+    criterion : Criterion
+        The scene's crack criterion.
+    contact : {"auto", "never"}
+        See :class:`ngfracture.run.simulation.Simulation`.
+    """
+
+    def __init__(self, scene, control, criterion, contact="auto"):
+        self.scene, self.control, self.criterion, self.contact = scene, control, criterion, contact
+
+    # -- the physics of one configuration ------------------------------------------------------
+    def problem(self, mesh, x, timings, u=None, check_mesh=True, triangle_piece=None):
+        """The scene's problem on a mesh at load x, with a displacement.
+
+        Parameters
+        ----------
+        mesh : ngsolve.Mesh
+        x : float
+            The load parameter.
+        timings : Timings
+        u : numpy.ndarray, optional
+            P1 displacement vector (VectorH1 layout).
+        check_mesh : bool
+            Validate the mesh (False for meshes the crack engine made from checked ones).
+        triangle_piece : numpy.ndarray, optional
+            Fragment per triangle, if known.
+
+        Returns
+        -------
+        ElasticProblem
+        """
+        with timings.timed("rebuild"):
+            prob = ElasticProblem(mesh, self.scene.material, order=1, check_mesh=check_mesh,
+                                  triangle_piece=triangle_piece)
+            self.scene.apply_load(prob, x)
+            if u is not None:
+                prob.u.vec.FV().NumPy()[:] = u
+        return prob
+
+    def needs_contact(self, mesh):
+        """True when a solve on this mesh needs contact rows.
+
+        Parameters
+        ----------
+        mesh : ngsolve.Mesh
+
+        Returns
+        -------
+        bool
+        """
+        if self.contact == "never":
+            return False
+        return self.scene.contact or "crack" in mesh.GetBoundaries()
+
+    def equilibrium(self, prob, phase, method, timings, substeps=1, warm=(), lineage=None, start=None):
+        """Solve ``prob`` in ``substeps`` load steps, with contact where the mesh needs it.
+
+        Parameters
+        ----------
+        prob : ElasticProblem
+        phase : {"increment", "relaxation"}
+        method : {"modified", "full"}
+        timings : Timings
+        substeps : int
+        warm : iterable of tuple
+            The active contact keys of the solve before (ContactSolver.solve).
+        lineage : object, optional
+            The mesh was split from a solved one (linalg.bordered).
+        start : SavedTangent, optional
+            A factorised tangent of this mesh to start from (State.tangent).
+
+        Returns
+        -------
+        Equilibrium
+
+        Raises
+        ------
+        StepFailed
+            The solve did not converge.
+        """
+        c = self.control
+        options = dict(method=method, tol=c.tol, maxit=c.maxit, load_steps=substeps)
+        if self.needs_contact(prob.mesh):
+            return self._contact_equilibrium(prob, phase, options, timings, warm, lineage, start)
+        t0 = time.perf_counter()
+        tangent = start.kept() if start is not None else SavedTangent(lineage)
+        status = prob.solve(fix_free_modes=self.scene.fix_free_modes, tangent=tangent, **options)
+        timings.add("solve", time.perf_counter() - t0)
+        for part, seconds in status.phase_seconds().items():
+            timings.add(part, seconds)
+        if not status.converged:
+            raise StepFailed(status.reason, phase, status.message)
+        return Equilibrium([], tangent, status.iterations, _merged([], status.notes))
+
+    def _contact_equilibrium(self, prob, phase, options, timings, warm, lineage, start):
+        """:meth:`equilibrium` with an active set of contact rows."""
+        solver = ContactSolver(prob, tol=self.scene.contact_tol,   # its tol: detection threshold
+                               fix_free_modes=self.scene.fix_free_modes)
+        solver.options.update(options)                              # Newton's tol, method, maxit
+        result = solver.solve(warm=warm, lineage=lineage, start=start)
+        collision = result.timings.get("collision", 0.0)
+        timings.add("solve", result.timings["solve"])
+        timings.add("contact", result.timings["contact"] - collision)
+        timings.add("collision", collision)
+        timings.add("linear", result.timings.get("linear", 0.0))
+        timings.add("assembly", result.timings.get("assembly", 0.0))
+        if not result.converged:
+            if result.reason == "penetration":
+                message = (f"contact rows still penetrate by {result.max_penetration:.3g} after "
+                           f"{result.updates} re-linearisations")
+            elif result.reason == "active_set":
+                message = f"contact active set did not settle in {result.rounds} rounds"
+            else:
+                message = result.status.message
+            raise StepFailed(result.reason, phase, message)
+        return Equilibrium(result.active_keys, result.tangent, result.status.iterations,
+                           _merged([], result.notes))
+
+    def crack_pass(self, prob, x, strength, tangent, timings):
+        """One splitting pass on an equilibrium.
+
+        Parameters
+        ----------
+        prob : ElasticProblem
+            The equilibrium.
+        x : float
+            Its load parameter (the split problem's).
+        strength : numpy.ndarray or None
+            Critical strain per vertex.
+        tangent : SavedTangent or None
+            The tangent the equilibrium ended with: the split mesh's solves start from it.
+        timings : Timings
+
+        Returns
+        -------
+        CrackPass
+        """
+        with timings.timed("strain"):
+            tensors = self.criterion.overstrain(prob.mesh, prob.u, strength, arrays=prob.arrays)
+        t0 = time.perf_counter()
+        # cracks judged at a critical distance grow from their tips (docs/criterion.md)
+        rules = PAPER_RULES if self.criterion.one_ring else GROWTH_RULES
+        res = split_by_tensor(prob.mesh, tensors, 1.0, skip_neighbours=self.control.split == "spread",
+                              first_only=self.control.split == "one", rules=rules,
+                              check_mesh=False)   # checked when made, or split from a checked mesh
+        rebuild = res.timings.get("netgen", 0.0) + res.timings.get("ngsolve_mesh", 0.0)
+        timings.add("split", time.perf_counter() - t0 - rebuild)
+        timings.add("rebuild", rebuild)
+        if res.nsplit == 0:
+            return CrackPass(None, 0, strength, None, np.zeros((0, 2)))
+        positions = res.record["position"][np.diff(res.record["new_offsets"]) > 0]
+        # P1: the displacement is a vertex field (component-major), copied through the split
+        u = transfer_vertex_field(prob.u.vec.FV().NumPy().reshape(2, -1).T, res).T.reshape(-1)
+        if strength is not None:
+            strength = transfer_vertex_field(strength, res)    # copies inherit the vertex's strength
+        inherited = bordered.lineage(tangent.factor, tangent.state, res.parent) if tangent is not None else None
+        # the engine split a checked mesh and keeps it valid
+        split = self.problem(res.mesh, x, timings, u, check_mesh=False, triangle_piece=res.fragment)
+        return CrackPass(split, res.nsplit, strength, inherited, positions)
+
+    # -- one load step ----------------------------------------------------------------------------
+    def attempt(self, state, dx, method, timings, substeps=1, keep=True):
+        """Try the step x + dx from an accepted state and relax it at fixed load.
+
+        Parameters
+        ----------
+        state : State
+        dx : float
+        method : {"modified", "full"}
+        timings : Timings
+        substeps : int
+            Newton load steps of the increment solve.
+        keep : bool
+            Start from the tangent the state keeps (if any, modified Newton).
+
+        Returns
+        -------
+        Attempt or TooManyCracks
+
+        Raises
+        ------
+        StepFailed
+            A solve failed (``from_kept`` when the increment solve started from the kept tangent).
+        """
+        c = self.control
+        x = state.x + dx
+        prob = self.problem(state.mesh, x, timings, state.u)
+        start = tangents.kept_tangent(state, prob, timings) if keep and method == "modified" else None
+        try:
+            eq = self.equilibrium(prob, "increment", method, timings, substeps, warm=state.contact_keys, start=start)
+        except StepFailed as err:
+            err.from_kept = start is not None
+            raise
+        work = self.increment_work(state, prob)
+        iterations, notes = eq.iterations, eq.notes
+        crack = self.crack_pass(prob, x, state.strength, eq.tangent, timings)
+        if crack.n_split > c.max_new_cracks and dx * c.cut >= c.dx_min:
+            return TooManyCracks(crack.n_split)
+        first, total, passes, positions, broken = crack.n_split, crack.n_split, 0, [], False
+        while crack.problem is not None:
+            positions.append(crack.positions)
+            passes += 1
+            if passes > c.max_relax_passes:
+                raise StepFailed("relaxation", "relaxation", f"cracks still grow after {c.max_relax_passes} passes at fixed load")
+            prob = crack.problem
+            eq = self.equilibrium(prob, "relaxation", method, timings, warm=eq.contact_keys, lineage=crack.lineage)
+            iterations, notes = iterations + eq.iterations, _merged(notes, eq.notes)
+            if (self.scene.stop_when_unloaded and prob.fragments()[0] > 1
+                    and self.cut_through(prob.arrays, prob.mesh, prob.assemble_constraints(), timings)):
+                broken = True
+                break     # the run ends with this step: no crack in the separated pieces
+            crack = self.crack_pass(prob, x, crack.strength, eq.tangent, timings)
+            total += crack.n_split
+        return Attempt(prob, x, first, total, crack.strength, eq.contact_keys, eq.tangent, work, positions,
+                       iterations, notes, start is not None, broken)
+
+    def step(self, state, dx, timings):
+        """Attempts of one step until one is accepted, or the last failure.
+
+        Too many cracks: dx * cut. A failed increment solve that started from the tangent
+        the state keeps: the same attempt with a tangent of its own (recorded in the notes,
+        not counted against ``max_retries``). A failed solve with modified Newton: the same
+        attempt with full Newton (from then on for this step). A failed solve of the
+        increment: the same target in twice as many substeps (load steps of the Newton
+        solver, no crack pass between them), so a passing trouble does not change the load
+        path. A failed solve at fixed load (relaxation on a split mesh): dx * cut, substeps
+        reset. Every attempt starts from the saved state: nothing of a failed attempt is kept.
+
+        Parameters
+        ----------
+        state : State
+        dx : float
+        timings : Timings
+
+        Returns
+        -------
+        StepOutcome
+        """
+        c = self.control
+        log = StepLog(method=c.method)
+        keep = True
+        while True:
+            try:
+                attempt = self.attempt(state, dx, log.method, timings, log.substeps, keep)
+            except StepFailed as err:
+                log.retries += 1
+                log.failures.append(err.reason)
+                if err.from_kept:
+                    # the same attempt with its own tangent, not counted against max_retries
+                    keep = False
+                    log.notes.append(f"the tangent kept from the step before failed ({err.reason}); "
+                                     "the step factorised its own")
+                    continue
+                if log.retries - (not keep) > c.max_retries:
+                    return StepOutcome(None, dx, log, err)
+                if log.method == "modified":
+                    log.method = "full"           # the same attempt with fresh tangents
+                elif err.phase == "increment":
+                    log.substeps *= 2
+                elif dx * c.cut >= c.dx_min:
+                    dx, log.substeps = dx * c.cut, 1
+                else:
+                    return StepOutcome(None, dx, log, err)
+                continue
+            if isinstance(attempt, TooManyCracks):     # too many cracks at once: smaller increment
+                dx *= c.cut
+                continue
+            log.kept_tangent = attempt.kept_tangent
+            log.notes = _merged(log.notes, attempt.notes)
+            return StepOutcome(attempt, dx, log)
+
+    @staticmethod
+    def increment_work(state, prob):
+        """Work of the reactions over the increment just solved (trapezoid rule).
+
+        The increment is solved on the mesh of the accepted state, so its fixed dofs have
+        the numbers they had there (cracks come later, at fixed load: they do no work).
+
+        Parameters
+        ----------
+        state : State
+            The accepted state the increment starts from.
+        prob : ElasticProblem
+            The solved increment.
+
+        Returns
+        -------
+        float
+        """
+        rows = prob.assemble_constraints()
+        pos = np.searchsorted(rows.fixed_dofs, state.fixed_dofs)
+        pos = np.minimum(pos, max(len(rows.fixed_dofs) - 1, 0))
+        same = (rows.fixed_dofs[pos] == state.fixed_dofs) if len(rows.fixed_dofs) else np.zeros(0, bool)
+        r_new = -prob.out_of_balance()[rows.fixed_dofs[pos[same]]]
+        dg = rows.fixed_values[pos[same]] - state.fixed_values[same]
+        return float(0.5 * np.dot(state.reactions[same] + r_new, dg))
+
+    def accept(self, state, outcome, timings):
+        """The accepted state of a step and its history record.
+
+        Parameters
+        ----------
+        state : State
+            The state the step started from.
+        outcome : StepOutcome
+            With an accepted attempt.
+        timings : Timings
+
+        Returns
+        -------
+        AcceptedStep
+        """
+        attempt, dx, log = outcome.attempt, outcome.dx, outcome.log
+        arrays, mesh = round_trip(attempt.problem.mesh)
+        u = attempt.problem.u.vec.FV().NumPy().copy()
+        # the solve ended at u (kept by the problem, no assembly); the round trip keeps the dof numbers
+        out_of_balance = attempt.problem.out_of_balance()
+        prob = self.problem(mesh, attempt.x, timings, u)   # the state as a resume would see it
+        rows = prob.assemble_constraints()
+        energy = float(prob.energy())
+        stats = FragmentStatistics(mesh)
+        work = state.work + attempt.work
+        # a step that cracked keeps its (possibly cut) increment; quiet steps may grow it
+        quiet = state.quiet + 1 if attempt.total_cracks == 0 else 0
+        new_dx = dx
+        if quiet >= self.control.grow_after:
+            new_dx, quiet = min(dx * self.control.grow, self.control.dx_max), 0
+        record = self._record(state, attempt, dx, log, energy, work, crack_length(arrays), stats.count)
+        new = State(arrays=arrays, u=u, x=attempt.x, dx=new_dx, step=state.step + 1, quiet=quiet, work=work,
+                    reactions=-out_of_balance[rows.fixed_dofs], fixed_values=rows.fixed_values.copy(),
+                    fixed_dofs=rows.fixed_dofs.copy(), peak_energy=max(state.peak_energy, energy),
+                    history=state.history + [record], strength=attempt.strength,
+                    contact_keys=attempt.contact_keys, mesh=mesh)
+        kept = tangents.tangent_to_keep(attempt.tangent, log.method, new.fixed_dofs)
+        if kept is not None:
+            new.tangent_state, new.tangent = kept.state, kept
+        return AcceptedStep(new, record, prob, stats, attempt)
+
+    @staticmethod
+    def _record(state, attempt, dx, log, energy, work, length, fragments):
+        """The history record of an accepted step."""
+        record = {"step": state.step + 1, "x": attempt.x, "dx": dx, "new_cracks_first_pass": int(attempt.first_cracks),
+                  "split_vertices": int(attempt.total_cracks), "elastic_energy": energy, "external_work": work,
+                  "released_energy": work - energy, "crack_length": length,
+                  "fragments": int(fragments), "newton_iterations": int(attempt.iterations),
+                  "retries": int(log.retries), "failures": list(log.failures),
+                  "substeps": int(log.substeps), "method": log.method,
+                  "relax_passes": max(len(attempt.split_positions) - 1, 0), "notes": list(log.notes),
+                  "kept_tangent": bool(log.kept_tangent)}
+        if attempt.first_cracks and not any(h["split_vertices"] for h in state.history):
+            # where cracking began: the vertices split by the first pass that split any
+            record["initiation"] = attempt.split_positions[0].tolist()
+        return record
+
+    # -- the end of a run -----------------------------------------------------------------------
+    def initial_state(self, timings):
+        """The state at x = 0: the scene's mesh through the checkpoint representation.
+
+        Parameters
+        ----------
+        timings : Timings
+
+        Returns
+        -------
+        State
+        """
+        arrays, mesh = round_trip(self.scene.mesh)
+        prob = self.problem(mesh, 0.0, timings)
+        rows = prob.assemble_constraints()
+        strength = None if self.scene.strength is None else np.array(self.scene.strength, dtype=float)
+        return State(arrays=arrays, u=np.zeros(prob.fes.ndof), x=0.0, dx=float(self.scene.dx), step=0,
+                     quiet=0, work=0.0, reactions=np.zeros(len(rows.fixed_dofs)),
+                     fixed_values=rows.fixed_values.copy(), fixed_dofs=rows.fixed_dofs.copy(),
+                     peak_energy=0.0, history=[], strength=strength, mesh=mesh)
+
+    def broken(self, state, timings):
+        """Why an accepted state is broken through (Scene.stop_when_unloaded), or "".
+
+        Parameters
+        ----------
+        state : State
+        timings : Timings
+
+        Returns
+        -------
+        str
+        """
+        last = state.history[-1]
+        if last["fragments"] > 1 and self.cut_through(state.arrays, state.mesh, state, timings):
+            return "the body is broken through (no fragment connects boundaries the load moves apart)"
+        if last["crack_length"] > 0 and last["elastic_energy"] < self.control.unloaded_fraction * state.peak_energy:
+            return "the body is broken through (elastic energy released)"
+        return ""
+
+    def cut_through(self, arrays, mesh, loaded, timings):
+        """True when no fragment of the mesh connects boundaries the load moves apart.
+
+        Parameters
+        ----------
+        arrays : MeshArrays
+            The mesh's arrays.
+        mesh : ngsolve.Mesh
+        loaded : ConstraintRows or State
+            The fixed dofs and values at the load.
+        timings : Timings
+
+        Returns
+        -------
+        bool
+        """
+        # the prescribed values at x against those at 0, on this mesh
+        unloaded = self.problem(mesh, 0.0, timings).assemble_constraints()
+        dofs, increment = prescribed_increment(unloaded.fixed_dofs, unloaded.fixed_values,
+                                               loaded.fixed_dofs, loaded.fixed_values)
+        return load_path_cut(arrays.points, arrays.triangles, dofs, increment)
+
