@@ -199,8 +199,8 @@ def _default_out(spec):
 
 
 def _run_run(args):
-    from .run.scene_source import load_scene_function, parse_assignments
     from .run.files import check_folder
+    from .run.scene_source import build_scene, load_scene_function, parse_assignments
     from .run.simulation import Simulation, StepControl
 
     if args.force and args.resume:
@@ -214,10 +214,7 @@ def _run_run(args):
     out = args.out if args.out is not None else _default_out(args.scene)
     check_folder(out, force=args.force, resume=args.resume,     # before meshing
                  option_names=("--force", "--resume"))
-    try:
-        scene = make_scene(**params)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"scene {args.scene!r} with {params}: {exc}") from exc
+    scene = build_scene(make_scene, args.scene, params)
     if args.load_max is not None:
         scene.load_max = args.load_max
         scene.parameters["load_max"] = args.load_max

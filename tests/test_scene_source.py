@@ -1,5 +1,6 @@
 """Scenes by name, file or module (ngfracture.run.scene_source), and --set NAME=VALUE parsing."""
 import inspect
+import re
 import textwrap
 
 import pytest
@@ -114,3 +115,22 @@ def test_none_switches_a_scene_to_the_papers_criterion():
     assert parse_assignments(["radius=none"], scenes.plate) == {"radius": None}
     assert scenes.plate(maxh=0.2, radius=None).radius is None
     assert scenes.plate(maxh=0.2).radius == scenes.PLATE_RADIUS
+
+
+@pytest.mark.parametrize("body, message", [
+    ("    raise RuntimeError('the mesher is out of paper')",
+     r"its function scene\(width=2.0\) raised RuntimeError: the mesher is out of paper"),
+    ("    from netgen.geom2d import unit_square\n    import ngsolve\n    return ngsolve.Mesh(unit_square.GenerateMesh(maxh=0.5))",
+     r"its function scene\(width=2.0\) returned ngsolve.comp.Mesh .*not an ngfracture Scene"),
+])
+def test_a_scene_function_that_fails_or_returns_no_scene_is_bad_input(tmp_path, capsys, body, message):
+    """Exit status 2 (the user's input), the function and what it did named, no file touched."""
+    from ngfracture.cli import main
+    path = tmp_path / "faulty.py"
+    path.write_text(f"def scene(width=1.0):\n{body}\n")
+    out = tmp_path / "out"
+    with pytest.raises(SystemExit) as exc:
+        main(["run", str(path), "--set", "width=2.0", "--out", str(out), "--progress", "none"])
+    assert exc.value.code == 2
+    assert re.search(message, capsys.readouterr().err)
+    assert not out.exists()

@@ -223,7 +223,7 @@ def test_resuming_a_finished_run_redraws_its_final_outputs(tmp_path):
     assert first.reason == "max_steps"
     # the phases are disjoint parts of the wall time, the final pictures included
     t = json.loads((tmp_path / "summary.json").read_text())["timings"]
-    phases = ("solve", "strain", "split", "rebuild", "collision", "contact", "output")
+    phases = ("solve", "strain", "split", "rebuild", "collision", "contact", "checks", "output")
     assert sum(t[k] for k in phases) <= t["wall"] + 1e-5
     (tmp_path / "summary.json").unlink()                 # as if killed before the summary
     again = Simulation(scenes.plate(maxh=0.1, radius=None), control(), out=tmp_path, resume=True).run()

@@ -15,7 +15,7 @@ import numpy as np
 
 from ..mechanics import rigid
 from .._ngfracture import ElementAreas
-from ..mechanics.problem import check_mesh, element_vertices
+from ..geometry.meshio import check_mesh, element_vertices
 
 __all__ = ["FragmentStatistics", "fragment_ids"]
 

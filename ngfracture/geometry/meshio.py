@@ -394,3 +394,48 @@ def separate_region(mesh, region, boundary="interface", region_boundary=None):
                              np.full(len(edges), names.index(region_boundary) + 1)])
     return mesh_from_arrays(MeshArrays(np.vstack([a.points, a.points[shared]]), tris, a.regions,
                                        a.region_names, segments, seg_bc, names))
+
+
+def check_mesh(mesh):
+    """Raise ValueError unless mesh is a non-empty 2D NGSolve mesh.
+
+    Parameters
+    ----------
+    mesh : object
+        The object to check.
+
+    Raises
+    ------
+    ValueError
+        If mesh is not an ``ngsolve.Mesh``, is not 2D or has no elements.
+    """
+    if not isinstance(mesh, ng.Mesh):
+        raise ValueError(f"mesh must be an ngsolve.Mesh, got {type(mesh).__name__}")
+    if mesh.dim != 2:
+        raise ValueError(f"ngfracture works on 2D meshes; this mesh has dimension {mesh.dim}")
+    if mesh.ne == 0:
+        raise ValueError("the mesh has no elements")
+
+
+def element_vertices(mesh):
+    """Vertex numbers of every triangle, 0-based.
+
+    Parameters
+    ----------
+    mesh : ngsolve.Mesh
+        2D mesh.
+
+    Returns
+    -------
+    numpy.ndarray of int64, shape (ne, 3)
+        In element order.
+
+    Raises
+    ------
+    ValueError
+        If the mesh has quadrilaterals.
+    """
+    nodes = mesh.ngmesh.Elements2D().NumPy()["nodes"]
+    if nodes.shape[1] > 3 and np.any(nodes[:, 3] != 0):
+        raise ValueError("only triangular meshes are supported (the mesh has quadrilaterals)")
+    return nodes[:, :3].astype(np.int64) - 1

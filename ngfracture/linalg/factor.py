@@ -254,6 +254,8 @@ class EliminatedFactor(FactorBase):
     linear_solver, inverse, gmres_tol
         See ConstrainedSolver. ``inverse`` is used only by "direct", ``gmres_tol`` (the
         relative residual GMRES must reach) only by "gmres".
+    pattern : ngsolve.la.SparseMatrixd, optional
+        An NGSolve matrix of K's sparsity pattern, for NGSolve's factorisation (to_ngsolve).
 
     Attributes
     ----------
@@ -270,12 +272,13 @@ class EliminatedFactor(FactorBase):
     """
 
     def __init__(self, K, fixed_dofs, pins=None, linear_solver="direct", inverse="auto",
-                 gmres_tol=1e-12):
+                 gmres_tol=1e-12, pattern=None):
         if linear_solver not in LINEAR_SOLVERS:
             raise ValueError(f"linear_solver must be one of {LINEAR_SOLVERS}, got {linear_solver!r}")
         t0 = time.perf_counter()
         super().__init__()
         self.K = to_scipy(K)      # products with K: scipy's CSR product
+        self._ngsolve_pattern = K if isinstance(K, ng.la.SparseMatrixd) else pattern
         self.ndof = self.K.shape[0]
         self.fixed_dofs = np.asarray(fixed_dofs, dtype=np.int64)
         self.pins = np.zeros(0, dtype=np.int64) if pins is None else np.asarray(pins, dtype=np.int64)
@@ -359,7 +362,8 @@ class EliminatedFactor(FactorBase):
             for d in np.flatnonzero(~self.factor_free).tolist():
                 factor_dofs.Clear(d)
             with reproducible_threads():
-                self._inv = to_ngsolve(self.K).Inverse(factor_dofs, inverse=self.inverse)
+                self._inv = to_ngsolve(self.K, self._ngsolve_pattern).Inverse(factor_dofs, inverse=self.inverse)
+                self._ngsolve_pattern = None     # not kept alive with the factor
         self.seconds += time.perf_counter() - t0
 
     def _factorised_block(self):

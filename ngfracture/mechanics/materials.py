@@ -430,3 +430,39 @@ def make_material(name, E, nu, plane="strain"):
     if name not in MATERIALS:
         raise ValueError(f"unknown material model {name!r}; choose one of {sorted(MATERIALS)}")
     return MATERIALS[name](E, nu, plane)
+
+
+def region_materials(mesh, material):
+    """{region name: Material} for every material region of the mesh.
+
+    Parameters
+    ----------
+    mesh : ngsolve.Mesh
+        The mesh whose regions (``mesh.GetMaterials()``) need a material.
+    material : Material or dict of str -> Material
+        One material for all regions, or one per region.
+
+    Returns
+    -------
+    dict of str -> Material
+        Every region of the mesh mapped to its material.
+
+    Raises
+    ------
+    ValueError
+        If a value is not a Material, a region has none, or a name is not a region.
+    """
+    regions = set(mesh.GetMaterials())
+    if isinstance(material, Material):
+        return {name: material for name in sorted(regions)}
+    if not isinstance(material, dict):
+        raise ValueError(f"material must be a ngfracture Material or a dict of them, got {type(material).__name__}")
+    for name, m in material.items():
+        if name not in regions:
+            raise ValueError(f"material region {name!r} does not exist in the mesh; its regions are {sorted(regions)}")
+        if not isinstance(m, Material):
+            raise ValueError(f"material for region {name!r} must be a ngfracture Material, got {type(m).__name__}")
+    missing = sorted(regions - set(material))
+    if missing:
+        raise ValueError(f"material region(s) {missing} have no material")
+    return dict(material)

@@ -354,7 +354,8 @@ class NewtonSolver:
         if self.fix_free_modes:
             rows = self._hold_free_modes(rows, support)
         factor = saved.factor if reuse else EliminatedFactor(prob.tangent(), rows.fixed_dofs, support.pins,
-                                                             self.linear_solver, self.inverse)
+                                                             self.linear_solver, self.inverse,
+                                                             pattern=prob.tangent_pattern())
         kkt = ConstrainedSolver(None, rows.fixed_dofs, rows.C, modes=support.modes, pins=support.pins,
                                 factor=factor, dependent_rows=True)
         u = prob.u.vec.FV().NumPy()
@@ -462,7 +463,8 @@ class NewtonSolver:
                 K = self.problem.tangent()
             # not inside prob.threads(): the factorisation runs on one thread (linalg.factor)
             with _Timer(timings, "factorize"):
-                factor = EliminatedFactor(K, rows.fixed_dofs, support.pins, self.linear_solver, self.inverse)
+                factor = EliminatedFactor(K, rows.fixed_dofs, support.pins, self.linear_solver, self.inverse,
+                                          pattern=self.problem.tangent_pattern())
         path = "auto" if self.method == "full" and given is None else "schur"
         with _Timer(timings, "factorize"):
             kkt = ConstrainedSolver(None, rows.fixed_dofs, rows.C, modes=support.modes, pins=support.pins,

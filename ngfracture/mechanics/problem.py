@@ -21,91 +21,10 @@ from . import rigid
 from .constraints import ConstraintSet
 from ..fracture.strain import vertex_displacement
 from ..linalg.sparse import to_scipy
-from .materials import Material
+from .materials import region_materials
 from ..geometry.meshcheck import validate_mesh
 from ..geometry.meshio import mesh_to_arrays
 from .newton import NewtonSolver
-
-
-def check_mesh(mesh):
-    """Raise ValueError unless mesh is a non-empty 2D NGSolve mesh.
-
-    Parameters
-    ----------
-    mesh : object
-        The object to check.
-
-    Raises
-    ------
-    ValueError
-        If mesh is not an ``ngsolve.Mesh``, is not 2D or has no elements.
-    """
-    if not isinstance(mesh, ng.Mesh):
-        raise ValueError(f"mesh must be an ngsolve.Mesh, got {type(mesh).__name__}")
-    if mesh.dim != 2:
-        raise ValueError(f"ngfracture works on 2D meshes; this mesh has dimension {mesh.dim}")
-    if mesh.ne == 0:
-        raise ValueError("the mesh has no elements")
-
-
-def element_vertices(mesh):
-    """Vertex numbers of every triangle, 0-based.
-
-    Parameters
-    ----------
-    mesh : ngsolve.Mesh
-        2D mesh.
-
-    Returns
-    -------
-    numpy.ndarray of int64, shape (ne, 3)
-        In element order.
-
-    Raises
-    ------
-    ValueError
-        If the mesh has quadrilaterals.
-    """
-    nodes = mesh.ngmesh.Elements2D().NumPy()["nodes"]
-    if nodes.shape[1] > 3 and np.any(nodes[:, 3] != 0):
-        raise ValueError("only triangular meshes are supported (the mesh has quadrilaterals)")
-    return nodes[:, :3].astype(np.int64) - 1
-
-
-def region_materials(mesh, material):
-    """{region name: Material} for every material region of the mesh.
-
-    Parameters
-    ----------
-    mesh : ngsolve.Mesh
-        The mesh whose regions (``mesh.GetMaterials()``) need a material.
-    material : Material or dict of str -> Material
-        One material for all regions, or one per region.
-
-    Returns
-    -------
-    dict of str -> Material
-        Every region of the mesh mapped to its material.
-
-    Raises
-    ------
-    ValueError
-        If a value is not a Material, a region has none, or a name is not a region.
-    """
-    regions = set(mesh.GetMaterials())
-    if isinstance(material, Material):
-        return {name: material for name in sorted(regions)}
-    if not isinstance(material, dict):
-        raise ValueError(f"material must be a ngfracture Material or a dict of them, got {type(material).__name__}")
-    for name, m in material.items():
-        if name not in regions:
-            raise ValueError(f"material region {name!r} does not exist in the mesh; its regions are {sorted(regions)}")
-        if not isinstance(m, Material):
-            raise ValueError(f"material for region {name!r} must be a ngfracture Material, got {type(m).__name__}")
-    missing = sorted(regions - set(material))
-    if missing:
-        raise ValueError(f"material region(s) {missing} have no material")
-    return dict(material)
 
 
 def _double_areas(x, elements):
@@ -265,6 +184,16 @@ class ElasticProblem:
             ``ngsolve.TaskManager()`` from ``PARALLEL_MIN_DOFS`` dofs on, else a no-op.
         """
         return ng.TaskManager() if self.fes.ndof >= self.PARALLEL_MIN_DOFS else contextlib.nullcontext()
+
+    def tangent_pattern(self):
+        """NGSolve's matrix of the last tangent assembled by NGSolve (its pattern), or None.
+
+        Returns
+        -------
+        ngsolve.la.SparseMatrixd or None
+            None where the C++ kernel assembles the tangent (P1 with the package's laws).
+        """
+        return self._form.mat if self._form is not None and self._kernel_data() is None else None
 
     @property
     def form(self):

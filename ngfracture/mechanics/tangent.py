@@ -99,7 +99,8 @@ class SavedTangent:
         support = problem.support(rows, state)
         saved = cls()
         saved.fixed_dofs, saved.support, saved.state = rows.fixed_dofs, support, np.array(state, dtype=float)
-        saved.factor = EliminatedFactor(problem.tangent(state), rows.fixed_dofs, support.pins)
+        saved.factor = EliminatedFactor(problem.tangent(state), rows.fixed_dofs, support.pins,
+                                        pattern=problem.tangent_pattern())
         saved.factor.factorise()
         return saved
 

@@ -24,8 +24,7 @@ break cell data (every line would need a fragment and a strain) and filters like
 import numpy as np
 
 from ..fracture.strain import element_strain, principal, vertex_displacement, vertex_strain
-from ..geometry.meshio import mesh_to_arrays
-from ..mechanics.problem import check_mesh
+from ..geometry.meshio import check_mesh, mesh_to_arrays
 
 __all__ = ["vertex_arrays", "displacement_values", "to_pyvista", "cracks_to_pyvista", "mesh_fields",
            "crack_fields", "region_names"]

@@ -27,8 +27,9 @@ class StepFailed(Exception):
     reason : str
         The solver's reason (nan, diverged, inverted_element, singular, active_set,
         penetration, ...).
-    phase : {"increment", "relaxation"}
-        The solve of the increment, or one at fixed load after a split.
+    phase : {"increment", "relaxation", "invariant"}
+        The solve of the increment, one at fixed load after a split, or the check of the
+        attempt's result (:mod:`ngfracture.run.invariants`).
     message : str
     from_kept : bool
         The increment solve started from the tangent kept from the step before.
@@ -116,6 +117,8 @@ class Attempt:
     broken_through : bool
         The relaxation stopped because the body came apart (Scene.stop_when_unloaded): no
         crack pass judged the separated pieces.
+    overlap : float
+        Overlap area between the pieces at the end (:mod:`ngfracture.run.invariants`).
     """
     problem: object
     x: float
@@ -130,6 +133,7 @@ class Attempt:
     notes: list
     kept_tangent: bool = False
     broken_through: bool = False
+    overlap: float = 0.0
 
 
 @dataclass(frozen=True)

@@ -249,3 +249,47 @@ def format_parameters(func):
 
 __all__ = ["load_scene_function", "scene_parameters", "parse_assignments", "convert_value",
            "builtin_scenes", "format_parameters"]
+
+
+def build_scene(make_scene, spec, params):
+    """Call a scene function; what goes wrong in it is the user's input, said as such.
+
+    Parameters
+    ----------
+    make_scene : callable
+        The scene function (:func:`load_scene_function`).
+    spec : str
+        How the user named it (for messages).
+    params : dict
+        Its keyword arguments.
+
+    Returns
+    -------
+    Scene
+
+    Raises
+    ------
+    ValueError
+        The function raised (its exception type and message, and the function named), or
+        returned something other than a Scene (what it returned).
+    """
+    from .scene import Scene
+    name = getattr(make_scene, "__qualname__", repr(make_scene))
+    try:
+        scene = make_scene(**params)
+    except Exception as exc:       # noqa: BLE001 - any error of the user's function is bad input
+        raise ValueError(f"scene {spec!r}: its function {name}({_call(params)}) raised "
+                         f"{type(exc).__name__}: {exc}") from exc
+    if not isinstance(scene, Scene):
+        raise ValueError(f"scene {spec!r}: its function {name}({_call(params)}) returned "
+                         f"{type(scene).__module__}.{type(scene).__qualname__} {_short(scene)}, not an ngfracture Scene")
+    return scene
+
+
+def _call(params):
+    return ", ".join(f"{k}={v!r}" for k, v in params.items())
+
+
+def _short(value):
+    text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."

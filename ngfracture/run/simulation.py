@@ -22,6 +22,7 @@ from ..fracture.criterion import ONE_RING_NOTE
 from ..fracture.fragments import FragmentStatistics
 from ..linalg.sparse import single_threaded_blas
 from ..mechanics.problem import ElasticProblem
+from . import checkpoint
 from .control import StepControl
 from .files import RunFiles, check_folder, read_resumable
 from .scene import Scene
@@ -29,11 +30,21 @@ from .state import crack_length
 from .step import LoadStep
 from .timings import Timings
 
-__all__ = ["Simulation", "RunResult", "Scene", "StepControl", "MeshDependentCriterion"]
+__all__ = ["Simulation", "RunResult", "Scene", "StepControl", "MeshDependentCriterion", "LinearAtLargeStrain",
+           "LINEAR_STRAIN_LIMIT"]
+
+#: critical strains above this in a linear-elastic region draw a warning: the linear model
+#: is not frame invariant (a rigid rotation by t strains it by about t^2 / 2), so where
+#: pieces strain or turn this much its stresses are an artefact (docs/limitations.md)
+LINEAR_STRAIN_LIMIT = 0.01
 
 
 class MeshDependentCriterion(UserWarning):
     """A scene without a critical distance or toughness: its cracks depend on the mesh."""
+
+
+class LinearAtLargeStrain(UserWarning):
+    """A linear-elastic region that cracks only at strains where the linear model is not valid."""
 
 
 class Simulation:
@@ -82,6 +93,8 @@ class Simulation:
     MeshDependentCriterion
         The scene has neither a critical distance nor a toughness (the paper's one-ring
         criterion decides; summary.json says so too).
+    LinearAtLargeStrain
+        A linear-elastic region with a critical strain above ``LINEAR_STRAIN_LIMIT``.
     """
 
     def __init__(self, scene, control=None, out=None, force=False, resume=False, pictures="final",
@@ -118,6 +131,11 @@ class Simulation:
                 read_resumable(self.out, self._identity())
         if self.criterion.one_ring:
             warnings.warn(f"Scene {scene.name!r}: {ONE_RING_NOTE}", MeshDependentCriterion, stacklevel=2)
+        for region in _linear_at_large_strain(scene):
+            warnings.warn(f"Scene {scene.name!r}: region {region!r} is linear elastic and cracks only above a "
+                          f"strain of {LINEAR_STRAIN_LIMIT:g}, where the linear model is not frame invariant "
+                          f"(rotations strain it); use StVenantKirchhoff or NeoHookean", LinearAtLargeStrain,
+                          stacklevel=2)
 
     def _check_load(self):
         """Build the problem at x = 0, at the first increment and at the final load: the scene's materials,
@@ -142,21 +160,21 @@ class Simulation:
         options = {**{k: v for k, v in asdict(self.control).items() if k != "max_steps"}, "contact": self.contact}
         return {"scene": self.scene.name, "parameters": self.scene.parameters, "control": options}
 
-    def _start(self, stepper, t0):
-        """The first state of the run and its files: (state, files, area_initial, wall seconds before).
+    def _start(self, stepper, area_initial, t0):
+        """The first state of the run and its files: (state, files, wall seconds before).
 
         A resumed run continues from its newest checkpoint (the timings and wall time of
         the earlier part included); a new one writes its state at x = 0.
         """
-        #: math.fsum of the triangle areas; splitting keeps every triangle and coordinate,
-        #: so the final area must equal it to the last bit
-        area_initial = FragmentStatistics(self.scene.mesh).total_area
         if self.resume:
             state, run = read_resumable(self.out, self._identity())
             timings = dict(run.get("timings", {}))
             wall_before = float(timings.pop("wall", 0.0))
             self.timings.update(timings)
-            return state, RunFiles.resume(self.out, state.step, self.pictures), run["area_initial"], wall_before
+            if run["area_initial"] != area_initial:
+                raise checkpoint.CheckpointError(f"{self.out}: the checkpoint's initial area {run['area_initial']!r} "
+                                                 f"is not the scene's {area_initial!r}")
+            return state, RunFiles.resume(self.out, state.step, self.pictures), wall_before
         state = stepper.initial_state(self.timings)
         files = None
         if self.out is not None:
@@ -164,7 +182,7 @@ class Simulation:
             prob = stepper.problem(state.mesh, 0.0, self.timings, state.u)
             files.write_step(state, prob, FragmentStatistics(state.mesh), self.timings)
             files.write_checkpoint(state, self._checkpoint_meta(area_initial, time.perf_counter() - t0), self.timings)
-        return state, files, area_initial, 0.0
+        return state, files, 0.0
 
     def _checkpoint_meta(self, area_initial, wall):
         identity = self._identity()
@@ -189,11 +207,14 @@ class Simulation:
             not an exception; the last good state is written.
         """
         self.timings = Timings()
-        stepper = LoadStep(self.scene, self.control, self.criterion, self.contact)
         t0 = time.perf_counter()
-        state, files, area_initial, wall_before = self._start(stepper, t0)
+        #: math.fsum of the triangle areas; splitting keeps every triangle and coordinate,
+        #: so the area of every accepted state equals it to the last bit
+        area_initial = FragmentStatistics(self.scene.mesh).total_area
+        stepper = LoadStep(self.scene, self.control, self.criterion, self.contact, area_initial)
+        state, files, wall_before = self._start(stepper, area_initial, t0)
         t_start = t0 - wall_before   # a resumed run counts the earlier part
-        reason, message, prob, stats = "load_max", "reached the final load", None, None
+        reason, message, prob, stats, failure = "load_max", "reached the final load", None, None, None
         while True:
             reason, message = self._ending(stepper, state) or (reason, message)
             if reason != "load_max" or state.x >= self.scene.load_max * (1 - 1e-12):
@@ -203,9 +224,11 @@ class Simulation:
             dx = remaining if remaining - state.dx < self.control.dx_min else state.dx
             outcome = stepper.step(state, dx, self.timings)
             if outcome.attempt is None:
-                reason = "failed"
+                reason, err = "failed", outcome.failure
                 message = (f"step {state.step + 1} at x = {state.x + outcome.dx:.6g} failed {outcome.log.retries} "
-                           f"time(s); last reason {outcome.failure.reason}: {outcome.failure.message}")
+                           f"time(s); last reason {err.reason}: {err.message}")
+                failure = {"step": state.step + 1, "x": state.x + outcome.dx, "retries": outcome.log.retries,
+                           "reason": err.reason, "phase": err.phase, "message": err.message}
                 break
             accepted = stepper.accept(state, outcome, self.timings)
             state, prob, stats = accepted.state, accepted.problem, accepted.fragments
@@ -222,6 +245,8 @@ class Simulation:
             files.write_checkpoint(state, self._checkpoint_meta(area_initial, time.perf_counter() - t_start),
                                    self.timings)
         summary = self._summary(state, prob, stats, area_initial, reason, message, time.perf_counter() - t_start)
+        if failure is not None:
+            summary["failure"] = failure       # what failed last, machine-readable
         if files is not None:
             files.write_final(state, prob, stats, summary, self.timings)
         return RunResult(ok=reason in ("load_max", "max_steps", "broken"), reason=reason, message=message,
@@ -271,6 +296,16 @@ class Simulation:
             "history": hist,
             "timings": {**{k: round(v, 6) for k, v in self.timings.items()}, "wall": round(wall, 6)},
         }
+
+
+def _linear_at_large_strain(scene):
+    """The regions of a scene with a linear material and a critical strain above the limit."""
+    from ..mechanics.materials import LinearElastic
+    regions = sorted(set(scene.mesh.GetMaterials()))
+    materials = scene.material if isinstance(scene.material, dict) else dict.fromkeys(regions, scene.material)
+    critical = scene.critical if isinstance(scene.critical, dict) else dict.fromkeys(regions, scene.critical)
+    return [r for r in regions if isinstance(materials.get(r), LinearElastic)
+            and critical.get(r) is not None and critical[r] > LINEAR_STRAIN_LIMIT]
 
 
 @dataclass

@@ -39,6 +39,7 @@ from ..linalg import bordered
 from ..mechanics.tangent import SavedTangent
 from ..mechanics.problem import ElasticProblem
 from .loadpath import load_path_cut, prescribed_increment
+from .invariants import check_state
 from .records import AcceptedStep, Attempt, CrackPass, Equilibrium, StepFailed, StepLog, StepOutcome, TooManyCracks
 from .state import State, crack_length, round_trip
 from . import tangents
@@ -68,10 +69,13 @@ class LoadStep:
         The scene's crack criterion.
     contact : {"auto", "never"}
         See :class:`ngfracture.run.simulation.Simulation`.
+    area_initial : float
+        ``math.fsum`` of the scene's reference triangle areas (the area invariant).
     """
 
-    def __init__(self, scene, control, criterion, contact="auto"):
+    def __init__(self, scene, control, criterion, contact, area_initial):
         self.scene, self.control, self.criterion, self.contact = scene, control, criterion, contact
+        self.area_initial = area_initial
 
     # -- the physics of one configuration ------------------------------------------------------
     def problem(self, mesh, x, timings, u=None, check_mesh=True, triangle_piece=None):
@@ -307,6 +311,8 @@ class LoadStep:
         while True:
             try:
                 attempt = self.attempt(state, dx, log.method, timings, log.substeps, keep)
+                if not isinstance(attempt, TooManyCracks):
+                    attempt.overlap = self.check(attempt.problem, timings)
             except StepFailed as err:
                 log.retries += 1
                 log.failures.append(err.reason)
@@ -333,6 +339,32 @@ class LoadStep:
             log.kept_tangent = attempt.kept_tangent
             log.notes = _merged(log.notes, attempt.notes)
             return StepOutcome(attempt, dx, log)
+
+    def check(self, prob, timings):
+        """The invariants of an attempt's result (:mod:`ngfracture.run.invariants`).
+
+        Parameters
+        ----------
+        prob : ElasticProblem
+            The equilibrium at the end of the attempt.
+        timings : Timings
+
+        Returns
+        -------
+        float
+            The overlap area between the pieces (0 where nothing can overlap).
+
+        Raises
+        ------
+        StepFailed
+            Naming the invariant broken (phase "invariant").
+        """
+        with timings.timed("checks"):
+            pieces = self.scene.contact or "crack" in prob.mesh.GetBoundaries() or prob.fragments()[0] > 1
+            violation, overlap = check_state(prob, self.area_initial, pieces)
+        if violation is not None:
+            raise StepFailed(violation.invariant, "invariant", violation.message)
+        return overlap
 
     @staticmethod
     def increment_work(state, prob):
@@ -411,7 +443,7 @@ class LoadStep:
                   "retries": int(log.retries), "failures": list(log.failures),
                   "substeps": int(log.substeps), "method": log.method,
                   "relax_passes": max(len(attempt.split_positions) - 1, 0), "notes": list(log.notes),
-                  "kept_tangent": bool(log.kept_tangent)}
+                  "kept_tangent": bool(log.kept_tangent), "overlap_area": float(attempt.overlap)}
         if attempt.first_cracks and not any(h["split_vertices"] for h in state.history):
             # where cracking began: the vertices split by the first pass that split any
             record["initiation"] = attempt.split_positions[0].tolist()

@@ -1,0 +1,114 @@
+"""What every accepted step keeps: area to the last bit, no inverted triangle, no overlap.
+
+A load step's attempt is judged before it is accepted (:meth:`ngfracture.run.step.LoadStep.step`);
+one that breaks an invariant is not accepted but retried as a failed solve is (full Newton,
+then a smaller increment), and when the retries run out the run ends with the invariant,
+the step and the size of the violation in its reason.
+
+* **Area**: splitting copies vertices and renumbers triangles, it never moves a
+  coordinate, so ``math.fsum`` of the reference triangle areas equals the scene's to the
+  last bit.
+* **No inverted triangle**: every triangle of the deformed configuration keeps a positive
+  area (for P1, det F > 0). The nonlinear models' Newton solves check det F at every
+  iterate; the linear model has no such notion, so this is where an inverted triangle
+  of a linear run is found.
+* **No overlap**: the deformed pieces (fragments, and the two lips of a crack) overlap by
+  at most :data:`OVERLAP_TOL` of the body's area, measured exactly by
+  :func:`ngfracture.contact.overlap.fragment_overlap_area`. Contact keeps penetration
+  below 1e-10 of its detection threshold, a length; the overlap of the polygonal lips that
+  remains is of second order in that (the scenes end with 1e-16 of the area or less,
+  docs/verification.md). A run without contact (``contact="never"``) is held to the same
+  bound: pieces that only separate never overlap.
+
+The checks cost a few percent of a run (docs/performance.md): the overlap is measured only
+where there are cracks or separate bodies.
+"""
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..contact.overlap import fragment_overlap_area
+from ..fracture.fragments import FragmentStatistics
+from ..fracture.strain import vertex_displacement
+
+__all__ = ["OVERLAP_TOL", "Violation", "check_state"]
+
+#: overlap accepted between pieces, relative to the body's area
+OVERLAP_TOL = 1e-10
+
+
+@dataclass(frozen=True)
+class Violation:
+    """An invariant an attempt breaks.
+
+    Parameters
+    ----------
+    invariant : {"area", "inverted_element", "overlap"}
+    size : float
+        How much: the area difference, the smallest deformed triangle area, or the
+        overlap area.
+    message : str
+        Says what, where and how much, against which tolerance.
+    """
+    invariant: str
+    size: float
+    message: str
+
+
+def deformed_areas(points, triangles, U):
+    """Signed areas of the triangles in the deformed configuration (positive: not inverted).
+
+    Parameters
+    ----------
+    points : numpy.ndarray (nv, 2)
+        Reference coordinates.
+    triangles : numpy.ndarray (ne, 3)
+        Counter-clockwise in the reference configuration.
+    U : numpy.ndarray (nv, 2)
+        Vertex displacements.
+
+    Returns
+    -------
+    numpy.ndarray (ne,)
+    """
+    x = points + U
+    a, b, c = x[triangles[:, 0]], x[triangles[:, 1]], x[triangles[:, 2]]
+    return 0.5 * ((b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0]))
+
+
+def check_state(problem, area_initial, with_overlap):
+    """The first invariant a solved problem breaks, or None.
+
+    Parameters
+    ----------
+    problem : ElasticProblem
+        The equilibrium at the end of an attempt.
+    area_initial : float
+        ``math.fsum`` of the scene's reference triangle areas.
+    with_overlap : bool
+        Measure the overlap (there are cracks or separate bodies).
+
+    Returns
+    -------
+    violation : Violation or None
+    overlap : float
+        The overlap area (0 when not measured), for the step's record.
+    """
+    area = FragmentStatistics(problem.mesh).total_area
+    if area != area_initial:
+        return Violation("area", area - area_initial,
+                         f"the reference area is {area!r}, not {area_initial!r}"), 0.0
+    arrays = problem.arrays
+    U = vertex_displacement(problem.u)
+    deformed = deformed_areas(arrays.points, arrays.triangles, U)
+    worst = int(np.argmin(deformed))
+    if not deformed[worst] > 0:
+        return Violation("inverted_element", float(deformed[worst]),
+                         f"triangle {worst} is inverted in the deformed configuration (area "
+                         f"{deformed[worst]:.3g})"), 0.0
+    overlap = fragment_overlap_area(problem) if with_overlap else 0.0
+    if not overlap <= OVERLAP_TOL * area_initial:
+        return Violation("overlap", overlap,
+                         f"pieces overlap by {overlap:.3g} ({overlap / area_initial:.2g} of the area; "
+                         f"at most {OVERLAP_TOL:g} of it is accepted)"), overlap
+    return None, overlap
