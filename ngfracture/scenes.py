@@ -9,6 +9,8 @@ pass it to :class:`ngfracture.run.simulation.Simulation`.
   boundary expands; contact passes the expansion on; radial cracks grow from the hole
   while the outer ring stays whole.
 * :func:`disintegration`: the same disk expanded further, until it falls apart.
+* :func:`beam`: a notched beam in three-point bending; its crack grows one event per load
+  step at its critical load, through the peak of the load-displacement curve.
 
 Every scene judges cracks at a critical distance ``radius`` (docs/criterion.md);
 ``radius=None`` selects the paper's one-ring criterion.
@@ -350,6 +352,138 @@ def disintegration(maxh=0.08, expansion=None, dx=None, core_stiffness=0.1, E=GLA
 
 
 #: the scenes of ``python -m ngfracture run``
-SCENES = {"plate": plate, "disk": disk, "disintegration": disintegration}
+
+
+BEAM_LOAD = "downward displacement of the loading pad on the beam's top (length; the beam's height is 1)"
+
+
+def senb_factor(alpha):
+    """The SENB geometry factor f(a/W) of a beam of span 4W (Srawley 1976; 0.5 % for any a/W).
+
+    K_I = P S / (B W^(3/2)) f(a/W) for the load P at mid-span, the span S = 4 W.
+
+    Parameters
+    ----------
+    alpha : float
+        a / W in [0, 1).
+
+    Returns
+    -------
+    float
+    """
+    a = float(alpha)
+    return (3 * math.sqrt(a) * (1.99 - a * (1 - a) * (2.15 - 3.93 * a + 2.7 * a * a))
+            / (2 * (1 + 2 * a) * (1 - a) ** 1.5))
+
+
+def notched_beam_mesh(maxh=0.1, fine=0.01, notch=0.3, span=4.0, overhang=0.2, pad=0.05):
+    """A beam of height 1 with a V-notch in the middle of its bottom edge (three-point bending).
+
+    Boundaries: ``support_left``, ``support_right`` (short segments of width ``pad`` at the
+    supports), ``load`` (the pad at mid-span on top), ``notch``, ``surface`` (the rest).
+    Regions: ``ligament`` (a band of width 1 around the notch, where cracks may run) and
+    ``beam``. The mesh is ``fine`` along the line above the notch and around its tip.
+
+    Parameters
+    ----------
+    maxh, fine : float
+        Mesh size, and the size along the crack's path.
+    notch : float
+        Notch depth a / W (its opening is a tenth of ``fine`` ... a fifth of the depth).
+    span, overhang, pad : float
+        Distance between the supports, the beam beyond them, the width of supports and pad.
+
+    Returns
+    -------
+    ngsolve.Mesh
+
+    Raises
+    ------
+    ValueError
+        Sizes that are not finite positive numbers, or a notch that does not fit.
+    """
+    for name, v in (("maxh", maxh), ("fine", fine), ("notch", notch), ("span", span), ("pad", pad)):
+        _positive(name, v)
+    if not notch < 0.8:
+        raise ValueError(f"notch must be a / W < 0.8, got {notch!r}")
+    length = span + 2 * overhang
+    c, w, half = length / 2, min(0.2 * notch, 0.01), 0.5
+    geo = SplineGeometry()
+    pts = [(0, 0), (overhang - pad / 2, 0), (overhang + pad / 2, 0), (c - half, 0), (c - w / 2, 0), (c, notch),
+           (c + w / 2, 0), (c + half, 0), (length - overhang - pad / 2, 0), (length - overhang + pad / 2, 0),
+           (length, 0), (length, 1), (c + half, 1), (c + pad / 2, 1), (c - pad / 2, 1), (c - half, 1), (0, 1)]
+    P = [geo.AppendPoint(x, y, maxh=fine) if (x, y) == (c, notch) else geo.AppendPoint(x, y) for x, y in pts]
+    # (start, end, boundary, region on the left): the ligament band is region 2
+    edges = [(0, 1, "surface", 1), (1, 2, "support_left", 1), (2, 3, "surface", 1), (3, 4, "surface", 2),
+             (4, 5, "notch", 2), (5, 6, "notch", 2), (6, 7, "surface", 2), (7, 8, "surface", 1),
+             (8, 9, "support_right", 1), (9, 10, "surface", 1), (10, 11, "surface", 1), (11, 12, "surface", 1),
+             (12, 13, "surface", 2), (13, 14, "load", 2), (14, 15, "surface", 2), (15, 16, "surface", 1),
+             (16, 0, "surface", 1)]
+    for a, b, name, left in edges:
+        geo.Append(["line", P[a], P[b]], bc=name, leftdomain=left, rightdomain=0)
+    geo.Append(["line", P[3], P[15]], bc="band", leftdomain=1, rightdomain=2)
+    geo.Append(["line", P[7], P[12]], bc="band", leftdomain=2, rightdomain=1)
+    geo.SetMaterial(1, "beam")
+    geo.SetMaterial(2, "ligament")
+    mp = MeshingParameters(maxh=maxh)
+    mp.RestrictHLine(p1=Pnt(c, notch, 0), p2=Pnt(c, 1, 0), maxh=fine)
+    return ng.Mesh(geo.GenerateMesh(mp=mp))
+
+
+def beam(maxh=0.1, radius=0.04, notch=0.3, deflection_max=None, dx=None, E=GLASS["E"], nu=GLASS["nu"],
+         critical=GLASS["critical"]):
+    """A notched glass beam in three-point bending (SENB), pressed down at mid-span.
+
+    Span 4, height 1, a V-notch of depth ``notch`` under the load; the beam rests on two
+    short supports (u_y = 0, the left one also u_x = 0) and a pad on its top is moved
+    down by x. Cracks may run in the band of width 1 above the notch (the rest never
+    cracks: no spurious cracks at the supports and the pad). The crack grows one event per
+    load step at the load that makes it critical (StepControl growth "critical"), so the
+    load-displacement curve (force_displacement.png) is followed through its peak and its
+    descending branch; its peak is the LEFM load P = K_c W^(3/2) / (S f(a/W)) with the
+    criterion's toughness K_c = E critical sqrt(2 pi radius) (:func:`senb_factor`).
+
+    Parameters
+    ----------
+    maxh : float
+        Mesh size away from the crack's path (radius / 4 along it).
+    radius : float
+        Critical distance.
+    notch : float
+        Notch depth a / W.
+    deflection_max : float, optional
+        The final deflection; default eight times the LEFM deflection at the peak by beam theory.
+    dx : float, optional
+        First increment; default an eighth of that deflection.
+    E, nu, critical : float
+        The glass (St Venant-Kirchhoff, plane stress) and its critical strain.
+
+    Returns
+    -------
+    Scene
+    """
+    maxh, radius = _positive("maxh", maxh), _positive("radius", radius)
+    fine = min(maxh, radius / 4)
+    mesh = notched_beam_mesh(maxh, fine, notch)
+    material = StVenantKirchhoff(E, nu, plane="stress")
+    peak = E * critical * math.sqrt(2 * math.pi * radius) / (4 * senb_factor(notch))
+    # beam theory: delta = P S^3 / (48 E I), I = 1/12; the notch and shear add to it
+    deflection = 16 * peak / E
+    deflection_max = 8 * deflection if deflection_max is None else _positive("deflection_max", deflection_max)
+    dx = deflection / 8 if dx is None else _positive("dx", dx)
+
+    def apply_load(prob, x):
+        prob.add_dirichlet("support_left", (0.0, 0.0))
+        prob.add_dirichlet("support_right", 0.0, component="y")
+        prob.add_dirichlet("load", -x, component="y")
+
+    return Scene(name="beam", mesh=mesh, material=material, critical={"ligament": critical}, apply_load=apply_load,
+                 load_max=deflection_max, dx=dx, contact_tol=1e-3 * fine, stop_when_unloaded=True, radius=radius,
+                 load_description=BEAM_LOAD, control={"growth": "critical", "max_steps": 1000},
+                 parameters={"maxh": maxh, "radius": radius, "notch": notch, "deflection_max": deflection_max, "dx": dx,
+                             "E": E, "nu": nu, "critical": critical, "lefm_peak_load": peak})
+
+
+SCENES = {"plate": plate, "disk": disk, "disintegration": disintegration, "beam": beam}
 #: what the load parameter x of each scene is (Scene.load_description)
-LOAD_DESCRIPTIONS = {"plate": PLATE_LOAD, "disk": DISK_LOAD, "disintegration": DISK_LOAD}
+LOAD_DESCRIPTIONS = {"plate": PLATE_LOAD, "disk": DISK_LOAD, "disintegration": DISK_LOAD, "beam": BEAM_LOAD}

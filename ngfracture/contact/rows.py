@@ -356,10 +356,17 @@ def select_contacts(coords, displacement, tris, boundary_edges, pairs, tol=0.0,
         g=gap_offset(X, ids[:, 0], ids[:, 1], ids[:, 2], geo[:, 0], geo[:, 1:3]), nv=X.shape[0])
 
 
+#: a master edge shorter than this fraction of its reference length counts as squeezed to a
+#: point (relinearise_node_to_segment): below it its direction is rounding
+DEGENERATE_EDGE = 1e-8
+
+
 def relinearise_node_to_segment(cs, X, U):
     """The rows of cs with normal and projection of the master edge at X + U (eq. 13, 14).
 
-    Rows snapped to a node (xi = 0 or 1) stay node-to-node; the normal keeps its side.
+    Rows snapped to a node (xi = 0 or 1) stay node-to-node; the normal keeps its side. A
+    master edge squeezed below ``DEGENERATE_EDGE`` of its reference length keeps its
+    previous normal and xi (a node-to-point row).
 
     Parameters
     ----------
@@ -380,10 +387,16 @@ def relinearise_node_to_segment(cs, X, U):
     x = X + U
     e = x[cs.c] - x[cs.a]
     length2 = np.einsum("ij,ij->i", e, e)
-    n = np.column_stack([e[:, 1], -e[:, 0]]) / np.sqrt(length2)[:, None]
+    # a master edge squeezed to (nearly) a point has no direction of its own: it keeps the
+    # normal and projection it had, a node-to-point row (finite: never NaN rows)
+    reference2 = np.einsum("ij,ij->i", X[cs.c] - X[cs.a], X[cs.c] - X[cs.a])
+    degenerate = ~(length2 > DEGENERATE_EDGE ** 2 * reference2)
+    safe2 = np.where(degenerate, 1.0, length2)
+    n = np.column_stack([e[:, 1], -e[:, 0]]) / np.sqrt(safe2)[:, None]
     n *= np.where(np.einsum("ij,ij->i", n, cs.normal) < 0, -1.0, 1.0)[:, None]
-    t = np.einsum("ij,ij->i", x[cs.slave] - x[cs.a], e) / length2
-    xi = np.where((cs.xi == 0.0) | (cs.xi == 1.0), cs.xi, np.clip(1.0 - t, 0.0, 1.0))
+    n[degenerate] = cs.normal[degenerate]
+    t = np.einsum("ij,ij->i", x[cs.slave] - x[cs.a], e) / safe2
+    xi = np.where((cs.xi == 0.0) | (cs.xi == 1.0) | degenerate, cs.xi, np.clip(1.0 - t, 0.0, 1.0))
     dist = np.einsum("ij,ij->i", x[cs.slave] - xi[:, None] * x[cs.a] - (1 - xi)[:, None] * x[cs.c], n)
     return ContactConstraints(cs.slave, cs.a, cs.c, cs.master_tri, cs.slave_tri, cs.pair, xi, n,
                               dist, cs.angle, gap_offset(X, cs.slave, cs.a, cs.c, xi, n), nv=len(X))

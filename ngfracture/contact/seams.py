@@ -275,8 +275,8 @@ def _facet_rows(seams, X, x, kink_angle, slip):
     n_ref = _outward(X[q] - X[p])
     length = np.linalg.norm(n_ref, axis=1)
     n_ref /= length[:, None]
-    n_cur = _outward((x[q] - x[p]) + (x[q2] - x[p2]))
-    n_cur /= np.linalg.norm(n_cur, axis=1)[:, None]
+    # the current facets' mean normal; where both lips are squeezed to a point, the reference one
+    n_cur = _unit_or(_outward((x[q] - x[p]) + (x[q2] - x[p2])), n_ref)
     # orient every end as (low vertex, high vertex) so both facets of a node pair agree
     b, b2, f = ends.T
     sign = np.where(b < b2, 1.0, -1.0)
@@ -294,7 +294,7 @@ def _facet_rows(seams, X, x, kink_angle, slip):
     group = np.cumsum(first) - 1
     normal = np.zeros((first.sum(), 2))
     np.add.at(normal, group, nc)
-    normal /= np.linalg.norm(normal, axis=1)[:, None]
+    normal = _unit_or(normal, nr[first])         # opposite facet normals cancel: the first's
     size = np.full(first.sum(), np.inf)
     np.minimum.at(size, group, ln)
     lo, hi = lo[first], hi[first]
@@ -345,6 +345,15 @@ def _diagonal_rows(seams, X, x, slip, choose):
 def _unit(v):
     """Rows of v scaled to unit length (zero rows stay zero)."""
     return v / np.maximum(np.linalg.norm(v, axis=1), 1e-300)[:, None]
+
+
+def _unit_or(v, fallback):
+    """Rows of v scaled to unit length; rows of (nearly) zero length take ``fallback``'s."""
+    norm = np.linalg.norm(v, axis=1)
+    small = ~(norm > 1e-12 * np.maximum(np.abs(v).max(initial=0.0), 1e-300))
+    out = v / np.where(small, 1.0, norm)[:, None]
+    out[small] = fallback[small]
+    return out
 
 
 def _outward(v):

@@ -170,6 +170,16 @@ class ElasticProblem:
         self._form = None
         self._internal = None
 
+    @property
+    def loads(self):
+        """The dead loads added so far: tuples (kind "volume" or "boundary", CF, boundary or None).
+
+        Returns
+        -------
+        tuple
+        """
+        return tuple(self._loads)
+
     # -- the discrete operators ----------------------------------------------------------
     #: below this many dofs assembly runs serially: starting NGSolve's task manager costs
     #: more than it saves (measured in a Jupyter kernel: a tutorial ran 4x slower with it)

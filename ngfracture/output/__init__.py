@@ -5,6 +5,7 @@ vtk         a mesh and its fields as VTK data (pyvista objects or numpy arrays)
 vtkxml      VTK XML files (.vtu, .vtp) from numpy arrays, without VTK
 timeseries  ``TimeSeriesWriter``: one .vtu and one .vtp per step, .pvd collections
 pictures    ``final.png`` of the deformed pieces and the fragment-size plot, headless
+curves      the load-displacement curve: ``force_displacement.csv`` and ``.png``
 
 The public names of these modules are re-exported here.
 """
@@ -12,6 +13,8 @@ from .atomic import *      # noqa: F401,F403
 from .vtk import *         # noqa: F401,F403
 from .timeseries import *  # noqa: F401,F403
 from .pictures import *    # noqa: F401,F403
-from . import atomic as _atomic, pictures as _pictures, timeseries as _timeseries, vtk as _vtk
+from .curves import *      # noqa: F401,F403
+from . import atomic as _atomic, curves as _curves, pictures as _pictures, timeseries as _timeseries, vtk as _vtk
 
-__all__ = list(_atomic.__all__) + list(_vtk.__all__) + list(_timeseries.__all__) + list(_pictures.__all__)
+__all__ = (list(_atomic.__all__) + list(_vtk.__all__) + list(_timeseries.__all__) + list(_pictures.__all__)
+           + list(_curves.__all__))

@@ -47,6 +47,17 @@ class StepControl:
         passes; docs/criterion.md); the default for a scene with a critical distance
         (``Scene.radius``) unless the scene's or the user's control sets it.
 
+    growth : {"fixed", "critical"}
+        How a crack grows within a load step. "fixed" (the paper's): at the step's load,
+        pass after pass until nothing splits, the unstable part of a crack's growth in one
+        step. "critical": one split event per load step, at the load that makes the crack
+        just critical (found by a few equilibria, lowered where the grown crack is critical
+        below the step's load): the load-displacement curve through its peak, its
+        descending branch and snap-back, a crack passing a hole resolved event by event;
+        ``max_new_cracks`` does not apply. A scene loaded by tractions or body forces
+        (force control) cracks at its critical load in either mode; with "fixed" the crack
+        then runs on at that load, as it does under a dead load.
+
     **settings
         The fields above by name (keyword only); the others take their defaults. Only
         these count as set (``explicit``): a Simulation starts from the scene's
@@ -71,6 +82,7 @@ class StepControl:
     maxit: int = 60
     unloaded_fraction: float = 1e-3
     split: str = "spread"
+    growth: str = "fixed"
 
     def __init__(self, **settings):
         names = [f.name for f in fields(self)]
@@ -160,7 +172,8 @@ class StepControl:
                   ("tol", number(self.tol) and 0 < self.tol < 1),
                   ("maxit", integer(self.maxit) and self.maxit >= 1),
                   ("unloaded_fraction", number(self.unloaded_fraction) and 0 < self.unloaded_fraction < 1),
-                  ("split", self.split in ("spread", "all", "one"))]
+                  ("split", self.split in ("spread", "all", "one")),
+                  ("growth", self.growth in ("fixed", "critical"))]
         for name, ok in checks:
             if not ok:
                 raise ValueError(f"StepControl.{name} = {getattr(self, name)!r} is out of range")

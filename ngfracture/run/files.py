@@ -11,6 +11,7 @@ from pathlib import Path
 
 from . import checkpoint
 from ..output.atomic import TEMPORARY_PREFIX, write_json
+from ..output.curves import plot_force_displacement, write_force_displacement_csv
 from ..output.timeseries import TimeSeriesWriter
 from .state import json_round_trip, load_state, save_state
 
@@ -18,7 +19,8 @@ __all__ = ["OWN_PATTERNS", "check_folder", "read_resumable", "RunFiles"]
 
 #: the files a run writes (what ``force`` removes); temporary files of a killed write too
 OWN_PATTERNS = ("step_*.vtu", "cracks_*.vtp", "results.pvd", "cracks.pvd", "checkpoint_*.npz",
-                "summary.json", "final.png", "step_*.png", "fragment_sizes.png", TEMPORARY_PREFIX + "*")
+                "summary.json", "final.png", "step_*.png", "fragment_sizes.png", "force_displacement.csv",
+                "force_displacement.png", TEMPORARY_PREFIX + "*")
 
 
 def check_folder(out, force=False, resume=False, option_names=("force", "resume")):
@@ -201,6 +203,11 @@ class RunFiles:
         if self.pictures != "none":     # ours: a resumed run redraws them
             pictures = final_pictures(self.folder, prob.mesh, prob.u, stats,
                                       picture_scale(state.arrays.points, state.u))
+        if state.history:
+            write_force_displacement_csv(self.folder / "force_displacement.csv", state.history)
+            if self.pictures != "none" and plot_force_displacement(
+                    self.folder / "force_displacement.png", state.history, summary.get("load_description", "")):
+                pictures["force_displacement"] = "force_displacement.png"
         seconds = time.perf_counter() - t0
         timings.add("output", seconds)
         summary["timings"]["output"] = round(timings["output"], 6)

@@ -15,8 +15,24 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["StepFailed", "Equilibrium", "CrackPass", "Attempt", "TooManyCracks", "StepLog", "StepOutcome",
-           "AcceptedStep"]
+__all__ = ["merged_notes", "StepFailed", "Equilibrium", "CrackPass", "Attempt", "Relaxation", "TooManyCracks", "StepLog",
+           "StepOutcome", "AcceptedStep"]
+
+
+def merged_notes(notes, more):
+    """``notes`` followed by those of ``more`` that are not in it yet, in order.
+
+    Parameters
+    ----------
+    notes, more : list of str
+
+    Returns
+    -------
+    list of str
+    """
+    out = list(notes)
+    out.extend(n for n in more if n not in out)
+    return out
 
 
 class StepFailed(Exception):
@@ -33,11 +49,14 @@ class StepFailed(Exception):
     message : str
     from_kept : bool
         The increment solve started from the tangent kept from the step before.
+    details : str
+        More for the record (the traceback of an unexpected error), or "".
     """
 
-    def __init__(self, reason, phase, message, from_kept=False):
+    def __init__(self, reason, phase, message, from_kept=False, details=""):
         super().__init__(f"{reason} ({phase}): {message}")
         self.reason, self.phase, self.message, self.from_kept = reason, phase, message, from_kept
+        self.details = details
 
 
 @dataclass(frozen=True)
@@ -117,6 +136,8 @@ class Attempt:
     broken_through : bool
         The relaxation stopped because the body came apart (Scene.stop_when_unloaded): no
         crack pass judged the separated pieces.
+    lost_support : str
+        Why a loaded piece has lost its support ("" if none): the run ends with this step.
     overlap : float
         Overlap area between the pieces at the end (:mod:`ngfracture.run.invariants`).
     """
@@ -133,7 +154,45 @@ class Attempt:
     notes: list
     kept_tangent: bool = False
     broken_through: bool = False
+    lost_support: str = ""
     overlap: float = 0.0
+
+
+@dataclass
+class Relaxation:
+    """The crack passes and equilibria of an attempt at fixed load.
+
+    Parameters
+    ----------
+    problem : ElasticProblem
+        The last equilibrium (or, with ``lost_support``, the state right after the split).
+    strength : numpy.ndarray or None
+    contact_keys : list of tuple
+    tangent : SavedTangent
+    splits : int
+        Vertices split by the passes after the first.
+    work : float
+        Work of the dead loads on the opening cracks.
+    positions : list of numpy.ndarray
+        Per pass that split: the reference positions of its vertices.
+    iterations : int
+    notes : list of str
+    broken_through : bool
+        Stopped where the body came apart (Scene.stop_when_unloaded).
+    lost_support : str
+        Stopped where a loaded piece lost its support: why ("" otherwise).
+    """
+    problem: object
+    strength: object
+    contact_keys: list
+    tangent: object
+    splits: int
+    work: float
+    positions: list
+    iterations: int
+    notes: list
+    broken_through: bool
+    lost_support: str
 
 
 @dataclass(frozen=True)

@@ -228,7 +228,8 @@ class Simulation:
                 message = (f"step {state.step + 1} at x = {state.x + outcome.dx:.6g} failed {outcome.log.retries} "
                            f"time(s); last reason {err.reason}: {err.message}")
                 failure = {"step": state.step + 1, "x": state.x + outcome.dx, "retries": outcome.log.retries,
-                           "reason": err.reason, "phase": err.phase, "message": err.message}
+                           "reason": err.reason, "phase": err.phase, "message": err.message,
+                           **({"details": err.details} if err.details else {})}
                 break
             accepted = stepper.accept(state, outcome, self.timings)
             state, prob, stats = accepted.state, accepted.problem, accepted.fragments
@@ -256,6 +257,8 @@ class Simulation:
         """(reason, message) when the run ends before another step (step limit, broken), else None."""
         if state.x >= self.scene.load_max * (1 - 1e-12):
             return None
+        if state.history and state.history[-1].get("lost_support"):
+            return "broken", f"at x = {state.x:.6g}: {state.history[-1]['lost_support']}"
         if state.step >= self.control.max_steps:
             return "max_steps", f"stopped after {self.control.max_steps} steps"
         broken = stepper.broken(state, self.timings) if self.scene.stop_when_unloaded and state.history else ""
@@ -267,7 +270,8 @@ class Simulation:
         if self.progress is not None:
             self.progress({"step": state.step, "x": state.x, "load_max": self.scene.load_max,
                            "split_vertices": sum(h["split_vertices"] for h in state.history),
-                           "fragments": state.history[-1]["fragments"], "seconds": time.perf_counter() - t_start})
+                           "fragments": state.history[-1]["fragments"], "seconds": time.perf_counter() - t_start,
+                           "boundaries": accepted.record["boundaries"]})
         if on_step is not None:
             on_step(accepted)
 

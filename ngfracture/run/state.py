@@ -52,6 +52,9 @@ class State:
         makes it again from ``tangent_state``).
     mesh : ngsolve.Mesh or None
         The mesh built from ``arrays`` (not in checkpoints: made again from the arrays).
+    external : numpy.ndarray or None
+        The dead loads' nodal forces at this state (None: the scene has none), for their
+        work over the next increment.
     """
     arrays: MeshArrays
     u: np.ndarray            # P1 displacement vector, VectorH1 layout
@@ -70,6 +73,7 @@ class State:
     tangent_state: np.ndarray = None
     tangent: object = field(default=None, repr=False, compare=False)
     mesh: object = field(default=None, repr=False, compare=False)
+    external: np.ndarray = None
 
 
 def round_trip(mesh):
@@ -147,6 +151,8 @@ def save_state(folder, state, run):
         arrays["strength"] = state.strength
     if state.tangent_state is not None:
         arrays["tangent_state"] = state.tangent_state
+    if state.external is not None:
+        arrays["external"] = state.external
     meta = {"x": state.x, "dx": state.dx, "step": state.step, "quiet": state.quiet, "work": state.work,
             "peak_energy": state.peak_energy, "history": state.history,
             "contact_keys": [list(k) for k in state.contact_keys], **run}
@@ -180,6 +186,6 @@ def load_state(folder):
                   fixed_dofs=arrays["fixed_dofs"], peak_energy=meta.pop("peak_energy"),
                   history=meta.pop("history"), strength=arrays.get("strength"),
                   contact_keys=[tuple(k) for k in meta.pop("contact_keys", [])],
-                  tangent_state=arrays.get("tangent_state"))
+                  tangent_state=arrays.get("tangent_state"), external=arrays.get("external"))
     state.mesh = mesh_from_arrays(state.arrays)
     return state, meta

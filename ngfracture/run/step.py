@@ -29,6 +29,7 @@ Where the paper is vague:
   work - elastic energy is the energy released by cracking.
 """
 import time
+import traceback
 
 import numpy as np
 
@@ -38,20 +39,17 @@ from ..fracture.split import GROWTH_RULES, PAPER_RULES, split_by_tensor, transfe
 from ..linalg import bordered
 from ..mechanics.tangent import SavedTangent
 from ..mechanics.problem import ElasticProblem
+from ..mechanics.resultants import boundary_resultants, load_vector, work_of_forces
 from .loadpath import load_path_cut, prescribed_increment
 from .invariants import check_state
-from .records import AcceptedStep, Attempt, CrackPass, Equilibrium, StepFailed, StepLog, StepOutcome, TooManyCracks
+from .records import (AcceptedStep, Attempt, CrackPass, Equilibrium, StepFailed, StepLog, StepOutcome, TooManyCracks,
+                      merged_notes)
 from .state import State, crack_length, round_trip
+from .timings import Timings
 from . import tangents
+from .growth import critical_event, relax
 
 __all__ = ["LoadStep"]
-
-
-def _merged(notes, more):
-    """``notes`` followed by those of ``more`` not in it yet, in order."""
-    out = list(notes)
-    out.extend(n for n in more if n not in out)
-    return out
 
 
 class LoadStep:
@@ -76,6 +74,8 @@ class LoadStep:
     def __init__(self, scene, control, criterion, contact, area_initial):
         self.scene, self.control, self.criterion, self.contact = scene, control, criterion, contact
         self.area_initial = area_initial
+        #: the scene loads by tractions or body forces (force control), not only by displacements
+        self.dead_loads = bool(self.problem(scene.mesh, float(scene.dx), Timings()).loads)
 
     # -- the physics of one configuration ------------------------------------------------------
     def problem(self, mesh, x, timings, u=None, check_mesh=True, triangle_piece=None):
@@ -159,7 +159,7 @@ class LoadStep:
             timings.add(part, seconds)
         if not status.converged:
             raise StepFailed(status.reason, phase, status.message)
-        return Equilibrium([], tangent, status.iterations, _merged([], status.notes))
+        return Equilibrium([], tangent, status.iterations, merged_notes([], status.notes))
 
     def _contact_equilibrium(self, prob, phase, options, timings, warm, lineage, start):
         """:meth:`equilibrium` with an active set of contact rows."""
@@ -183,7 +183,7 @@ class LoadStep:
                 message = result.status.message
             raise StepFailed(result.reason, phase, message)
         return Equilibrium(result.active_keys, result.tangent, result.status.iterations,
-                           _merged([], result.notes))
+                           merged_notes([], result.notes))
 
     def crack_pass(self, prob, x, strength, tangent, timings):
         """One splitting pass on an equilibrium.
@@ -252,7 +252,52 @@ class LoadStep:
             A solve failed (``from_kept`` when the increment solve started from the kept tangent).
         """
         c = self.control
-        x = state.x + dx
+        if c.growth == "critical" or self.dead_loads:
+            # force control cracks at its critical load (and runs on there unless "critical")
+            x, prob, eq, crack, start, iterations, notes = critical_event(self, state, dx, method, timings,
+                                                                         substeps, keep)
+        else:
+            x = state.x + dx
+            prob, eq, start = self.increment(state, x, method, timings, substeps, keep)
+            crack, iterations, notes = None, eq.iterations, eq.notes
+        work = self.increment_work(state, prob)
+        if prob.loads:        # the dead loads' work over the increment (same mesh, same dofs)
+            forces = load_vector(prob)
+            before = state.external if state.external is not None else np.zeros_like(forces)
+            work += work_of_forces(before, forces, state.u, prob.u.vec.FV().NumPy())
+        if crack is None:
+            crack = self.crack_pass(prob, x, state.strength, eq.tangent, timings)
+            if c.growth == "fixed" and crack.n_split > c.max_new_cracks and dx * c.cut >= c.dx_min:
+                return TooManyCracks(crack.n_split)
+        relaxed = relax(self, prob, crack, eq, x, method, timings)
+        return Attempt(relaxed.problem, x, crack.n_split, crack.n_split + relaxed.splits, relaxed.strength,
+                       relaxed.contact_keys, relaxed.tangent, work + relaxed.work, relaxed.positions,
+                       iterations + relaxed.iterations, merged_notes(notes, relaxed.notes), start is not None,
+                       relaxed.broken_through, relaxed.lost_support)
+
+    def increment(self, state, x, method, timings, substeps=1, keep=True):
+        """The increment's problem at x on the state's mesh and its equilibrium.
+
+        Parameters
+        ----------
+        state : State
+        x : float
+        method : {"modified", "full"}
+        timings : Timings
+        substeps : int
+        keep : bool
+            Start from the tangent the state keeps (modified Newton).
+
+        Returns
+        -------
+        (ElasticProblem, Equilibrium, SavedTangent or None)
+            The problem, its equilibrium, and the kept tangent it started from.
+
+        Raises
+        ------
+        StepFailed
+            The solve failed (``from_kept`` when it started from the kept tangent).
+        """
         prob = self.problem(state.mesh, x, timings, state.u)
         start = tangents.kept_tangent(state, prob, timings) if keep and method == "modified" else None
         try:
@@ -260,28 +305,7 @@ class LoadStep:
         except StepFailed as err:
             err.from_kept = start is not None
             raise
-        work = self.increment_work(state, prob)
-        iterations, notes = eq.iterations, eq.notes
-        crack = self.crack_pass(prob, x, state.strength, eq.tangent, timings)
-        if crack.n_split > c.max_new_cracks and dx * c.cut >= c.dx_min:
-            return TooManyCracks(crack.n_split)
-        first, total, passes, positions, broken = crack.n_split, crack.n_split, 0, [], False
-        while crack.problem is not None:
-            positions.append(crack.positions)
-            passes += 1
-            if passes > c.max_relax_passes:
-                raise StepFailed("relaxation", "relaxation", f"cracks still grow after {c.max_relax_passes} passes at fixed load")
-            prob = crack.problem
-            eq = self.equilibrium(prob, "relaxation", method, timings, warm=eq.contact_keys, lineage=crack.lineage)
-            iterations, notes = iterations + eq.iterations, _merged(notes, eq.notes)
-            if (self.scene.stop_when_unloaded and prob.fragments()[0] > 1
-                    and self.cut_through(prob.arrays, prob.mesh, prob.assemble_constraints(), timings)):
-                broken = True
-                break     # the run ends with this step: no crack in the separated pieces
-            crack = self.crack_pass(prob, x, crack.strength, eq.tangent, timings)
-            total += crack.n_split
-        return Attempt(prob, x, first, total, crack.strength, eq.contact_keys, eq.tangent, work, positions,
-                       iterations, notes, start is not None, broken)
+        return prob, eq, start
 
     def step(self, state, dx, timings):
         """Attempts of one step until one is accepted, or the last failure.
@@ -310,9 +334,7 @@ class LoadStep:
         keep = True
         while True:
             try:
-                attempt = self.attempt(state, dx, log.method, timings, log.substeps, keep)
-                if not isinstance(attempt, TooManyCracks):
-                    attempt.overlap = self.check(attempt.problem, timings)
+                attempt = self._checked_attempt(state, dx, log, timings, keep)
             except StepFailed as err:
                 log.retries += 1
                 log.failures.append(err.reason)
@@ -337,8 +359,22 @@ class LoadStep:
                 dx *= c.cut
                 continue
             log.kept_tangent = attempt.kept_tangent
-            log.notes = _merged(log.notes, attempt.notes)
+            log.notes = merged_notes(log.notes, attempt.notes)
             return StepOutcome(attempt, dx, log)
+
+    def _checked_attempt(self, state, dx, log, timings, keep):
+        """:meth:`attempt` and :meth:`check`; an unexpected error in them is a failed attempt
+        (reason "exception", its type, message and traceback recorded), not a lost run."""
+        try:
+            attempt = self.attempt(state, dx, log.method, timings, log.substeps, keep)
+            if not isinstance(attempt, TooManyCracks):
+                attempt.overlap = self.check(attempt.problem, timings)
+            return attempt
+        except StepFailed:
+            raise
+        except Exception as exc:     # noqa: BLE001 - recorded with its traceback, then retried
+            raise StepFailed("exception", "relaxation", f"{type(exc).__name__}: {exc}",
+                             details=traceback.format_exc()) from exc
 
     def check(self, prob, timings):
         """The invariants of an attempt's result (:mod:`ngfracture.run.invariants`).
@@ -423,11 +459,15 @@ class LoadStep:
         if quiet >= self.control.grow_after:
             new_dx, quiet = min(dx * self.control.grow, self.control.dx_max), 0
         record = self._record(state, attempt, dx, log, energy, work, crack_length(arrays), stats.count)
+        record["boundaries"] = boundary_resultants(prob, out_of_balance)
+        if attempt.lost_support:
+            record["lost_support"] = attempt.lost_support
         new = State(arrays=arrays, u=u, x=attempt.x, dx=new_dx, step=state.step + 1, quiet=quiet, work=work,
                     reactions=-out_of_balance[rows.fixed_dofs], fixed_values=rows.fixed_values.copy(),
                     fixed_dofs=rows.fixed_dofs.copy(), peak_energy=max(state.peak_energy, energy),
                     history=state.history + [record], strength=attempt.strength,
-                    contact_keys=attempt.contact_keys, mesh=mesh)
+                    contact_keys=attempt.contact_keys, mesh=mesh,
+                    external=load_vector(prob) if prob.loads else None)
         kept = tangents.tangent_to_keep(attempt.tangent, log.method, new.fixed_dofs)
         if kept is not None:
             new.tangent_state, new.tangent = kept.state, kept
@@ -466,6 +506,7 @@ class LoadStep:
         rows = prob.assemble_constraints()
         strength = None if self.scene.strength is None else np.array(self.scene.strength, dtype=float)
         return State(arrays=arrays, u=np.zeros(prob.fes.ndof), x=0.0, dx=float(self.scene.dx), step=0,
+                     external=load_vector(prob) if prob.loads else None,
                      quiet=0, work=0.0, reactions=np.zeros(len(rows.fixed_dofs)),
                      fixed_values=rows.fixed_values.copy(), fixed_dofs=rows.fixed_dofs.copy(),
                      peak_energy=0.0, history=[], strength=strength, mesh=mesh)

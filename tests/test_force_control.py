@@ -1,0 +1,99 @@
+"""Fracture under force, and the load-displacement curve through its peak (LEFM checks).
+
+* Edge-cracked strip (SENT) under an end traction: the crack starts at the LEFM load of
+  Tada's geometry factor with the criterion's toughness K_c = E eps_c sqrt(2 pi r), and
+  the run ends broken at that load: under a dead load the crack runs on (no equilibrium).
+* Notched beam in three-point bending (SENB, growth resolved in load): the peak of the
+  load-displacement curve is the LEFM load of the SENB factor, and past the peak the
+  force follows the LEFM load of the grown crack, one split event per step.
+"""
+import csv
+import math
+
+import ngsolve as ng
+import numpy as np
+import pytest
+from netgen.geom2d import SplineGeometry
+from netgen.meshing import MeshingParameters, Pnt
+
+import ngfracture as nf
+from ngfracture.scenes import senb_factor
+
+E, NU, EPS = 1e9, 0.3, 1e-3
+
+
+def tada_sent(alpha):
+    """Tada's geometry factor of a single edge crack in a strip under tension (0.5 % for a/W < 0.6)."""
+    return 0.265 * (1 - alpha) ** 4 + (0.857 + 0.265 * alpha) / (1 - alpha) ** 1.5
+
+
+def sent_scene(a=0.3, r=0.02, h=0.005, height=3.0):
+    """Strip of width 1, a slit-like V-notch of depth a at mid-height, clamped bottom,
+    traction E x on top; the mesh is h along the ligament and around the tip."""
+    geo = SplineGeometry()
+    c = height / 2
+    corners = [(0, 0), (1, 0), (1, height), (0, height), (0, c + 0.004), (a, c), (0, c - 0.004)]
+    names = ["bottom", "right", "top", "left", "notch", "notch", "left"]
+    pts = [geo.AppendPoint(x, y, maxh=h) if (x, y) == (a, c) else geo.AppendPoint(x, y) for x, y in corners]
+    for i, name in enumerate(names):
+        geo.Append(["line", pts[i], pts[(i + 1) % len(pts)]], bc=name, **({"maxh": h} if name == "notch" else {}))
+    mp = MeshingParameters(maxh=0.1)
+    mp.RestrictHLine(p1=Pnt(a, c, 0), p2=Pnt(1, c, 0), maxh=h)
+    for i in range(-4, 5):
+        for j in range(-4, 5):
+            mp.RestrictH(x=a + i * r / 2, y=c + j * r / 2, z=0, h=h)
+
+    def apply_load(prob, x):
+        prob.add_dirichlet("bottom", (0.0, 0.0))
+        prob.add_traction("top", (0.0, E * x))
+
+    x_lefm = EPS * math.sqrt(2 * r / a) / tada_sent(a)       # sigma sqrt(pi a) F = E eps sqrt(2 pi r)
+    scene = nf.Scene(name="sent", mesh=ng.Mesh(geo.GenerateMesh(mp=mp)), material=nf.LinearElastic(E, NU, plane="stress"),
+                     critical=EPS, apply_load=apply_load, load_max=2 * x_lefm, dx=x_lefm / 4, contact_tol=1e-6, radius=r)
+    return scene, x_lefm
+
+
+def test_an_edge_cracked_strip_under_traction_breaks_at_the_lefm_load():
+    scene, x_lefm = sent_scene()
+    steps = []
+    result = nf.Simulation(scene, pictures="none").run(on_step=steps.append)
+    first = next(s for s in steps if s.record["split_vertices"])
+    assert abs(first.state.x / x_lefm - 1) <= 0.05, first.state.x / x_lefm
+    assert result.reason == "broken", result.message
+    assert result.state.x == first.state.x             # no equilibrium at that load any more
+    assert "runs on unstably" in result.message or "lost its support" in result.message
+    assert result.summary["area_final"] == result.summary["area_initial"]
+
+
+@pytest.fixture(scope="module")
+def senb(tmp_path_factory):
+    out = tmp_path_factory.mktemp("senb")
+    scene = nf.scenes.beam(radius=0.02, maxh=0.1)
+    return scene, nf.Simulation(scene, out=out).run(), out
+
+
+def test_the_senb_peak_is_the_lefm_load(senb):
+    scene, result, _ = senb
+    history = result.summary["history"]
+    force = np.array([-h["boundaries"]["load"]["force"][1] for h in history])
+    assert abs(force.max() / scene.parameters["lefm_peak_load"] - 1) <= 0.10, force.max()
+    assert all(h["split_vertices"] <= 1 for h in history)          # one event per step
+    assert history[int(np.argmax(force))]["split_vertices"] == 1    # the peak is a crack event
+
+
+def test_past_the_peak_the_force_follows_the_lefm_load_of_the_grown_crack(senb):
+    scene, result, out = senb
+    p = scene.parameters
+    kc = p["E"] * p["critical"] * math.sqrt(2 * math.pi * p["radius"])
+    ratios = [(-h["boundaries"]["load"]["force"][1]) / (kc / (4 * senb_factor(p["notch"] + h["crack_length"])))
+              for h in result.summary["history"] if h["split_vertices"] and h["crack_length"] <= 0.15]
+    assert len(ratios) >= 10
+    assert all(abs(r - 1) <= 0.15 for r in ratios), ratios
+    # snap-back: past the peak the crack grows at deflections below the peak's, which
+    # displacement control with growth at fixed load would jump over
+    force = [-h["boundaries"]["load"]["force"][1] for h in result.summary["history"]]
+    x = [h["x"] for h in result.summary["history"]]
+    peak = int(np.argmax(force))
+    assert min(x[peak + 1:]) < x[peak]
+    rows = list(csv.reader((out / "force_displacement.csv").open()))
+    assert "load_Fy" in rows[0] and len(rows) == 1 + result.summary["n_steps"]
