@@ -17,6 +17,7 @@ Reported per case:
   solve_equivalents      wall / t_unit: the run in units of one linear solve of its own
                size, a figure that does not depend on the machine's speed
   seconds_per_step, solve_equivalents_per_step
+  checks_share           checks / wall: the invariants judged before every step is accepted
   outside_solve_share    1 - solve / wall: everything outside the Newton solves (crack
                criterion, splitting, rebuilding, collision, contact rows, output)
   outside_fe_share       1 - (linear + assembly) / wall: everything but NGSolve's finite
@@ -111,6 +112,7 @@ def run_case(name, factor, steps=None, one_ring=False):
             "t_unit_after": t_unit_after, "solve_equivalents": wall / t_unit,
             "seconds_per_step": wall / nsteps, "solve_equivalents_per_step": wall / t_unit / nsteps,
             "outside_solve_share": 1.0 - s["timings"]["solve"] / wall,
+            "checks_share": s["timings"].get("checks", 0.0) / wall,     # the invariants of every step
             "outside_fe_share": 1.0 - (linear + assembly) / wall,
             "outside_linear_share": 1.0 - linear / wall}
 

@@ -25,6 +25,7 @@ from .materials import region_materials
 from ..geometry.meshcheck import validate_mesh
 from ..geometry.meshio import mesh_to_arrays
 from .newton import NewtonSolver
+from .pressure import oriented_segments, pressure_stiffness, total_pressure_forces
 
 
 def _double_areas(x, elements):
@@ -95,6 +96,7 @@ class ElasticProblem:
             self.constraints = ConstraintSet(self.fes, arrays)
         self.load_factor = ng.Parameter(0.0)
         self._loads = []      # (kind, CF, region)
+        self._pressures = []  # (boundary, p, its segments)
         self._form = None
         self.arrays = arrays
         self._elements = arrays.triangles
@@ -144,8 +146,7 @@ class ElasticProblem:
             Force per unit reference area (2-vector).
         """
         self._loads.append(("volume", ng.CF(tuple(f)) if not isinstance(f, ng.CoefficientFunction) else f, None))
-        self._form = None
-        self._internal = None
+        self._form = self._internal = None
 
     def add_traction(self, boundary, t):
         """Add a dead traction per unit reference length on a named boundary.
@@ -167,18 +168,73 @@ class ElasticProblem:
         if boundary not in self.mesh.GetBoundaries():
             raise ValueError(f"boundary {boundary!r} does not exist in the mesh; its boundaries are {sorted(set(self.mesh.GetBoundaries()))}")
         self._loads.append(("boundary", ng.CF(tuple(t)) if not isinstance(t, ng.CoefficientFunction) else t, boundary))
-        self._form = None
-        self._internal = None
+        self._form = self._internal = None
+
+    def add_pressure(self, boundary, p):
+        """Add a pressure on a named boundary that follows the deformed surface.
+
+        Scaled by ``load_factor``; ``p`` > 0 pushes into the body; the linear model takes it on
+        the reference configuration (:mod:`ngfracture.mechanics.pressure`).
+
+        Parameters
+        ----------
+        boundary : str
+            Boundary name of the mesh (``"crack"`` for the crack faces, once there are any).
+        p : float
+            The pressure (force per unit length).
+
+        Raises
+        ------
+        ValueError
+            An unknown boundary, a pressure that is not a finite number, or a space of
+            order > 1 (the pressure is implemented for P1).
+        """
+        if boundary not in self.mesh.GetBoundaries():
+            raise ValueError(f"boundary {boundary!r} does not exist in the mesh; its boundaries are {sorted(set(self.mesh.GetBoundaries()))}")
+        if isinstance(p, bool) or not isinstance(p, (int, float)) or not np.isfinite(p):
+            raise ValueError(f"pressure must be a finite number, got {p!r}")
+        if self.order != 1:
+            raise ValueError("pressure loads need a first-order space (order=1)")
+        self._pressures.append((boundary, float(p), oriented_segments(self.arrays, boundary)))
+        self._linear_K = None
+        self._last_residual = None
 
     @property
     def loads(self):
-        """The dead loads added so far: tuples (kind "volume" or "boundary", CF, boundary or None).
+        """The dead loads added so far: tuples (kind "volume", "boundary" or "pressure", CF or p, boundary or None).
 
         Returns
         -------
         tuple
         """
-        return tuple(self._loads)
+        return tuple(self._loads) + tuple(("pressure", p, b) for b, p, _ in self._pressures)
+
+    def pressures(self):
+        """The pressures added so far.
+
+        Returns
+        -------
+        tuple of (str, float, numpy.ndarray)
+            Boundary, pressure, its segments (each with the body on its left).
+        """
+        return tuple(self._pressures)
+
+    def pressure_positions(self, u=None):
+        """The vertex positions pressures act at: current, or the reference ones if linear.
+
+        Parameters
+        ----------
+        u : numpy.ndarray, optional
+            A displacement (ndof,) instead of the current one.
+
+        Returns
+        -------
+        numpy.ndarray (nv, 2)
+        """
+        if not self.nonlinear:
+            return self._points
+        at = self.u.vec.FV().NumPy() if u is None else np.asarray(u, dtype=float)
+        return self._points + at.reshape(2, -1)[:, :self.mesh.nv].T
 
     # -- the discrete operators ----------------------------------------------------------
     #: below this many dofs assembly runs serially: starting NGSolve's task manager costs
@@ -258,9 +314,12 @@ class ElasticProblem:
             with self.threads():
                 form.AssembleLinearization(state)
             K = to_scipy(form.mat)
+        if self._pressures and self.nonlinear:
+            # the follower pressure's stiffness (its symmetric part), at the current load factor
+            K = K - self.load_factor.Get() * sum(pressure_stiffness(s, p, self.fes.ndof) for _, p, s in self._pressures)
         if not self.nonlinear:
             self._linear_K = K
-            self._load = np.zeros(self.fes.ndof)
+            self._load = -total_pressure_forces(self)
             if self._loads:
                 zero = self.u.vec.CreateVector()
                 zero[:] = 0.0
@@ -271,7 +330,7 @@ class ElasticProblem:
                 with self.threads():
                     form.Apply(zero, res)
                 self.load_factor.Set(factor)
-                self._load = res.FV().NumPy().copy()
+                self._load += res.FV().NumPy()
         return K
 
     def out_of_balance(self):
@@ -302,10 +361,12 @@ class ElasticProblem:
             kind, mu, lam, external = kernel
             r = _ext.InternalForces(self._points, self._elements, u, kind, mu, lam)
             r = (load * external - r) if external is not None else -r
+            if self._pressures:
+                r += load * total_pressure_forces(self, u)
         else:
             with self.threads():
                 form.Apply(self.u.vec, self._res)
-            r = -self._res.FV().NumPy().copy()
+            r = -self._res.FV().NumPy().copy() + load * total_pressure_forces(self, u)
         self._last_residual = (u.copy(), load, r)
         return r.copy()
 

@@ -12,12 +12,13 @@ import numpy as np
 import ngsolve as ng
 
 from ..fracture.strain import vertex_displacement
+from .pressure import pressure_forces
 
 __all__ = ["load_vector", "work_of_forces", "boundary_resultants", "unsupported_pieces"]
 
 
 def load_vector(problem, boundary=None):
-    """The external nodal forces of the problem's dead loads, fully applied.
+    """The external nodal forces of the problem's loads, fully applied (pressures at the current configuration).
 
     A solve ramps the loads up with ``problem.load_factor`` from 0 to 1; a solved state
     carries them whole, which is what this returns.
@@ -34,15 +35,21 @@ def load_vector(problem, boundary=None):
         Zero when there are no such loads.
     """
     loads = [(k, cf, r) for k, cf, r in problem.loads if boundary is None or r == boundary]
-    if not loads:
-        return np.zeros(problem.fes.ndof)
+    out = np.zeros(problem.fes.ndof)
+    x = problem.pressure_positions()     # the current configuration (the reference one if linear)
+    for region, p, segments in problem.pressures():
+        if boundary is None or region == boundary:
+            out += pressure_forces(x, segments, p, problem.fes.ndof)
+    dead = [(k, cf, r) for k, cf, r in loads if k != "pressure"]
+    if not dead:
+        return out
     v = problem.fes.TestFunction()
     f = ng.LinearForm(problem.fes)
-    for kind, cf, region in loads:
+    for kind, cf, region in dead:
         f += (cf * v) * (ng.dx if kind == "volume" else ng.ds(region))
     with problem.threads():
         f.Assemble()
-    return f.vec.FV().NumPy().copy()
+    return out + f.vec.FV().NumPy()
 
 
 def work_of_forces(f_start, f_end, u_start, u_end):
@@ -95,7 +102,7 @@ def boundary_resultants(problem, out_of_balance):
     U = vertex_displacement(problem.u)
     X = problem.arrays.points
     names = {name for cond in problem.constraints.dirichlet for name in cond.boundaries}
-    loaded = {r for kind, _, r in problem.loads if kind == "boundary"}
+    loaded = {r for kind, _, r in problem.loads if kind in ("boundary", "pressure")}
     out = {}
     for name in sorted(names | loaded):
         dofs, segments = _boundary_dofs(problem, name)
