@@ -11,7 +11,7 @@ from pathlib import Path
 import ngfracture
 
 PACKAGE = Path(ngfracture.__file__).parent
-DESIGN = PACKAGE.parent / "docs" / "design.md"
+DESIGN = Path(__file__).resolve().parent.parent / "docs" / "design.md"   # the repository, not the installed package
 MAX_FUNCTION_LINES, MAX_MODULE_LINES = 80, 600
 
 
