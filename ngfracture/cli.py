@@ -178,11 +178,12 @@ def progress_json(info):
     -------
     str
         One JSON object: step, load (x), load_max, splits (split vertices so far),
-        fragments, seconds (wall time of the run so far).
+        fragments, seconds (wall time of the run so far), and forces: the force and mean
+        displacement of every loaded boundary (as in ``force_displacement.csv``).
     """
     return json.dumps({"step": info["step"], "load": info["x"], "load_max": info["load_max"],
                        "splits": info["split_vertices"], "fragments": info["fragments"],
-                       "seconds": round(info["seconds"], 3)})
+                       "seconds": round(info["seconds"], 3), "forces": info.get("boundaries", {})})
 
 
 def _print_json_progress(info):

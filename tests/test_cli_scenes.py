@@ -56,7 +56,9 @@ def test_json_progress_is_one_object_per_accepted_step(beam_run):
     s = summary(out)
     records = [json.loads(line) for line in lines]
     assert [r["step"] for r in records] == list(range(1, s["n_steps"] + 1))
-    assert all(set(r) == {"step", "load", "load_max", "splits", "fragments", "seconds"} for r in records)
+    assert all(set(r) == {"step", "load", "load_max", "splits", "fragments", "seconds", "forces"} for r in records)
+    # the forces of every record are those of the step's history record
+    assert [r["forces"] for r in records] == [h["boundaries"] for h in s["history"]]
     # the load of every record is the accepted x of that step, bit for bit
     assert [r["load"] for r in records] == [h["x"] for h in s["history"]]
     splits = [r["splits"] for r in records]
@@ -66,9 +68,11 @@ def test_json_progress_is_one_object_per_accepted_step(beam_run):
 
 
 def test_progress_json_line():
-    info = {"step": 3, "x": 0.25, "load_max": 1.0, "split_vertices": 7, "fragments": 2, "seconds": 1.23456}
+    forces = {"top": {"force": [0.0, 2.5], "displacement": [0.0, 1e-3]}}
+    info = {"step": 3, "x": 0.25, "load_max": 1.0, "split_vertices": 7, "fragments": 2, "seconds": 1.23456,
+            "boundaries": forces}
     assert json.loads(progress_json(info)) == {"step": 3, "load": 0.25, "load_max": 1.0, "splits": 7,
-                                               "fragments": 2, "seconds": 1.235}
+                                               "fragments": 2, "seconds": 1.235, "forces": forces}
 
 
 def test_module_function_and_set_reach_the_builtin_scene(tmp_path, capsys):
