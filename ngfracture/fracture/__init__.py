@@ -5,6 +5,7 @@ strain     fields of a displacement: vertex values, element and nodal strain, st
 criterion  ``Criterion``: critical strain and distance per region, the overstrain of every
            vertex; the critical-distance measure, toughness and critical distance
 split      node splitting by the paper's rules with a netgen rebuild, exact field transfer
+crack_graph  the cracks as a graph: tips, mouths, junctions, branches
 strength   random strength: a Weibull critical strain per vertex, weakest-link size effect
 fragments  fragment statistics (count, areas, centroids)
 

@@ -16,6 +16,8 @@ configuration (a dead load, as its small-strain theory has it).
 import numpy as np
 import scipy.sparse as sp
 
+from ..geometry.meshio import orient_segments
+
 __all__ = ["oriented_segments", "pressure_forces", "pressure_stiffness", "total_pressure_forces"]
 
 
@@ -31,13 +33,7 @@ def oriented_segments(arrays, boundary):
     -------
     numpy.ndarray (m, 2)
     """
-    seg = np.asarray(arrays.boundary_segments(boundary), dtype=np.int64).reshape(-1, 2)
-    T = np.asarray(arrays.triangles, dtype=np.int64)
-    nv = len(arrays.points)
-    # the directed edges of the counter-clockwise triangles: the body is on their left
-    directed = np.concatenate([T[:, [0, 1]], T[:, [1, 2]], T[:, [2, 0]]])
-    left = np.isin(seg[:, 0] * nv + seg[:, 1], directed[:, 0] * nv + directed[:, 1])
-    return np.where(left[:, None], seg, seg[:, ::-1])
+    return orient_segments(arrays.triangles, arrays.boundary_segments(boundary))
 
 
 def pressure_forces(x, segments, p, ndof):

@@ -19,6 +19,7 @@ from pathlib import Path
 
 from ..contact.overlap import fragment_overlap_area
 from ..fracture.criterion import ONE_RING_NOTE
+from ..fracture.crack_graph import crack_graph
 from ..fracture.fragments import FragmentStatistics
 from ..linalg.sparse import single_threaded_blas
 from ..mechanics.problem import ElasticProblem
@@ -287,6 +288,7 @@ class Simulation:
             "n_steps": state.step, "load": state.x,
             "n_split_vertices": int(sum(h["split_vertices"] for h in hist)),
             "crack_length": crack_length(state.arrays),
+            "crack_graph": crack_graph(state.arrays).summary(),
             "n_fragments": int(stats.count), "fragment_areas": stats.areas.tolist(),
             "area_initial": area_initial, "area_final": stats.total_area,
             "max_overlap_area": overlap,
