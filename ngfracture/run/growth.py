@@ -32,15 +32,18 @@ CRITICAL_MARGIN = 1e-3
 CRITICAL_ITERATIONS = 40
 
 
-def max_overstrain(stepper, prob, strength, timings):
-    """The largest overstrain of the problem's vertices (a vertex cracks above 1).
+def max_overstrain(stepper, mesh, u, strength, arrays, timings):
+    """The largest overstrain of a displacement's vertices (a vertex cracks above 1).
 
     Parameters
     ----------
     stepper : LoadStep
-    prob : ElasticProblem
-        A solved problem.
+    mesh : ngsolve.Mesh
+    u : ngsolve.GridFunction or numpy.ndarray
+        The displacement, or its vertex values (nv, 2).
     strength : numpy.ndarray or None
+    arrays : MeshArrays
+        The mesh as arrays.
     timings : Timings
 
     Returns
@@ -48,8 +51,9 @@ def max_overstrain(stepper, prob, strength, timings):
     float
     """
     with timings.timed("strain"):
-        tensors = stepper.criterion.overstrain(prob.mesh, prob.u, strength, arrays=prob.arrays)
+        tensors = stepper.criterion.overstrain(mesh, u, strength, arrays=arrays)
         return float(principal(tensors)[0].max(initial=0.0))
+
 
 def critical_event(stepper, state, dx, method, timings, substeps=1, keep=True):
     """The next crack event of a step with growth resolved in load, and its load.
@@ -83,8 +87,7 @@ def critical_event(stepper, state, dx, method, timings, substeps=1, keep=True):
     notes : list of str
     """
     U = state.u.reshape(2, -1)[:, :state.mesh.nv].T
-    tensors = stepper.criterion.overstrain(state.mesh, U, state.strength, arrays=state.arrays)
-    m_state = float(principal(tensors)[0].max(initial=0.0)) if state.step else 0.0
+    m_state = max_overstrain(stepper, state.mesh, U, state.strength, state.arrays, timings) if state.step else 0.0
     x_try = state.x if m_state >= 1.0 else state.x + dx
     prob, eq, start = stepper.increment(state, x_try, method, timings, substeps, keep)
     x, pc, ec, more = critical_load(stepper, state, x_try, prob, eq, method, timings)
@@ -132,7 +135,7 @@ def critical_load(stepper, state, x_try, prob, eq, method, timings):
     StepFailed
         "critical_load": no load within CRITICAL_ITERATIONS makes the crack just critical.
     """
-    m = max_overstrain(stepper, prob, state.strength, timings)
+    m = max_overstrain(stepper, prob.mesh, prob.u, state.strength, prob.arrays, timings)
     if m <= 1.0:
         return x_try, prob, eq, 0
     target = 1.0 + CRITICAL_MARGIN
@@ -146,7 +149,7 @@ def critical_load(stepper, state, x_try, prob, eq, method, timings):
         prob = stepper.problem(state.mesh, x, timings, state.u)
         eq = stepper.equilibrium(prob, "increment", method, timings, warm=state.contact_keys)
         iterations += eq.iterations
-        m = max_overstrain(stepper, prob, state.strength, timings)
+        m = max_overstrain(stepper, prob.mesh, prob.u, state.strength, prob.arrays, timings)
         if 1.0 <= m <= 1.0 + 2 * CRITICAL_MARGIN:
             return x, prob, eq, iterations
         if m > 1.0:

@@ -125,7 +125,8 @@ class Simulation:
         self.checkpoint_every = checkpoint_every
         self.progress = progress
         self.timings = Timings()
-        self._check_load()              # before the output folder is touched
+        #: the scene loads by tractions, body forces or pressures (force control), found by the check
+        self.dead_loads = self._check_load()      # before the output folder is touched
         if self.out is not None:
             check_folder(self.out, force, resume)
             if resume:
@@ -140,7 +141,9 @@ class Simulation:
 
     def _check_load(self):
         """Build the problem at x = 0, at the first increment and at the final load: the scene's materials,
-        regions and the boundaries its ``apply_load`` names are checked before any work."""
+        regions and the boundaries its ``apply_load`` names are checked before any work. Returns
+        whether the problem at the first increment has loads other than prescribed displacements."""
+        dead_loads = False
         for x in (0.0, float(self.scene.dx), float(self.scene.load_max)):
             try:
                 with warnings.catch_warnings():
@@ -148,9 +151,12 @@ class Simulation:
                     prob = ElasticProblem(self.scene.mesh, self.scene.material, order=1)
                 self.scene.apply_load(prob, x)
                 prob.assemble_constraints()
+                if x == float(self.scene.dx):
+                    dead_loads = bool(prob.loads)
             except Exception as exc:
                 raise ValueError(f"Scene {self.scene.name!r}: the problem at load x = {x:g} cannot be "
                                  f"built: {type(exc).__name__}: {exc}") from exc
+        return dead_loads
 
     def _identity(self):
         """What a checkpoint must match to be resumed by this run.
@@ -212,7 +218,7 @@ class Simulation:
         #: math.fsum of the triangle areas; splitting keeps every triangle and coordinate,
         #: so the area of every accepted state equals it to the last bit
         area_initial = FragmentStatistics(self.scene.mesh).total_area
-        stepper = LoadStep(self.scene, self.control, self.criterion, self.contact, area_initial)
+        stepper = LoadStep(self.scene, self.control, self.criterion, self.contact, area_initial, self.dead_loads)
         state, files, wall_before = self._start(stepper, area_initial, t0)
         t_start = t0 - wall_before   # a resumed run counts the earlier part
         reason, message, prob, stats, failure = "load_max", "reached the final load", None, None, None
@@ -306,11 +312,10 @@ class Simulation:
 
 def _linear_at_large_strain(scene):
     """The regions of a scene with a linear material and a critical strain above the limit."""
-    from ..mechanics.materials import LinearElastic
-    regions = sorted(set(scene.mesh.GetMaterials()))
-    materials = scene.material if isinstance(scene.material, dict) else dict.fromkeys(regions, scene.material)
-    critical = scene.critical if isinstance(scene.critical, dict) else dict.fromkeys(regions, scene.critical)
-    return [r for r in regions if isinstance(materials.get(r), LinearElastic)
+    from ..mechanics.materials import LinearElastic, region_materials
+    materials = region_materials(scene.mesh, scene.material)
+    critical = scene.critical if isinstance(scene.critical, dict) else dict.fromkeys(materials, scene.critical)
+    return [r for r, m in materials.items() if isinstance(m, LinearElastic)
             and critical.get(r) is not None and critical[r] > LINEAR_STRAIN_LIMIT]
 
 

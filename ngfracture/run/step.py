@@ -45,7 +45,6 @@ from .invariants import check_state
 from .records import (AcceptedStep, Attempt, CrackPass, Equilibrium, StepFailed, StepLog, StepOutcome, TooManyCracks,
                       merged_notes)
 from .state import State, crack_length, round_trip
-from .timings import Timings
 from . import tangents
 from .growth import critical_event, relax
 
@@ -69,13 +68,14 @@ class LoadStep:
         See :class:`ngfracture.run.simulation.Simulation`.
     area_initial : float
         ``math.fsum`` of the scene's reference triangle areas (the area invariant).
+    dead_loads : bool
+        The scene loads by tractions, body forces or pressures (force control), not only by
+        prescribed displacements.
     """
 
-    def __init__(self, scene, control, criterion, contact, area_initial):
+    def __init__(self, scene, control, criterion, contact, area_initial, dead_loads=False):
         self.scene, self.control, self.criterion, self.contact = scene, control, criterion, contact
-        self.area_initial = area_initial
-        #: the scene loads by tractions or body forces (force control), not only by displacements
-        self.dead_loads = bool(self.problem(scene.mesh, float(scene.dx), Timings()).loads)
+        self.area_initial, self.dead_loads = area_initial, dead_loads
 
     # -- the physics of one configuration ------------------------------------------------------
     def problem(self, mesh, x, timings, u=None, check_mesh=True, triangle_piece=None):
