@@ -164,8 +164,7 @@ def test_a_pressurised_crack_opens_as_sneddon_says():
     inner = np.flatnonzero((np.abs(X[:, 1]) < 1e-12) & (np.abs(X[:, 0]) < a - 1e-9))
     cracked = split_vertices(mesh, inner[np.argsort(X[inner, 0])], np.tile([0.0, 1.0], (len(inner), 1))).mesh
     prob = nf.ElasticProblem(cracked, nf.LinearElastic(E, NU, plane="strain"))
-    for lip in ("crack", "line"):
-        prob.add_pressure(lip, p)
+    prob.add_pressure("line", p)         # the crack lip, connected to it at the tips, inherits it
     assert prob.solve(fix_free_modes=True).converged
     U = prob.u.vec.FV().NumPy().reshape(2, -1)[:, :cracked.nv].T
     P = prob.arrays.points
@@ -178,3 +177,41 @@ def test_a_pressurised_crack_opens_as_sneddon_says():
     sneddon = 4 * p * (1 - NU ** 2) / E * np.sqrt(a * a - opening[:, 0] ** 2)
     assert len(opening) > 100
     assert np.abs(opening[:, 1] / sneddon - 1).max() <= 0.05
+
+
+def test_crack_faces_inherit_the_pressure_of_the_boundary_they_grow_from():
+    """A slit from the left edge (split by the engine, mouth included) and a slit inside,
+    not touching any boundary: the pressure on ``left`` loads the left edge and both lips
+    of the first slit (connected through its mouth and tip), none of the second; naming the
+    crack faces as well is refused, and crack_faces=False keeps the edge alone."""
+    from ngfracture.fracture import split_vertices
+    geo = SplineGeometry()
+    corners = [geo.AppendPoint(x, y) for x, y in ((-1, -1), (1, -1), (1, 1), (-1, 1), (-1, 0))]
+    for i, name in enumerate(["bottom", "right", "top", "left", "left"]):
+        geo.Append(["line", corners[i], corners[(i + 1) % 5]], bc=name)
+    slits = [(corners[4], geo.AppendPoint(0, 0)), (geo.AppendPoint(0.3, 0.4), geo.AppendPoint(0.7, 0.4))]
+    for ends in slits:
+        geo.Append(["line", *ends], leftdomain=1, rightdomain=1, bc="slit", maxh=0.05)
+    mesh = ng.Mesh(geo.GenerateMesh(maxh=0.2))
+    X = mesh.ngmesh.Coordinates()[:, :2]
+    first = np.flatnonzero((np.abs(X[:, 1]) < 1e-12) & (X[:, 0] < -1e-9))            # mouth at x = -1
+    second = np.flatnonzero((np.abs(X[:, 1] - 0.4) < 1e-12) & (X[:, 0] > 0.3 + 1e-9) & (X[:, 0] < 0.7 - 1e-9))
+    order = np.concatenate([first[np.argsort(X[first, 0])], second[np.argsort(X[second, 0])]])
+    res = split_vertices(mesh, order, np.tile([0.0, 1.0], (len(order), 1)))
+    assert res.nsplit == len(order)
+    prob = nf.ElasticProblem(res.mesh, nf.LinearElastic(E, NU))
+    crack = prob.arrays.boundary_segments("crack")
+    P = prob.arrays.points
+    on_first = np.abs(P[crack, 1]).max(axis=1) < 1e-12
+    assert on_first.sum() > 0 and (~on_first).sum() > 0      # a lip of each slit is named crack
+    prob.add_pressure("left", 1e5)
+    (_, _, segments), = prob.pressures()
+    loaded = {tuple(sorted(e)) for e in segments.tolist()}
+    assert loaded.issuperset(tuple(sorted(e)) for e in crack[on_first].tolist())
+    assert loaded.isdisjoint(tuple(sorted(e)) for e in crack[~on_first].tolist())
+    assert len(segments) == len(prob.arrays.boundary_segments("left")) + on_first.sum()
+    with pytest.raises(ValueError, match="'crack'.*'left'"):
+        prob.add_pressure("crack", 1e5)
+    alone = nf.ElasticProblem(res.mesh, nf.LinearElastic(E, NU))
+    alone.add_pressure("left", 1e5, crack_faces=False)
+    assert len(alone.pressures()[0][2]) == len(alone.arrays.boundary_segments("left"))

@@ -25,7 +25,7 @@ from .materials import region_materials
 from ..geometry.meshcheck import validate_mesh
 from ..geometry.meshio import mesh_to_arrays
 from .newton import NewtonSolver
-from .pressure import oriented_segments, pressure_stiffness, total_pressure_forces
+from .pressure import check_no_overlap, oriented_segments, pressure_stiffness, total_pressure_forces
 
 
 def _double_areas(x, elements):
@@ -170,7 +170,7 @@ class ElasticProblem:
         self._loads.append(("boundary", ng.CF(tuple(t)) if not isinstance(t, ng.CoefficientFunction) else t, boundary))
         self._form = self._internal = None
 
-    def add_pressure(self, boundary, p):
+    def add_pressure(self, boundary, p, crack_faces=True):
         """Add a pressure on a named boundary that follows the deformed surface.
 
         Scaled by ``load_factor``; ``p`` > 0 pushes into the body; the linear model takes it on
@@ -179,15 +179,16 @@ class ElasticProblem:
         Parameters
         ----------
         boundary : str
-            Boundary name of the mesh (``"crack"`` for the crack faces, once there are any).
+            Boundary name of the mesh (``"crack"`` for all crack faces, once there are any).
         p : float
             The pressure (force per unit length).
+        crack_faces : bool
+            The crack faces connected to the boundary carry its pressure (False: not).
 
         Raises
         ------
         ValueError
-            An unknown boundary, a pressure that is not a finite number, or a space of
-            order > 1 (the pressure is implemented for P1).
+            An unknown boundary, a pressure that is not finite, or an order > 1 (P1 only).
         """
         if boundary not in self.mesh.GetBoundaries():
             raise ValueError(f"boundary {boundary!r} does not exist in the mesh; its boundaries are {sorted(set(self.mesh.GetBoundaries()))}")
@@ -195,9 +196,9 @@ class ElasticProblem:
             raise ValueError(f"pressure must be a finite number, got {p!r}")
         if self.order != 1:
             raise ValueError("pressure loads need a first-order space (order=1)")
-        self._pressures.append((boundary, float(p), oriented_segments(self.arrays, boundary)))
-        self._linear_K = None
-        self._last_residual = None
+        segments = check_no_overlap(self._pressures, boundary, oriented_segments(self.arrays, boundary, bool(crack_faces)))
+        self._pressures.append((boundary, float(p), segments))
+        self._linear_K = self._last_residual = None
 
     @property
     def loads(self):
@@ -210,12 +211,11 @@ class ElasticProblem:
         return tuple(self._loads) + tuple(("pressure", p, b) for b, p, _ in self._pressures)
 
     def pressures(self):
-        """The pressures added so far.
+        """The pressures added so far: tuples (boundary, p, its segments with the body on their left).
 
         Returns
         -------
         tuple of (str, float, numpy.ndarray)
-            Boundary, pressure, its segments (each with the body on its left).
         """
         return tuple(self._pressures)
 
@@ -275,8 +275,8 @@ class ElasticProblem:
             self._form = ng.BilinearForm(self.fes, symmetric=True)
             self._form += ng.Variation(energy.Compile())
             self._res = self.u.vec.CreateVector()
-            self._linear_K = None
-            self._last_residual = None   # (u, load factor, out-of-balance) of the last evaluation
+            # _last_residual: (u, load factor, out-of-balance) of the last evaluation
+            self._linear_K = self._last_residual = None
         return self._form
 
     def tangent(self, u=None):
