@@ -11,10 +11,12 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components
 
 from ..geometry.meshio import boundary_only
 
-__all__ = ["CrackGraph", "crack_graph"]
+__all__ = ["CrackGraph", "crack_graph", "tip_sizes", "tip_advances"]
 
 
 @dataclass
@@ -31,6 +33,10 @@ class CrackGraph:
         Indices into ``points``.
     branches : list of dict
         ``{"length", "ends": (kind, kind)}`` per branch, kinds "tip", "mouth", "junction".
+    vertex_point : numpy.ndarray (nv,)
+        The point of every mesh vertex (the copies of a split vertex share it).
+    edges : numpy.ndarray (m, 2)
+        The crack segments as pairs of points (both lips: one edge).
     """
     points: np.ndarray
     degree: np.ndarray
@@ -38,6 +44,8 @@ class CrackGraph:
     mouths: np.ndarray
     junctions: np.ndarray
     branches: list
+    vertex_point: np.ndarray = None
+    edges: np.ndarray = None
 
     def side_branches(self, shorter_than):
         """Branches from a junction to a tip shorter than a length.
@@ -63,7 +71,7 @@ class CrackGraph:
                 "branches": [{"length": b["length"], "ends": list(b["ends"])} for b in self.branches]}
 
 
-def crack_graph(arrays, crack="crack"):
+def crack_graph(arrays, crack="crack", branches=True):
     """The crack graph of a mesh (see the module docstring).
 
     Parameters
@@ -71,6 +79,8 @@ def crack_graph(arrays, crack="crack"):
     arrays : MeshArrays
     crack : str
         The crack faces' boundary name.
+    branches : bool
+        Walk the branches (False: ``branches`` is empty; the points and their kinds only).
 
     Returns
     -------
@@ -80,7 +90,8 @@ def crack_graph(arrays, crack="crack"):
     seg = arrays.boundary_segments(crack) if crack in arrays.bc_names else np.zeros((0, 2), dtype=np.int64)
     if len(seg) == 0:
         empty = np.zeros(0, dtype=np.int64)
-        return CrackGraph(np.zeros((0, 2)), empty, empty, empty, empty, [])
+        return CrackGraph(np.zeros((0, 2)), empty, empty, empty, empty, [], np.arange(len(X)),
+                          np.zeros((0, 2), dtype=np.int64))
     points, ids = np.unique(X, axis=0, return_inverse=True)       # twins merge: same reference point
     ids = ids.reshape(-1)
     edges = np.unique(np.sort(ids[seg], axis=1), axis=0)          # both lips: one edge
@@ -95,7 +106,8 @@ def crack_graph(arrays, crack="crack"):
     mouths = np.flatnonzero((degree >= 1) & on_boundary & (degree <= 2))
     junctions = np.flatnonzero(degree >= 3)
     kind = {int(i): "tip" for i in tips} | {int(i): "mouth" for i in mouths} | {int(i): "junction" for i in junctions}
-    return CrackGraph(points, degree, tips, mouths, junctions, _branches(points, edges, kind))
+    walked = _branches(points, edges, kind) if branches else []
+    return CrackGraph(points, degree, tips, mouths, junctions, walked, ids, edges)
 
 
 def _branches(points, edges, kind):
@@ -122,3 +134,72 @@ def _branches(points, edges, kind):
             length = math.fsum(float(np.hypot(*(points[path[i + 1]] - points[path[i]]))) for i in range(len(path) - 1))
             branches.append({"length": length, "ends": (kind[start], kind.get(here, "tip"))})
     return branches
+
+
+def tip_sizes(arrays, crack="crack"):
+    """The crack tips and the size of the triangles at each: how finely the mesh resolves them.
+
+    Parameters
+    ----------
+    arrays : MeshArrays
+    crack : str
+
+    Returns
+    -------
+    (numpy.ndarray (k, 2), numpy.ndarray (k,))
+        The tips' reference points and the longest edge of the triangles touching each.
+    """
+    graph = crack_graph(arrays, crack, branches=False)
+    if len(graph.tips) == 0:
+        return np.zeros((0, 2)), np.zeros(0)
+    p, t = arrays.points, arrays.triangles
+    edges = np.stack([p[t[:, 1]] - p[t[:, 0]], p[t[:, 2]] - p[t[:, 1]], p[t[:, 0]] - p[t[:, 2]]], axis=1)
+    longest = np.hypot(edges[..., 0], edges[..., 1]).max(axis=1)
+    at_point = np.zeros(len(graph.points))
+    corner_point = graph.vertex_point[t]                           # (ne, 3) points of the corners
+    for k in range(3):
+        np.maximum.at(at_point, corner_point[:, k], longest)
+    return graph.points[graph.tips], at_point[graph.tips]
+
+
+def tip_advances(before, after, crack="crack"):
+    """How far the crack grew to each tip between two meshes of one run.
+
+    The crack edges of ``after`` that ``before`` lacks (matched by their reference points)
+    fall into connected pieces; a tip at the end of such a piece advanced by its length (a
+    crack that started in between: both its tips by its whole length), any other by 0.
+
+    Parameters
+    ----------
+    before, after : MeshArrays
+    crack : str
+
+    Returns
+    -------
+    (numpy.ndarray (k, 2), numpy.ndarray (k,))
+        The tips of ``after`` and their advances.
+    """
+    new_graph, old_graph = crack_graph(after, crack, branches=False), crack_graph(before, crack, branches=False)
+    tips = new_graph.tips
+    if len(tips) == 0:
+        return np.zeros((0, 2)), np.zeros(0)
+    # both graphs' points in one numbering
+    common = np.unique(np.concatenate([old_graph.points, new_graph.points]), axis=0, return_inverse=True)[1]
+    common = common.reshape(-1)
+    old_id, new_id = common[:len(old_graph.points)], common[len(old_graph.points):]
+    n = common.max() + 1
+    old_keys = np.sort(old_id[old_graph.edges], axis=1) @ np.array([n, 1])
+    keys = np.sort(new_id[new_graph.edges], axis=1) @ np.array([n, 1])
+    grown = new_graph.edges[~np.isin(keys, old_keys)]
+    advance = np.zeros(len(tips))
+    if len(grown):
+        npts = len(new_graph.points)
+        graph = sp.coo_matrix((np.ones(len(grown)), (grown[:, 0], grown[:, 1])), shape=(npts, npts))
+        _, piece = connected_components(graph, directed=False)
+        d = new_graph.points[grown[:, 0]] - new_graph.points[grown[:, 1]]
+        length = np.bincount(piece[grown[:, 0]], weights=np.hypot(d[:, 0], d[:, 1]), minlength=piece.max() + 1)
+        touched = np.zeros(npts, dtype=bool)
+        touched[grown.ravel()] = True
+        advance = np.where(touched[tips], length[piece[tips]], 0.0)
+    return new_graph.points[tips], advance
+

@@ -219,6 +219,12 @@ class Criterion:
         """True without any critical distance: the paper's mesh-dependent nodal strain."""
         return all(v is None for _, v in self._items(self.radius))
 
+    @property
+    def smallest_radius(self):
+        """The smallest critical distance of the regions (None: the one-ring criterion)."""
+        values = [v for _, v in self._items(self.radius) if v is not None]
+        return min(values) if values else None
+
     def overstrain(self, mesh, u, strength=None, arrays=None):
         """The overstrain tensor of every vertex: a vertex cracks when its largest
         principal value exceeds 1, across the principal direction.

@@ -32,6 +32,7 @@ from .step import LoadStep
 from .timings import Timings
 
 __all__ = ["Simulation", "RunResult", "Scene", "StepControl", "MeshDependentCriterion", "LinearAtLargeStrain",
+           "UnresolvedCrackTip", "TIP_RESOLUTION_LIMIT",
            "LINEAR_STRAIN_LIMIT"]
 
 #: critical strains above this in a linear-elastic region draw a warning: the linear model
@@ -46,6 +47,16 @@ class MeshDependentCriterion(UserWarning):
 
 class LinearAtLargeStrain(UserWarning):
     """A linear-elastic region that cracks only at strains where the linear model is not valid."""
+
+
+class UnresolvedCrackTip(UserWarning):
+    """A crack tip in triangles larger than TIP_RESOLUTION_LIMIT times the critical distance."""
+
+
+#: h / r at a crack tip (h the longest edge of its triangles) above which the point at r from
+#: the tip lies in the tip's own triangles: the measure reads the ring's average, not the
+#: field at r, and cracks in such triangles branch (docs/criterion.md, "Resolution")
+TIP_RESOLUTION_LIMIT = 1.0
 
 
 class Simulation:
@@ -246,6 +257,13 @@ class Simulation:
                     files.write_checkpoint(state, self._checkpoint_meta(area_initial, time.perf_counter() - t_start),
                                            self.timings)
             self._report(accepted, t_start, on_step)
+            resolution = accepted.record.get("tip_resolution", 0.0)
+            if resolution > TIP_RESOLUTION_LIMIT and not any(h.get("tip_resolution", 0.0) > TIP_RESOLUTION_LIMIT
+                                                             for h in state.history[:-1]):
+                warnings.warn(f"Scene {self.scene.name!r}, step {state.step}: a crack tip lies in triangles of "
+                              f"{resolution:.3g} times the critical distance (more than {TIP_RESOLUTION_LIMIT}); "
+                              f"the criterion does not resolve the stress there and cracks may branch: refine "
+                              f"the mesh where cracks run", UnresolvedCrackTip, stacklevel=3)
         if prob is None:
             prob = stepper.problem(state.mesh, state.x, self.timings, state.u)
             stats = FragmentStatistics(state.mesh)
@@ -295,6 +313,7 @@ class Simulation:
             "n_split_vertices": int(sum(h["split_vertices"] for h in hist)),
             "crack_length": crack_length(state.arrays),
             "crack_graph": crack_graph(state.arrays).summary(),
+            "max_tip_resolution": max((h.get("tip_resolution", 0.0) for h in hist), default=0.0),
             "n_fragments": int(stats.count), "fragment_areas": stats.areas.tolist(),
             "area_initial": area_initial, "area_final": stats.total_area,
             "max_overlap_area": overlap,
