@@ -147,34 +147,40 @@ def _inside(corners, point):
     return bool(np.count_nonzero(crosses & (point[0] < x_at)) % 2)
 
 
-def _sifs(prob, tip, t, h, material):
-    """K_I, K_II at the tip from the lips' nodal displacements 8 h to 20 h behind it."""
+def _sifs(prob, points, h, material):
+    """K_I, K_II at the tip from the lips' nodal displacements 8 h to 20 h behind it, the
+    distance measured along the crack, the jumps in the frame of its last segment."""
+    tip = points[-1]
+    t = (tip - points[-2]) / np.linalg.norm(tip - points[-2])
     n = np.array([-t[1], t[0]])
     mu = material.E / (2 * (1 + material.nu))
     kappa = (3 - material.nu) / (1 + material.nu)
-    arrays = prob.arrays
-    X, tri = arrays.points, arrays.triangles
+    X, tri = prob.arrays.points, prob.arrays.triangles
     U = prob.u.vec.FV().NumPy().reshape(2, -1)[:, :len(X)].T
-    behind = (tip - X) @ t
-    off = np.abs((X - tip) @ n)
-    near = np.flatnonzero((off < 1e-9) & (behind > 7.5 * h) & (behind < 20.5 * h))
-    # the side of each lip vertex: where its triangles' centroids lie
+    # the side of a lip vertex: where its triangles' centroids lie from its segment
     centroid = X[tri].mean(axis=1)
-    side = np.zeros(len(X))
-    for k in range(3):
-        np.add.at(side, tri[:, k], (centroid - tip) @ n)
-    d, k1, k2 = [], [], []
-    for key in np.unique(np.round(behind[near] / h, 6)):
-        pair = near[np.round(behind[near] / h, 6) == key]
-        if len(pair) != 2:
-            continue
-        upper, lower = (pair if side[pair[0]] > side[pair[1]] else pair[::-1])
-        jump = U[upper] - U[lower]
-        dist = float(behind[upper])
-        scale = mu / (kappa + 1) * math.sqrt(2 * math.pi / dist)
-        d.append(dist)
-        k1.append(scale * jump @ n)
-        k2.append(scale * jump @ t)
+    d, k1, k2, walked = [], [], [], 0.0
+    for a, b in zip(points[-2::-1], points[:0:-1]):          # segments from the tip backwards
+        length = float(np.linalg.norm(b - a))
+        ts = (b - a) / length
+        ns = np.array([-ts[1], ts[0]])
+        back = (b - X) @ ts
+        on = np.flatnonzero((np.abs((X - b) @ ns) < 1e-9) & (back > 1e-9) & (back < length - 1e-9))
+        for key in np.unique(np.round(back[on] / h, 6)):
+            dist = walked + float(back[on][np.round(back[on] / h, 6) == key][0])
+            pair = on[np.round(back[on] / h, 6) == key]
+            if len(pair) != 2 or not 7.5 * h < dist < 20.5 * h:
+                continue
+            side = [((centroid[(tri == v).any(axis=1)] - X[v]) @ ns).sum() for v in pair]
+            upper, lower = pair if side[0] > side[1] else pair[::-1]
+            jump = U[upper] - U[lower]
+            scale = mu / (kappa + 1) * math.sqrt(2 * math.pi / dist)
+            d.append(dist)
+            k1.append(scale * jump @ n)
+            k2.append(scale * jump @ t)
+        walked += length
+        if walked > 20.5 * h:
+            break
     if len(d) < 3:
         raise RuntimeError("edge_crack_path: too few lip vertices behind the tip to read the SIFs")
     return float(np.polyfit(d, k1, 1)[1]), float(np.polyfit(d, k2, 1)[1])
@@ -222,7 +228,7 @@ def edge_crack_path(corners, names, path, apply_load, E, nu, da, steps, maxh, h_
         status = prob.solve(fix_free_modes=True)
         if not status.converged:
             raise RuntimeError(f"edge_crack_path: the solve failed ({status.message})")
-        k1, k2 = _sifs(prob, tip, t, h_tip, material)
+        k1, k2 = _sifs(prob, np.array(points), h_tip, material)
         k1s.append(k1)
         k2s.append(k2)
         theta = kink_angle(k1, k2)
