@@ -14,6 +14,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
+from ..geometry.meshcheck import cross_and_longest
 from ..geometry.meshio import boundary_only
 
 __all__ = ["CrackGraph", "crack_graph", "tip_sizes", "tip_advances"]
@@ -136,25 +137,26 @@ def _branches(points, edges, kind):
     return branches
 
 
-def tip_sizes(arrays, crack="crack"):
+def tip_sizes(arrays, crack="crack", graph=None):
     """The crack tips and the size of the triangles at each: how finely the mesh resolves them.
 
     Parameters
     ----------
     arrays : MeshArrays
     crack : str
+    graph : CrackGraph, optional
+        The mesh's crack graph, if the caller has it (the branches are not needed).
 
     Returns
     -------
     (numpy.ndarray (k, 2), numpy.ndarray (k,))
         The tips' reference points and the longest edge of the triangles touching each.
     """
-    graph = crack_graph(arrays, crack, branches=False)
+    graph = crack_graph(arrays, crack, branches=False) if graph is None else graph
     if len(graph.tips) == 0:
         return np.zeros((0, 2)), np.zeros(0)
-    p, t = arrays.points, arrays.triangles
-    edges = np.stack([p[t[:, 1]] - p[t[:, 0]], p[t[:, 2]] - p[t[:, 1]], p[t[:, 0]] - p[t[:, 2]]], axis=1)
-    longest = np.hypot(edges[..., 0], edges[..., 1]).max(axis=1)
+    t = arrays.triangles
+    longest = np.sqrt(cross_and_longest(arrays.points, t)[1])
     at_point = np.zeros(len(graph.points))
     corner_point = graph.vertex_point[t]                           # (ne, 3) points of the corners
     for k in range(3):
@@ -162,7 +164,7 @@ def tip_sizes(arrays, crack="crack"):
     return graph.points[graph.tips], at_point[graph.tips]
 
 
-def tip_advances(before, after, crack="crack"):
+def tip_advances(before, after, crack="crack", graph=None):
     """How far the crack grew to each tip between two meshes of one run.
 
     The crack edges of ``after`` that ``before`` lacks (matched by their reference points)
@@ -173,13 +175,16 @@ def tip_advances(before, after, crack="crack"):
     ----------
     before, after : MeshArrays
     crack : str
+    graph : CrackGraph, optional
+        The crack graph of ``after``, if the caller has it.
 
     Returns
     -------
     (numpy.ndarray (k, 2), numpy.ndarray (k,))
         The tips of ``after`` and their advances.
     """
-    new_graph, old_graph = crack_graph(after, crack, branches=False), crack_graph(before, crack, branches=False)
+    new_graph = crack_graph(after, crack, branches=False) if graph is None else graph
+    old_graph = crack_graph(before, crack, branches=False)
     tips = new_graph.tips
     if len(tips) == 0:
         return np.zeros((0, 2)), np.zeros(0)

@@ -96,7 +96,7 @@ def validate_mesh(mesh):
     if bad.size:
         raise MeshError(f"mesh: vertex {bad[0]} at {_xy(P[bad[0]])} belongs to no triangle" + _more(bad))
 
-    cross, longest2 = _cross_and_longest(P, T)
+    cross, longest2 = cross_and_longest(P, T)
     zero = np.abs(cross) <= 16 * np.finfo(float).eps * longest2
     bad = np.flatnonzero(zero)
     if bad.size:
@@ -137,8 +137,20 @@ def _arrays(mesh):
         raise MeshError(str(err)) from None
 
 
-def _cross_and_longest(P, T):
-    """Twice the signed area of every triangle and its longest squared edge length."""
+def cross_and_longest(P, T):
+    """Twice the signed area of every triangle and its longest squared edge length.
+
+    Parameters
+    ----------
+    P : numpy.ndarray (nv, 2)
+        Vertex coordinates.
+    T : numpy.ndarray of int (ne, 3)
+        Triangles.
+
+    Returns
+    -------
+    (numpy.ndarray (ne,), numpy.ndarray (ne,))
+    """
     X, Y = P[:, 0][T], P[:, 1][T]
     ux, uy = X[:, 1] - X[:, 0], Y[:, 1] - Y[:, 0]
     vx, vy = X[:, 2] - X[:, 0], Y[:, 2] - Y[:, 0]

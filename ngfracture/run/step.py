@@ -34,7 +34,7 @@ import traceback
 import numpy as np
 
 from ..contact.solver import ContactSolver
-from ..fracture.crack_graph import tip_advances, tip_sizes
+from ..fracture.crack_graph import crack_graph, tip_advances, tip_sizes
 from ..fracture.fragments import FragmentStatistics
 from ..fracture.split import GROWTH_RULES, PAPER_RULES, split_by_tensor, transfer_vertex_field
 from ..linalg import bordered
@@ -461,13 +461,14 @@ class LoadStep:
             new_dx, quiet = min(dx * self.control.grow, self.control.dx_max), 0
         record = self._record(state, attempt, dx, log, energy, work, crack_length(arrays), stats.count)
         record["boundaries"] = boundary_resultants(prob, out_of_balance)
-        if attempt.total_cracks:      # each tip's advance over the step (reference length)
-            points, advances = tip_advances(state.arrays, arrays)
-            record["tips"] = [{"position": p, "advanced": a} for p, a in zip(points.tolist(), advances.tolist())]
         r = self.criterion.smallest_radius
+        graph = crack_graph(arrays, branches=False) if attempt.total_cracks or r is not None else None
+        if attempt.total_cracks:      # each tip's advance over the step (reference length)
+            points, advances = tip_advances(state.arrays, arrays, graph=graph)
+            record["tips"] = [{"position": p, "advanced": a} for p, a in zip(points.tolist(), advances.tolist())]
         if r is not None:
             # how finely the mesh resolves the criterion at the crack tips (h / r)
-            _, sizes = tip_sizes(arrays)
+            _, sizes = tip_sizes(arrays, graph=graph)
             record["tip_resolution"] = float(sizes.max(initial=0.0) / r)
         if attempt.lost_support:
             record["lost_support"] = attempt.lost_support
