@@ -28,11 +28,13 @@ Reported per case:
 and per scene run at two or more factors:
 
   growth       the exponent p of the least-squares fit seconds_per_step ~ ntri^p over
-               the factors (and of wall ~ ntri^p), with the cases it was fitted to
+               the factors (and of wall, of wall per split vertex and of t_unit ~ ntri^p),
+               with the cases it was fitted to
 
 Writes JSON {"cases": [...], "growth": {...}} (stdout, or the file of --json FILE). Targets: cost per step grows at
 most like N^1.2 between the 1x, 4x and 16x plate; the 16x plate (about 31k triangles)
-runs until broken in at most 150 solve-equivalents. The modules the run loads on first
+runs until broken in at most 150 solve-equivalents; the holed beam (``--scenes holed_beam
+--factors 1 4``: its band meshed at r/4 and r/8) in at most 400 solve-equivalents at 4x. The modules the run loads on first
 use (pyvista, matplotlib) are imported before the first case, as NGSolve itself is: a
 once-per-process cost that would otherwise land in the first case's "output" phase only.
 
@@ -92,7 +94,9 @@ def unit_solve(scene):
 def run_case(name, factor, steps=None, one_ring=False):
     criterion = {"radius": None} if one_ring else {}
     base = scenes.SCENES[name](**criterion)
-    scene = scenes.SCENES[name](maxh=base.parameters["maxh"] / math.sqrt(factor), **criterion)
+    # every mesh size the scene declares shrinks by sqrt(factor): maxh, and the band's where it has one
+    sizes = {k: base.parameters[k] / math.sqrt(factor) for k in ("maxh", "fine") if k in base.parameters}
+    scene = scenes.SCENES[name](**sizes, **criterion)
     t_unit_before = unit_solve(scene)
     control = StepControl(**{**scene.control, "max_steps": steps}) if steps else None
     with tempfile.TemporaryDirectory() as out:
@@ -128,6 +132,9 @@ def growth(cases):
         exponent = lambda values: float(np.polyfit(logn, np.log(values), 1)[0])
         fits[name] = {"factors": [c["factor"] for c in mine], "ntri": [c["ntri"] for c in mine],
                       "seconds_per_step_exponent": exponent([c["seconds_per_step"] for c in mine]),
+                      # a finer band splits more vertices per crack length: the cost of one split
+                      "seconds_per_split_exponent": exponent([c["phases"]["wall"] / max(c["n_split_vertices"], 1)
+                                                              for c in mine]),
                       "wall_exponent": exponent([c["phases"]["wall"] for c in mine]),
                       "t_unit_exponent": exponent([c["t_unit"] for c in mine])}
     return fits

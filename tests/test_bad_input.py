@@ -215,3 +215,15 @@ def test_constraints_that_leave_no_free_dof_are_an_error():
 
 if __name__ == "__main__":
     raise SystemExit(pytest.main([__file__, "-q"]))
+
+
+@pytest.mark.parametrize("holes, message", [
+    (((0.0, 0.1, 0.2),), "holes[0] = (0.0, 0.1, 0.2) does not lie inside the beam"),     # cuts the bottom edge
+    (((-0.3, 0.5, 0.2), (-0.12, 0.5, 0.08)), "holes[0] = (-0.3, 0.5, 0.2) does not lie"),  # across the band's side
+    (((-0.22, 0.5, 0.08), (-0.12, 0.5, 0.08)), "holes[1] = (-0.12, 0.5, 0.08) does not lie"),
+    (((-0.5, 0.22, 0.05),), "clear of the notch"),                                        # on the notch's tip
+    (((-0.22, 0.5, -1.0),), "holes[0] radius must be a finite number > 0"),
+])
+def test_holed_beam_names_a_hole_that_does_not_fit(holes, message):
+    with pytest.raises(ValueError, match=re.escape(message)):
+        nf.scenes.holed_beam(holes=holes)

@@ -8,15 +8,20 @@
 The reference is the path of the maximum hoop stress criterion with SIFs from an
 independent solve at each increment (:mod:`ngfracture.studies.lefm_path`); the
 simulation's crack (critical distance r, the mesh r/4 within 5 r of the reference path)
-follows it within a mean distance of 2 r, as one crack (no junction)."""
+follows it within a mean distance of 2 r, as one crack (no junction, one tip at most).
+
+* The built-in ``holed_beam``: the offset notch with a hole beside the path; the crack
+  passes the hole, drawn towards it, and keeps one tip.
+
+The crack graph is read from the run's last VTU and VTP files (:mod:`vtk_crack_util`)."""
 import math
 
 import numpy as np
 import pytest
 
 import ngfracture as nf
-from ngfracture.fracture.crack_graph import crack_graph
 from ngfracture.studies.lefm_path import cracked_polygon, edge_crack_path
+from vtk_crack_util import final_files, read_crack_graph, side_branches
 
 E, NU, EPS, R = 1e9, 0.3, 1e-3, 0.02
 WIDTH, HEIGHT = 1.0, 2.0
@@ -46,32 +51,42 @@ def band(path, r):
     return sizes
 
 
-def simulated_path(corners, names, start, reference, apply_load, load_max):
-    """The crack the simulation grows from ``start`` (its points past the start)."""
-    mesh = cracked_polygon(corners, names, start, 0.1, R / 4, band(reference, R))
-    scene = nf.Scene(name="mixed", mesh=mesh, material=nf.LinearElastic(E, NU, plane="stress"), critical=EPS,
-                     apply_load=apply_load, load_max=load_max, dx=load_max / 32, contact_tol=1e-6, radius=R,
-                     stop_when_unloaded=True)
-    result = nf.Simulation(scene, pictures="none").run()
-    graph = crack_graph(result.state.arrays)
-    on_crack = graph.points[graph.degree > 0]
+def simulated_path(scene, start, out):
+    """The crack a scene grows from ``start``: its points past the start, its graph, the result."""
+    result = nf.Simulation(scene, out=out, pictures="none").run()
+    graph = read_crack_graph(*final_files(out))
+    on_crack = graph["points"][graph["degree"] > 0]
     grown = on_crack[distance_to_polyline(on_crack, start) > 1e-9]
     return grown, graph, result
 
 
+def band_scene(corners, names, start, reference, apply_load, load_max):
+    """The body with its edge crack, meshed at r/4 within 5 r of the reference path."""
+    mesh = cracked_polygon(corners, names, start, 0.1, R / 4, band(reference, R))
+    return nf.Scene(name="mixed", mesh=mesh, material=nf.LinearElastic(E, NU, plane="stress"), critical=EPS,
+                    apply_load=apply_load, load_max=load_max, dx=load_max / 32, contact_tol=1e-6, radius=R,
+                    stop_when_unloaded=True)
+
+
+def check_one_crack(grown, graph, r):
+    """A crack of more than 20 points with at most one tip, no junction and no short side branch."""
+    assert len(grown) > 20
+    assert len(graph["junctions"]) == 0 and len(graph["tips"]) <= 1 and not side_branches(graph, r)
+
+
 @pytest.mark.slow
-def test_an_inclined_edge_crack_follows_the_maximum_hoop_stress_path():
+def test_an_inclined_edge_crack_follows_the_maximum_hoop_stress_path(tmp_path):
     start = np.array([[0.0, 1.0], [0.2 * math.cos(math.pi / 4), 1.0 + 0.2 * math.sin(math.pi / 4)]])
     corners = [(0.0, 0.0), (WIDTH, 0.0), (WIDTH, HEIGHT), (0.0, HEIGHT), tuple(start[0])]
     names = ["bottom", "right", "top", "left", "left"]
     reference = edge_crack_path(corners, names, start, grips, E, NU, da=0.02, steps=60, maxh=0.1, h_tip=0.002)
     assert len(reference.points) > 20
-    grown, graph, result = simulated_path(corners, names, start, reference.points, lambda prob, x: grips(prob, x),
-                                          4 * EPS)
+    scene = band_scene(corners, names, start, reference.points, lambda prob, x: grips(prob, x), 4 * EPS)
+    grown, graph, result = simulated_path(scene, start, tmp_path / "out")
     distance = distance_to_polyline(grown, reference.points)
     print(f"inclined: mean distance {distance.mean() / R:.3f} r, max {distance.max() / R:.3f} r, {len(grown)} points, "
-          f"tips {len(graph.tips)}, junctions {len(graph.junctions)}, {result.reason}")
-    assert len(grown) > 20 and len(graph.junctions) == 0
+          f"tips {len(graph['tips'])}, junctions {len(graph['junctions'])}, {result.reason}")
+    check_one_crack(grown, graph, R)
     assert distance.mean() < 2 * R
 
 
@@ -92,18 +107,43 @@ def three_point_bending(prob, x=1e-3):
 
 
 @pytest.mark.slow
-def test_an_offset_notch_in_three_point_bending_curves_to_the_load_as_lefm_says():
+def test_an_offset_notch_in_three_point_bending_curves_to_the_load_as_lefm_says(tmp_path):
     corners, names = beam_outline(mouth=1.5)
     start = np.array([[1.5, 0.0], [1.5, 0.2]])
     reference = edge_crack_path(corners, names, start, three_point_bending, E, NU, da=0.02, steps=60, maxh=0.1,
                                 h_tip=0.002)
     assert len(reference.points) > 20
-    grown, graph, result = simulated_path(corners, names, start, reference.points,
-                                          lambda prob, x: three_point_bending(prob, x), 4e-3)
+    scene = band_scene(corners, names, start, reference.points, lambda prob, x: three_point_bending(prob, x), 4e-3)
+    grown, graph, result = simulated_path(scene, start, tmp_path / "out")
     grown = grown[grown[:, 1] <= reference.points[:, 1].max()]      # as far as the reference goes
     distance = distance_to_polyline(grown, reference.points)
     print(f"offset notch: mean distance {distance.mean() / R:.3f} r, max {distance.max() / R:.3f} r, "
-          f"{len(grown)} points, tips {len(graph.tips)}, junctions {len(graph.junctions)}, {result.reason}, "
+          f"{len(grown)} points, tips {len(graph['tips'])}, junctions {len(graph['junctions'])}, {result.reason}, "
           f"reference from {reference.points[1]} to {reference.points[-1]}")
-    assert len(grown) > 20 and len(graph.junctions) == 0
+    check_one_crack(grown, graph, R)
     assert distance.mean() < 2 * R
+
+
+@pytest.mark.slow
+def test_a_crack_passing_a_hole_keeps_one_tip_and_the_lefm_path(tmp_path):
+    scene = nf.scenes.holed_beam()
+    p, pad, mid = scene.parameters, 0.05, 2.2
+    mouth = mid - p["notch_offset"]
+    corners = [(0.0, 0.0), (0.2 - pad / 2, 0.0), (0.2 + pad / 2, 0.0), (mouth, 0.0), (4.2 - pad / 2, 0.0),
+               (4.2 + pad / 2, 0.0), (4.4, 0.0), (4.4, 1.0), (mid + pad / 2, 1.0), (mid - pad / 2, 1.0), (0.0, 1.0)]
+    names = ["bottom", "support_left", "bottom", "bottom", "support_right", "bottom", "right", "top", "load", "top",
+             "left"]
+    holes = [(x + mid, y, radius) for x, y, radius in p["holes"]]
+    start = np.array([[mouth, 0.0], [mouth, p["notch"]]])
+    reference = edge_crack_path(corners, names, start, three_point_bending, p["E"], p["nu"], da=0.02, steps=60,
+                                maxh=0.1, h_tip=0.002, holes=holes)
+    assert len(reference.points) > 20
+    grown, graph, result = simulated_path(scene, start, tmp_path / "out")
+    grown = grown[grown[:, 1] <= reference.points[:, 1].max()]
+    distance = distance_to_polyline(grown, reference.points)
+    hole_distance = min(np.hypot(*(grown - hole[:2]).T).min() - hole[2] for hole in np.array(holes))
+    print(f"holed beam: mean distance {distance.mean() / scene.radius:.3f} r, max {distance.max() / scene.radius:.3f} "
+          f"r, closest to the hole {hole_distance:.3f}, {len(grown)} points, tips {len(graph['tips'])}, "
+          f"junctions {len(graph['junctions'])}, {result.reason}")
+    check_one_crack(grown, graph, scene.radius)
+    assert distance.mean() < 2 * scene.radius

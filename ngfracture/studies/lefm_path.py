@@ -80,7 +80,7 @@ def cracked_rectangle(width, height, path, maxh, h_path, refine=()):
     return cracked_polygon(corners, ["bottom", "right", "top", "left", "left"], path, maxh, h_path, refine)
 
 
-def cracked_polygon(corners, names, path, maxh, h_path, refine=()):
+def cracked_polygon(corners, names, path, maxh, h_path, refine=(), holes=()):
     """A polygon with an edge crack along a polyline from one of its corners, opened into lips.
 
     Parameters
@@ -95,6 +95,8 @@ def cracked_polygon(corners, names, path, maxh, h_path, refine=()):
         Mesh size away from and along the crack (the tip too).
     refine : iterable of (x, y, h)
         More local mesh sizes.
+    holes : iterable of (x, y, radius)
+        Circular holes (boundary "hole"), clear of the crack.
 
     Returns
     -------
@@ -119,6 +121,8 @@ def cracked_polygon(corners, names, path, maxh, h_path, refine=()):
         here = geo.AppendPoint(*p, maxh=h_path)
         geo.Append(["line", prev, here], bc="path", leftdomain=1, rightdomain=1, maxh=h_path)
         prev = here
+    for x, y, r in holes:
+        geo.AddCircle((x, y), r, leftdomain=0, rightdomain=1, bc="hole")
     mp = MeshingParameters(maxh=maxh)
     for x, y, h in refine:
         mp.RestrictH(x=x, y=y, z=0, h=h)
@@ -186,7 +190,7 @@ def _sifs(prob, points, h, material):
     return float(np.polyfit(d, k1, 1)[1]), float(np.polyfit(d, k2, 1)[1])
 
 
-def edge_crack_path(corners, names, path, apply_load, E, nu, da, steps, maxh, h_tip):
+def edge_crack_path(corners, names, path, apply_load, E, nu, da, steps, maxh, h_tip, holes=()):
     """The LEFM path of an edge crack grown by ``steps`` increments of ``da``.
 
     Parameters
@@ -205,11 +209,13 @@ def edge_crack_path(corners, names, path, apply_load, E, nu, da, steps, maxh, h_
     steps : int
     maxh, h_tip : float
         Mesh sizes away from and at the crack (h_tip within 24 h_tip of the tip).
+    holes : iterable of (x, y, radius)
+        Circular holes in the body.
 
     Returns
     -------
     LefmPath
-        Stops early where the next tip would leave the body.
+        Stops early where the next tip would leave the body or come within 2 ``da`` of a hole.
 
     Raises
     ------
@@ -222,7 +228,7 @@ def edge_crack_path(corners, names, path, apply_load, E, nu, da, steps, maxh, h_
         tip, before = points[-1], points[-2]
         t = (tip - before) / np.linalg.norm(tip - before)
         around = [(tip[0] + i * h_tip, tip[1] + j * h_tip, h_tip) for i in range(-24, 25, 3) for j in range(-24, 25, 3)]
-        mesh = cracked_polygon(corners, names, np.array(points), maxh, h_tip, around)
+        mesh = cracked_polygon(corners, names, np.array(points), maxh, h_tip, around, holes)
         prob = ElasticProblem(mesh, material)
         apply_load(prob)
         status = prob.solve(fix_free_modes=True)
@@ -234,7 +240,7 @@ def edge_crack_path(corners, names, path, apply_load, E, nu, da, steps, maxh, h_
         theta = kink_angle(k1, k2)
         c, s = math.cos(theta), math.sin(theta)
         nxt = tip + da * np.array([c * t[0] - s * t[1], s * t[0] + c * t[1]])
-        if not _inside(corners, nxt):
+        if not _inside(corners, nxt) or any(math.hypot(nxt[0] - x, nxt[1] - y) < r + 2 * da for x, y, r in holes):
             break
         points.append(nxt)
     return LefmPath(np.array(points), np.array(k1s), np.array(k2s))

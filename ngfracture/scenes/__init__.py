@@ -1,0 +1,36 @@
+"""The paper's scenes (section 4.2) as functions that return a Scene.
+
+Each is short on purpose: copy one, change the geometry, material or loading, and
+pass it to :class:`ngfracture.run.simulation.Simulation`.
+
+* :func:`plate`: a square glass plate with small notches on the top and bottom edges,
+  pulled apart by gliding conditions on the left and right sides.
+* :func:`disk`: a brittle disk with a hole around a softer, separate core whose inner
+  boundary expands; contact passes the expansion on; radial cracks grow from the hole
+  while the outer ring stays whole.
+* :func:`disintegration`: the same disk expanded further, until it falls apart.
+* :func:`beam`: a notched beam in three-point bending; its crack grows one event per load
+  step at its critical load, through the peak of the load-displacement curve.
+* :func:`holed_beam`: a beam in three-point bending with its notch off mid-span and a hole
+  beside the crack's path: a mixed-mode crack that curves past the hole.
+
+Every scene judges cracks at a critical distance ``radius`` (docs/criterion.md);
+``radius=None`` selects the paper's one-ring criterion.
+"""
+from .beams import beam, holed_beam, holed_beam_mesh, notched_beam_mesh, senb_factor
+from .common import (BEAM_LOAD, CORE_INNER, DISINTEGRATION_RADIUS, DISK_LOAD, DISK_RADIUS, FIRST_CRACK, GLASS, HOLE,
+                     PLATE_LOAD, PLATE_RADIUS)
+from .disks import cored_disk_mesh, disintegration, disk
+from .plates import notched_plate_mesh, plate
+
+__all__ = ["plate", "disk", "disintegration", "beam", "holed_beam", "notched_plate_mesh", "cored_disk_mesh",
+           "notched_beam_mesh", "holed_beam_mesh", "senb_factor", "GLASS", "PLATE_RADIUS", "DISK_RADIUS",
+           "DISINTEGRATION_RADIUS", "HOLE", "CORE_INNER", "FIRST_CRACK", "PLATE_LOAD", "DISK_LOAD", "BEAM_LOAD",
+           "SCENES", "LOAD_DESCRIPTIONS"]
+
+#: the scenes of ``python -m ngfracture run``
+SCENES = {"plate": plate, "disk": disk, "disintegration": disintegration, "beam": beam, "holed_beam": holed_beam}
+#: what the load parameter x of each scene is (Scene.load_description)
+LOAD_DESCRIPTIONS = {"plate": PLATE_LOAD, "disk": DISK_LOAD, "disintegration": DISK_LOAD, "beam": BEAM_LOAD,
+                     "holed_beam": BEAM_LOAD}
+
