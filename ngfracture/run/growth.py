@@ -17,6 +17,7 @@ run ends broken at that load with the cracked state.
 from ..fracture.strain import principal
 from ..mechanics.resultants import load_vector, unsupported_pieces, work_of_forces
 from .records import Relaxation, StepFailed, merged_notes
+from .refinement import refine_equilibrium
 
 __all__ = ["NO_EQUILIBRIUM", "CRITICAL_MARGIN", "CRITICAL_ITERATIONS", "max_overstrain", "critical_event", "critical_load", "relax"]
 
@@ -170,7 +171,7 @@ def critical_load(stepper, state, x_try, prob, eq, method, timings):
                      f"{CRITICAL_ITERATIONS} solves (overstrain {m:.6g} at x = {x:.6g})")
 
 
-def relax(stepper, prob, crack, eq, x, method, timings):
+def relax(stepper, prob, crack, eq, x, area, method, timings):
     """Crack passes and equilibria at fixed load x until a pass splits nothing.
 
     It stops early where the body comes apart (Scene.stop_when_unloaded), and where a
@@ -187,6 +188,8 @@ def relax(stepper, prob, crack, eq, x, method, timings):
     eq : Equilibrium
         The equilibrium it split.
     x : float
+    area : float
+        The reference area of the split mesh (the area invariant's).
     method : {"modified", "full"}
     timings : Timings
 
@@ -212,6 +215,8 @@ def relax(stepper, prob, crack, eq, x, method, timings):
         try:
             eq = stepper.equilibrium(prob, "relaxation", method, timings, warm=eq.contact_keys, lineage=crack.lineage)
             lost = unsupported_pieces(prob)
+            if not lost:     # the next pass judges the new tips on refined material (Scene.refine)
+                refined = refine_equilibrium(stepper, prob, eq, x, strength, area, method, timings)
         except StepFailed as err:
             lost = unsupported_pieces(prob, contact_holds=False)
             if not lost and stepper.dead_loads and err.reason in NO_EQUILIBRIUM:
@@ -228,6 +233,8 @@ def relax(stepper, prob, crack, eq, x, method, timings):
             forces = load_vector(prob)
             work += work_of_forces(forces, forces, carried, prob.u.vec.FV().NumPy())
         iterations, notes = iterations + eq.iterations, merged_notes(notes, eq.notes)
+        prob, eq, strength, area = refined.problem, refined.equilibrium, refined.strength, refined.area
+        work, iterations = work + refined.work, iterations + refined.iterations
         if (stepper.scene.stop_when_unloaded and prob.fragments()[0] > 1
                 and stepper.cut_through(prob.arrays, prob.mesh, prob.assemble_constraints(), timings)):
             broken = True
@@ -238,4 +245,4 @@ def relax(stepper, prob, crack, eq, x, method, timings):
         splits += crack.n_split
     # after a lost support the last factorisation is of another mesh: nothing to keep
     return Relaxation(prob, strength, eq.contact_keys, None if lost else eq.tangent, splits, work, positions,
-                      iterations, notes, broken, lost)
+                      iterations, notes, broken, lost, area)

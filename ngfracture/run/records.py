@@ -140,6 +140,8 @@ class Attempt:
         Why a loaded piece has lost its support ("" if none): the run ends with this step.
     overlap : float
         Overlap area between the pieces at the end (:mod:`ngfracture.run.invariants`).
+    area : float or None
+        The reference area of the final mesh (changed only by refinement; None: the scene's).
     """
     problem: object
     x: float
@@ -156,6 +158,7 @@ class Attempt:
     broken_through: bool = False
     lost_support: str = ""
     overlap: float = 0.0
+    area: float = None
 
 
 @dataclass
@@ -181,6 +184,8 @@ class Relaxation:
         Stopped where the body came apart (Scene.stop_when_unloaded).
     lost_support : str
         Stopped where a loaded piece lost its support: why ("" otherwise).
+    area : float
+        The reference area of the problem's mesh (changed only by refinement).
     """
     problem: object
     strength: object
@@ -193,6 +198,7 @@ class Relaxation:
     notes: list
     broken_through: bool
     lost_support: str
+    area: float
 
 
 @dataclass(frozen=True)

@@ -8,12 +8,19 @@ import numpy as np
 from ..fracture.criterion import Criterion, critical_distance
 from ..mechanics.materials import Material
 
-__all__ = ["Scene"]
+__all__ = ["Scene", "REFINE_RADIUS", "REFINE_REACH"]
 
 
 def _positive_or_none(value):
     return value is None or (not isinstance(value, bool) and isinstance(value, (int, float))
                              and math.isfinite(value) and value > 0)
+
+
+#: triangles within this many critical distances of a tip are refined (Scene.refine) once
+#: one within REFINE_REACH r is too coarse: the tip's rays read 2 r, and the tip advances
+#: REFINE_RADIUS - REFINE_REACH r into refined material before the next refinement
+REFINE_RADIUS = 4.0
+REFINE_REACH = 2.0
 
 
 @dataclass
@@ -72,6 +79,11 @@ class Scene:
     load_description : str
         What the load parameter x is, with its unit (e.g. "total extension of the plate
         (length)"); shown by ``ngfracture scenes`` and written to summary.json.
+    refine : bool or float, optional
+        Refine the mesh ahead of crack tips and stress concentrations during the run
+        (:mod:`ngfracture.run.refinement`): True for a target edge length of r/4, a number
+        for that length. Needs a critical distance (radius or toughness). None or False: the
+        mesh is refined only by cracking.
     """
     name: str
     mesh: object
@@ -90,6 +102,7 @@ class Scene:
     strength: object = None
     load_description: str = ""
     toughness: object = None
+    refine: object = None
 
     def validate(self):
         """Check every field before any work.
@@ -122,6 +135,7 @@ class Scene:
         if not isinstance(self.material, (Material, dict)):
             raise ValueError(f"Scene {self.name!r}: material must be a Material or a dict of them")
         self._check_regions()
+        self.refinement()
         if self.strength is not None:
             s = np.asarray(self.strength)
             if s.shape != (self.mesh.nv,) or not np.issubdtype(s.dtype, np.floating) \
@@ -191,3 +205,33 @@ class Scene:
             (:meth:`critical_distances`), or the paper's one-ring nodal strain without any.
         """
         return Criterion(self.critical, radius=self.critical_distances(), material=self.material)
+
+    def refinement(self):
+        """The target edge length and the radius of the refinement ahead of tips, or None.
+
+        Returns
+        -------
+        (float, float, float) or None
+            h (r/4 for ``refine=True``, the smallest r of the regions), the radius within
+            which triangles are refined around a tip and the reach that triggers it
+            (REFINE_RADIUS and REFINE_REACH times the largest r).
+
+        Raises
+        ------
+        ValueError
+            A bad ``refine``, or refinement without a critical distance.
+        """
+        if self.refine is None or self.refine is False:
+            return None
+        if not (self.refine is True or (isinstance(self.refine, (int, float)) and math.isfinite(self.refine)
+                                        and self.refine > 0)):
+            raise ValueError(f"Scene {self.name!r}: refine must be True, False, None or a target edge length > 0, "
+                             f"got {self.refine!r}")
+        radii = self.critical_distances()
+        values = [r for r in (radii.values() if isinstance(radii, dict) else [radii]) if r]
+        if not values:
+            raise ValueError(f"Scene {self.name!r}: refine needs the critical-distance criterion "
+                             f"(a radius or a toughness): the one-ring criterion depends on the mesh")
+        h = min(values) / 4 if self.refine is True else float(self.refine)
+        return h, REFINE_RADIUS * max(values), REFINE_REACH * max(values)
+

@@ -192,6 +192,8 @@ class Simulation:
             if run["area_initial"] != area_initial:
                 raise checkpoint.CheckpointError(f"{self.out}: the checkpoint's initial area {run['area_initial']!r} "
                                                  f"is not the scene's {area_initial!r}")
+            if state.area is None:        # a checkpoint of an unrefined run
+                state.area = area_initial
             return state, RunFiles.resume(self.out, state.step, self.pictures), wall_before
         state = stepper.initial_state(self.timings)
         files = None

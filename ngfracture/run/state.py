@@ -55,6 +55,9 @@ class State:
     external : numpy.ndarray or None
         The dead loads' nodal forces at this state (None: the scene has none), for their
         work over the next increment.
+    area : float or None
+        The reference area of the mesh (the area invariant's reference: the scene's, or
+        that of the last refinement, Scene.refine).
     """
     arrays: MeshArrays
     u: np.ndarray            # P1 displacement vector, VectorH1 layout
@@ -74,6 +77,7 @@ class State:
     tangent: object = field(default=None, repr=False, compare=False)
     mesh: object = field(default=None, repr=False, compare=False)
     external: np.ndarray = None
+    area: float = None
 
 
 def round_trip(mesh):
@@ -155,7 +159,7 @@ def save_state(folder, state, run):
         arrays["external"] = state.external
     meta = {"x": state.x, "dx": state.dx, "step": state.step, "quiet": state.quiet, "work": state.work,
             "peak_energy": state.peak_energy, "history": state.history,
-            "contact_keys": [list(k) for k in state.contact_keys], **run}
+            "contact_keys": [list(k) for k in state.contact_keys], "area": state.area, **run}
     return checkpoint.write(folder, state.step, arrays, meta)
 
 
@@ -186,6 +190,7 @@ def load_state(folder):
                   fixed_dofs=arrays["fixed_dofs"], peak_energy=meta.pop("peak_energy"),
                   history=meta.pop("history"), strength=arrays.get("strength"),
                   contact_keys=[tuple(k) for k in meta.pop("contact_keys", [])],
-                  tangent_state=arrays.get("tangent_state"), external=arrays.get("external"))
+                  tangent_state=arrays.get("tangent_state"), external=arrays.get("external"),
+                  area=meta.pop("area", None))
     state.mesh = mesh_from_arrays(state.arrays)
     return state, meta

@@ -48,6 +48,7 @@ from .records import (AcceptedStep, Attempt, CrackPass, Equilibrium, StepFailed,
 from .state import State, crack_length, round_trip
 from . import tangents
 from .growth import critical_event, relax
+from .refinement import refine_equilibrium, refine_initial
 
 __all__ = ["LoadStep"]
 
@@ -266,15 +267,20 @@ class LoadStep:
             forces = load_vector(prob)
             before = state.external if state.external is not None else np.zeros_like(forces)
             work += work_of_forces(before, forces, state.u, prob.u.vec.FV().NumPy())
+        area = state.area
         if crack is None:
-            crack = self.crack_pass(prob, x, state.strength, eq.tangent, timings)
+            # judged on refined material around tips and hot spots (Scene.refine)
+            refined = refine_equilibrium(self, prob, eq, x, state.strength, area, method, timings)
+            prob, eq, area = refined.problem, refined.equilibrium, refined.area
+            work, iterations = work + refined.work, iterations + refined.iterations
+            crack = self.crack_pass(prob, x, refined.strength, eq.tangent, timings)
             if c.growth == "fixed" and crack.n_split > c.max_new_cracks and dx * c.cut >= c.dx_min:
                 return TooManyCracks(crack.n_split)
-        relaxed = relax(self, prob, crack, eq, x, method, timings)
+        relaxed = relax(self, prob, crack, eq, x, area, method, timings)
         return Attempt(relaxed.problem, x, crack.n_split, crack.n_split + relaxed.splits, relaxed.strength,
                        relaxed.contact_keys, relaxed.tangent, work + relaxed.work, relaxed.positions,
                        iterations + relaxed.iterations, merged_notes(notes, relaxed.notes), start is not None,
-                       relaxed.broken_through, relaxed.lost_support)
+                       relaxed.broken_through, relaxed.lost_support, area=relaxed.area)
 
     def increment(self, state, x, method, timings, substeps=1, keep=True):
         """The increment's problem at x on the state's mesh and its equilibrium.
@@ -369,7 +375,7 @@ class LoadStep:
         try:
             attempt = self.attempt(state, dx, log.method, timings, log.substeps, keep)
             if not isinstance(attempt, TooManyCracks):
-                attempt.overlap = self.check(attempt.problem, timings)
+                attempt.overlap = self.check(attempt.problem, attempt.area, timings)
             return attempt
         except StepFailed:
             raise
@@ -377,13 +383,15 @@ class LoadStep:
             raise StepFailed("exception", "relaxation", f"{type(exc).__name__}: {exc}",
                              details=traceback.format_exc()) from exc
 
-    def check(self, prob, timings):
+    def check(self, prob, area, timings):
         """The invariants of an attempt's result (:mod:`ngfracture.run.invariants`).
 
         Parameters
         ----------
         prob : ElasticProblem
             The equilibrium at the end of the attempt.
+        area : float
+            The reference area its mesh must have to the last bit.
         timings : Timings
 
         Returns
@@ -398,7 +406,7 @@ class LoadStep:
         """
         with timings.timed("checks"):
             pieces = self.scene.contact or "crack" in prob.mesh.GetBoundaries() or prob.fragments()[0] > 1
-            violation, overlap = check_state(prob, self.area_initial, pieces)
+            violation, overlap = check_state(prob, area, pieces)
         if violation is not None:
             raise StepFailed(violation.invariant, "invariant", violation.message)
         return overlap
@@ -476,7 +484,7 @@ class LoadStep:
                     reactions=-out_of_balance[rows.fixed_dofs], fixed_values=rows.fixed_values.copy(),
                     fixed_dofs=rows.fixed_dofs.copy(), peak_energy=max(state.peak_energy, energy),
                     history=state.history + [record], strength=attempt.strength,
-                    contact_keys=attempt.contact_keys, mesh=mesh,
+                    contact_keys=attempt.contact_keys, mesh=mesh, area=attempt.area,
                     external=load_vector(prob) if prob.loads else None)
         kept = tangents.tangent_to_keep(attempt.tangent, log.method, new.fixed_dofs)
         if kept is not None:
@@ -511,11 +519,13 @@ class LoadStep:
         -------
         State
         """
-        arrays, mesh = round_trip(self.scene.mesh)
+        strength = None if self.scene.strength is None else np.array(self.scene.strength, dtype=float)
+        mesh, strength = refine_initial(self, self.scene.mesh, strength, timings)
+        arrays, mesh = round_trip(mesh)
         prob = self.problem(mesh, 0.0, timings)
         rows = prob.assemble_constraints()
-        strength = None if self.scene.strength is None else np.array(self.scene.strength, dtype=float)
-        return State(arrays=arrays, u=np.zeros(prob.fes.ndof), x=0.0, dx=float(self.scene.dx), step=0,
+        area = self.area_initial if mesh.nv == self.scene.mesh.nv else FragmentStatistics(mesh).total_area
+        return State(arrays=arrays, u=np.zeros(prob.fes.ndof), x=0.0, dx=float(self.scene.dx), step=0, area=area,
                      external=load_vector(prob) if prob.loads else None,
                      quiet=0, work=0.0, reactions=np.zeros(len(rows.fixed_dofs)),
                      fixed_values=rows.fixed_values.copy(), fixed_dofs=rows.fixed_dofs.copy(),

@@ -7,7 +7,8 @@ __all__ = ["PHASES", "Timings"]
 #: wall time per phase; "linear" (factorisations and triangular solves) and "assembly"
 #: (NGSolve's residual and tangent assembly) are parts of "solve"; "checks": the invariants
 #: of every attempt (run/invariants.py)
-PHASES = ("solve", "linear", "assembly", "strain", "split", "rebuild", "collision", "contact", "checks", "output")
+PHASES = ("solve", "linear", "assembly", "strain", "split", "rebuild", "refine", "collision", "contact", "checks",
+          "output")
 
 
 class Timings(dict):
