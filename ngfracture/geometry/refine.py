@@ -157,7 +157,7 @@ def _broken_twins(arrays, twins):
     return marked
 
 
-def refine_near(mesh, centres, radius, h, reach=None, max_rounds=MAX_ROUNDS):
+def refine_near(mesh, centres, radius, h, reach=None, max_rounds=MAX_ROUNDS, arrays=None):
     """Bisect the triangles near some points until none near them is longer than h.
 
     With ``reach`` < ``radius`` the refinement happens only when a triangle within
@@ -177,6 +177,8 @@ def refine_near(mesh, centres, radius, h, reach=None, max_rounds=MAX_ROUNDS):
     reach : float, optional
         Refine only when a triangle within this distance needs it (default: ``radius``).
     max_rounds : int
+    arrays : MeshArrays, optional
+        The mesh as arrays, if the caller has them.
 
     Returns
     -------
@@ -191,9 +193,9 @@ def refine_near(mesh, centres, radius, h, reach=None, max_rounds=MAX_ROUNDS):
     if not (np.isfinite(radius) and radius >= 0 and np.isfinite(h) and h > 0):
         raise ValueError(f"refine_near: radius must be >= 0 and h > 0, got radius={radius!r}, h={h!r}")
     centres = np.asarray(centres, dtype=float).reshape(-1, 2)
-    arrays = mesh_to_arrays(mesh)
     if len(centres) == 0:
         return None
+    arrays = mesh_to_arrays(mesh) if arrays is None else arrays
     tree = cKDTree(centres)
     if reach is not None and reach < radius and not _marked(arrays, tree, reach, h).any():
         return None

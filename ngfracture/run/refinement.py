@@ -31,15 +31,22 @@ from typing import NamedTuple
 import numpy as np
 
 from ..fracture.fragments import FragmentStatistics
+from ..fracture.strain import principal
 from ..geometry.refine import AREA_ROUNDING, refine_near, sharp_vertices
 from ..mechanics.resultants import load_vector, work_of_forces
 
-__all__ = ["REFINE_AT", "REFINE_JUMP", "MAX_REFINEMENTS", "Refined", "refine_initial", "refine_equilibrium"]
+__all__ = ["REFINE_AT", "MAX_REFINEMENTS", "Refined", "refine_initial", "refine_equilibrium"]
 
-#: local overstrain from which a triangle with a steep field is refined around (half way to cracking)
-REFINE_AT = 0.5
-#: the jump of the local overstrain to a neighbour that marks a field the mesh does not resolve
-REFINE_JUMP = 0.1
+#: a vertex whose criterion measure reaches this fraction of cracking is refined around
+#: (with the crack tips and sharp notch tips): it may crack at the next equilibrium, and it
+#: must be judged on a mesh that resolves r. A body loaded near its strength but below
+#: this (the plate's ligament at 0.7 while a crack grows) is left as it is
+REFINE_AT = 0.9
+#: ... and reaches this fraction of the largest measure: under a load step that overshoots
+#: (a whole ligament above its strength, its notch tip far above) the vertices that may
+#: split next are the most overstrained ones, one per pass (StepControl split "one"); a
+#: coarse mesh reads a concentration low by less than this
+REFINE_NEAR_MAX = 0.8
 #: refinements of one equilibrium at most (each may reveal a new hot spot to refine around)
 MAX_REFINEMENTS = 4
 
@@ -55,32 +62,19 @@ class Refined(NamedTuple):
     refinements: int
 
 
-def _largest_jumps(triangles, values):
-    """Per triangle, the largest difference of ``values`` to a triangle sharing an edge."""
-    nv = triangles.max() + 1
-    edges = np.sort(np.concatenate([triangles[:, [0, 1]], triangles[:, [1, 2]], triangles[:, [2, 0]]]), axis=1)
-    keys = edges @ np.array([nv, 1])
-    owner = np.tile(np.arange(len(triangles)), 3)
-    order = np.argsort(keys, kind="stable")
-    keys, owner = keys[order], owner[order]
-    shared = np.flatnonzero(keys[1:] == keys[:-1])
-    a, b = owner[shared], owner[shared + 1]
-    jump = np.zeros(len(triangles))
-    diff = np.abs(values[a] - values[b])
-    np.maximum.at(jump, a, diff)
-    np.maximum.at(jump, b, diff)
-    return jump
-
-
-def _centres(stepper, prob, timings):
-    """Where to refine: the sharp tips, and the centroids of the triangles of an
-    unresolved concentration (REFINE_AT, REFINE_JUMP)."""
+def _centres(stepper, prob, strength, timings):
+    """Where to refine: the sharp tips (crack tips, notch tips), and the vertices whose
+    criterion measure has reached REFINE_AT and REFINE_NEAR_MAX of the largest."""
     arrays = prob.arrays
     with timings.timed("strain"):
-        values = stepper.criterion.element_overstrain(prob.mesh, prob.u, arrays)
-    hot = (values >= REFINE_AT) & (_largest_jumps(arrays.triangles, values) >= REFINE_JUMP)
+        tensors = stepper.criterion.overstrain(prob.mesh, prob.u, strength, arrays=arrays)
+    measure = principal(tensors)[0]
+    hot = measure >= max(REFINE_AT, REFINE_NEAR_MAX * measure.max(initial=0.0))
+    import os
+    if os.environ.get("NGF_GEOMETRIC_ONLY"):
+        hot[:] = False
     points = arrays.points
-    return np.concatenate([points[sharp_vertices(arrays)], points[arrays.triangles[hot]].mean(axis=1)])
+    return np.concatenate([points[sharp_vertices(arrays)], points[hot]])
 
 
 def _transferred(refinement, prob, strength):
@@ -111,7 +105,7 @@ def refine_initial(stepper, mesh, strength, timings):
     h, radius, _ = spec
     prob = stepper.problem(mesh, 0.0, timings)
     with timings.timed("refine"):
-        ref = refine_near(mesh, prob.arrays.points[sharp_vertices(prob.arrays)], radius, h)
+        ref = refine_near(mesh, prob.arrays.points[sharp_vertices(prob.arrays)], radius, h, arrays=prob.arrays)
     if ref is None:
         return mesh, strength
     return ref.mesh, (None if strength is None else ref.transfer(strength))
@@ -150,9 +144,9 @@ def refine_equilibrium(stepper, prob, eq, x, strength, area, method, timings):
         return Refined(prob, eq, strength, area, work, iterations, count)
     h, radius, reach = spec
     for _ in range(MAX_REFINEMENTS):
-        centres = _centres(stepper, prob, timings)
+        centres = _centres(stepper, prob, strength, timings)
         with timings.timed("refine"):
-            ref = refine_near(prob.mesh, centres, radius, h, reach)
+            ref = refine_near(prob.mesh, centres, radius, h, reach, arrays=prob.arrays)
         if ref is None:
             break
         u, strength = _transferred(ref, prob, strength)

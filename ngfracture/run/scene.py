@@ -19,8 +19,11 @@ def _positive_or_none(value):
 #: triangles within this many critical distances of a tip are refined (Scene.refine) once
 #: one within REFINE_REACH r is too coarse: the tip's rays read 2 r, and the tip advances
 #: REFINE_RADIUS - REFINE_REACH r into refined material before the next refinement
-REFINE_RADIUS = 4.0
-REFINE_REACH = 2.0
+REFINE_RADIUS = 3.0
+REFINE_REACH = 1.5
+#: the refined triangles' longest edge at most this times the target h: bisection halves a
+#: triangle, so their edges then lie about h on average (a netgen mesh of maxh h alike)
+LONGEST_EDGE = math.sqrt(2.0)
 
 
 @dataclass
@@ -233,5 +236,5 @@ class Scene:
             raise ValueError(f"Scene {self.name!r}: refine needs the critical-distance criterion "
                              f"(a radius or a toughness): the one-ring criterion depends on the mesh")
         h = min(values) / 4 if self.refine is True else float(self.refine)
-        return h, REFINE_RADIUS * max(values), REFINE_REACH * max(values)
+        return LONGEST_EDGE * h, REFINE_RADIUS * max(values), REFINE_REACH * max(values)
 
