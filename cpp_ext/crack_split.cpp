@@ -172,6 +172,24 @@ namespace ngfracture
       }
   }
 
+  bool CrackSplitter :: IntoFan (int v, const double * d) const
+  {
+    const int * S = StarBegin(v);
+    int m = StarSize(v);
+    double px = points[2*size_t(v)], py = points[2*size_t(v)+1];
+    for (int i = 0; i < m; i++)
+      {
+        int t = S[i];
+        int k = Local(t, v);
+        int a = trigs[3*t+(k+1)%3], b = trigs[3*t+(k+2)%3];
+        double ax = points[2*size_t(a)] - px, ay = points[2*size_t(a)+1] - py;
+        double bx = points[2*size_t(b)] - px, by = points[2*size_t(b)+1] - py;
+        // counter-clockwise (v, a, b): d lies between a and b
+        if (ax*d[1] - ay*d[0] >= 0 && d[0]*by - d[1]*bx >= 0) return true;
+      }
+    return false;
+  }
+
   bool CrackSplitter :: ShareTriangle (int v, const Edge & a, const Edge & b) const
   {
     const int * S = StarBegin(v);
@@ -302,6 +320,31 @@ namespace ngfracture
             for (size_t i = 0; i < edges.size(); i++)
               if (edges[i].count != 1 && (e2 < 0 || better(edges[i], edges[e2]))) e2 = int(i);
             if (e2 >= 0 && edges[e2].score >= std::cos(enter_angle)) { e1 = e2; rule |= RULE_2C; }
+          }
+        if (edges[e1].count == 1 && enter_angle > 0)
+          {
+            // rule 2d: no interior edge near the line, but one half of it points into the body
+            // clear of the surface (a concave corner with a coarse fan: its crack starts there
+            // on the mesh's nearest edge; along a straight boundary both halves run along it)
+            double px = points[2*size_t(v)], py = points[2*size_t(v)+1];
+            int e2 = -1;
+            for (double sign : { 1.0, -1.0 })
+              {
+                double h[2] = { sign * tdir[0], sign * tdir[1] };
+                bool clear = IntoFan(v, h);
+                for (int b : bnd)
+                  {
+                    double bx = points[2*size_t(edges[b].x)] - px, by = points[2*size_t(edges[b].x)+1] - py;
+                    double len = std::hypot(bx, by);
+                    if (len > 0 && (bx*h[0] + by*h[1]) / len > std::cos(enter_angle)) clear = false;
+                  }
+                if (!clear) continue;
+                for (size_t i = 0; i < edges.size(); i++)
+                  if (edges[i].count != 1 && (e2 < 0 || sign * edges[i].side > sign * edges[e2].side ||
+                                              (sign * edges[i].side == sign * edges[e2].side && edges[i].x < edges[e2].x)))
+                    e2 = int(i);
+              }
+            if (e2 >= 0) { e1 = e2; rule |= RULE_2D; }
           }
         if (edges[e1].count == 1) { rule |= RULE_2A; finish(); return; }   // along the boundary: no split
         cuts.push_back(edges[e1].x);

@@ -30,8 +30,12 @@ namespace ngfracture
       RULE_NONE   = 128,  // nothing split (no admissible edge, pinched or isolated vertex)
       RULE_2C     = 256,  // boundary vertex whose best edge is a boundary edge: the best
                           // interior edge within enter_angle of the crack line cut instead
-      RULE_TIP1   = 512   // crack tip extended by one edge, the one nearest the crack line
+      RULE_TIP1   = 512,  // crack tip extended by one edge, the one nearest the crack line
                           // ahead of the tip (single_edge_tips)
+      RULE_2D     = 1024  // boundary vertex whose best edge is a boundary edge and no interior
+                          // edge within enter_angle: the half of the crack line into the body,
+                          // enter_angle or more off both boundary edges, enters on the interior
+                          // edge nearest it (a concave corner whose fan is coarse)
     };
 
   class CrackSplitter
@@ -100,6 +104,8 @@ namespace ngfracture
     bool SplitAt (int w, const int * cut, int ncut);   // cut: far vertices of removed edges
     void ProcessVertex (int v, const double * dir, double enter_angle, bool single_edge_tips);
     bool ShareTriangle (int v, const Edge & a, const Edge & b) const;
+    // true if the direction d from v points into one of v's triangles (or along its sides)
+    bool IntoFan (int v, const double * d) const;
   };
 }
 

@@ -42,7 +42,7 @@ void ExportCrack (py::module & m)
   rules["1"] = int(RULE_1); rules["1a"] = int(RULE_1A); rules["1b"] = int(RULE_1B);
   rules["2"] = int(RULE_2); rules["2a"] = int(RULE_2A); rules["2b"] = int(RULE_2B);
   rules["tip"] = int(RULE_TIP); rules["none"] = int(RULE_NONE); rules["2c"] = int(RULE_2C);
-  rules["tip1"] = int(RULE_TIP1);
+  rules["tip1"] = int(RULE_TIP1); rules["2d"] = int(RULE_2D);
   m.attr("CRACK_RULES") = rules;   // bit flags of the split record's "rule" entries
 
   m.def("CrackElementStrain",

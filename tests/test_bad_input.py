@@ -223,6 +223,7 @@ if __name__ == "__main__":
     (((-0.22, 0.5, 0.08), (-0.12, 0.5, 0.08)), "holes[1] = (-0.12, 0.5, 0.08) does not lie"),
     (((-0.5, 0.22, 0.05),), "clear of the notch"),                                        # on the notch's tip
     (((-0.22, 0.5, -1.0),), "holes[0] radius must be a finite number > 0"),
+    (((-0.22, 0.5, 0.08), (-0.22, 0.62, 0.05)), "holes[1] = (-0.22, 0.62, 0.05) overlaps holes[0]"),
 ])
 def test_holed_beam_names_a_hole_that_does_not_fit(holes, message):
     with pytest.raises(ValueError, match=re.escape(message)):

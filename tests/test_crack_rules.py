@@ -6,7 +6,7 @@ import ngsolve
 
 from ngfracture._ngfracture import ElementAreas
 from ngfracture import fracture
-from crack_util import grid_mesh, vid, fan_mesh, check_invariants, coords
+from crack_util import grid_mesh, vid, fan_mesh, check_invariants, coords, mesh_from_arrays
 
 X = [[1.0, 0.0]]   # maximum strain along x: cracks want to run along y
 Y = [[0.0, 1.0]]
@@ -300,3 +300,25 @@ def test_single_edge_tip_reaches_the_boundary():
     res3 = fracture.split_vertices(res2.mesh, [vid(4, 2, 1)], X, rules=fracture.GROWTH_RULES)
     assert res3.nfragments == 2
     assert crack_length(res3.mesh) == pytest.approx(8.0, rel=1e-14)
+
+
+def test_rule_2d_a_concave_corner_with_a_coarse_fan_starts_its_crack_on_the_nearest_edge():
+    """A corner whose body spans 270 degrees (boundary edges at 0 and 270 degrees,
+    interior edges at 60, 150 and 210): a crack line at 100 degrees. Its best edge is the
+    boundary edge at 270 (10 degrees off the line's other half, which points out of the
+    body); no interior edge lies within 30 degrees (rule 2c cuts nothing). The half at 100
+    degrees points into the body, 100 and 170 degrees off the boundary edges: the edge
+    nearest it (60 degrees, 40 off) is cut; its far end lies on the boundary and splits too
+    (rule 2b: the fan is cut through). With enter_angle 0 (the paper's rules) nothing."""
+    angles = np.radians([0.0, 60.0, 150.0, 210.0, 270.0])
+    points = np.vstack([[0.0, 0.0], np.column_stack([np.cos(angles), np.sin(angles)])])
+    m = mesh_from_arrays(points, [[0, 1, 2], [0, 2, 3], [0, 3, 4], [0, 4, 5]])
+    a = np.radians(100.0)
+    direction = [[-np.sin(a), np.cos(a)]]
+    res = fracture.split_vertices(m, [0], direction, rules=fracture.GROWTH_RULES)
+    check_invariants(m, res)
+    assert fracture.rule_names(res.record["rule"][0]) == ["2", "2b", "2d"]
+    assert edge_set(res) == {(0, 2)} and res.mesh.nv == m.nv + 2
+    assert crack_length(res.mesh) == pytest.approx(2.0, rel=1e-14)       # both faces of the unit edge
+    paper = fracture.split_vertices(m, [0], direction, rules=fracture.PAPER_RULES)
+    assert paper.record["rule"][0] == fracture.RULE_2 | fracture.RULE_2A and paper.mesh.nv == m.nv

@@ -1,8 +1,10 @@
 """The dense QP behind the contact LCP: exact Kuhn-Tucker points in finitely many steps."""
+from pathlib import Path
+
 import numpy as np
 import pytest
 
-from ngfracture.linalg.qp import Infeasible, convex_qp
+from ngfracture.linalg.qp import Infeasible, QPError, convex_qp
 
 
 def kuhn_tucker_error(H, c, A_eq, b_eq, A_in, b_in, x, u_eq, u_in):
@@ -74,3 +76,13 @@ def test_infeasible_constraints_are_reported():
 if __name__ == "__main__":
     import sys
     sys.exit(pytest.main([__file__, "-q"]))
+
+
+def test_a_nearly_singular_h_is_an_error_not_a_huge_answer():
+    """The complementarity QP of a cracked L-panel's contact rows (79 multipliers, 6 rigid
+    modes; H = S + G G^T + 1e-10 I of condition 2e11, its rows dependent): the dual steps
+    ran away to 1e157 and the loop's stopping level, relative to the iterate, accepted it.
+    Now a QPError (the contact solver records it and takes the primal-dual update)."""
+    data = np.load(Path(__file__).parent / "data" / "qp_nearly_singular.npz")
+    with pytest.raises(QPError, match="nearly singular"):
+        convex_qp(*(data[k] for k in ("H", "c", "A_eq", "b_eq", "A_in", "b_in")))

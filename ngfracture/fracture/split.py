@@ -45,7 +45,10 @@ Rules as implemented (paper section 3; decisions where the paper is silent)
   (rule tip1: a crack grows from its tip, it does not fork there); a boundary vertex
   whose best edge is a boundary edge cuts its best interior edge if that lies within
   ``enter_angle`` of the crack line (rule 2c: a crack starts at a V-notch tip, whose
-  flank is often the best edge).
+  flank is often the best edge); where none is, but one half of the crack line points
+  into the body ``enter_angle`` or more off both boundary edges, it cuts the interior edge
+  nearest that half (rule 2d: a concave corner whose fan is coarser than the angle; a
+  crack line along a straight boundary still splits nothing).
 * Rules 1b/2b and "never two pieces joined by a single vertex": after the cut, the far end
   of every cut edge is split if its fan fell apart (it was on the boundary, on a crack face
   or a crack tip). Only the processed vertex and those far ends change their fans.
@@ -69,7 +72,7 @@ from .criterion import Criterion
 from .strain import check_mesh_2d, check_positive, displacement_order, principal
 
 __all__ = [
-    "RULE_1", "RULE_1A", "RULE_1B", "RULE_2", "RULE_2A", "RULE_2B", "RULE_2C", "RULE_TIP", "RULE_TIP1",
+    "RULE_1", "RULE_1A", "RULE_1B", "RULE_2", "RULE_2A", "RULE_2B", "RULE_2C", "RULE_2D", "RULE_TIP", "RULE_TIP1",
     "RULE_NONE", "RULE_NAMES", "SplitRules", "PAPER_RULES", "GROWTH_RULES", "SplitResult", "split_vertices",
     "transfer", "transfer_vertex_field", "split_by_tensor", "crack_step", "rule_names",
 ]
@@ -86,10 +89,11 @@ RULE_TIP = 64    # crack tip (fan open only along a crack): treated by rule 1
 RULE_NONE = 128  # nothing split (no admissible edge pair, isolated or pinched vertex)
 RULE_2C = 256    # boundary vertex whose best edge is a boundary edge: the crack entered the body (enter_angle)
 RULE_TIP1 = 512  # crack tip extended by one edge (single_edge_tips)
+RULE_2D = 1024   # boundary vertex, no interior edge within enter_angle: the crack entered on the edge nearest its half-line into the body
 
 RULE_NAMES = [(RULE_1, "1"), (RULE_1A, "1a"), (RULE_1B, "1b"), (RULE_2, "2"),
                (RULE_2A, "2a"), (RULE_2B, "2b"), (RULE_TIP, "tip"), (RULE_NONE, "none"), (RULE_2C, "2c"),
-               (RULE_TIP1, "tip1")]
+               (RULE_TIP1, "tip1"), (RULE_2D, "2d")]
 
 
 @dataclass(frozen=True)

@@ -17,7 +17,13 @@ constraints, instead of a factorisation per step (docs/solvers.md, "The contact 
 import numpy as np
 import scipy.linalg as sla
 
-__all__ = ["QPError", "Infeasible", "convex_qp"]
+__all__ = ["QPError", "Infeasible", "convex_qp", "GROWTH_LIMIT"]
+
+#: the iterate's size in the metric of H may exceed the data's (the unconstrained minimiser's
+#: and the constraints' offsets) by this factor at most: beyond it rounding in a nearly
+#: singular H drives the dual steps, and the loop's stopping level (relative to the iterate)
+#: would accept any miss (measured: an H of condition 2e11 reached 1e157)
+GROWTH_LIMIT = 1e8
 
 
 class QPError(ValueError):
@@ -62,7 +68,8 @@ def convex_qp(H, c, A_eq, b_eq, A_in, b_in, tol=1e-12, max_steps=None):
     Infeasible
         If the constraints cannot all hold.
     QPError
-        If max_steps did not suffice (rounding; the method is finite in exact arithmetic).
+        If max_steps did not suffice (rounding; the method is finite in exact arithmetic),
+        or the iterate grew beyond GROWTH_LIMIT times the data (a nearly singular H).
     """
     H = np.asarray(H, dtype=float)
     n = H.shape[0]
@@ -94,6 +101,10 @@ def convex_qp(H, c, A_eq, b_eq, A_in, b_in, tol=1e-12, max_steps=None):
                 break
         x, u, Q, R = _enter(j_new, sign[j_new] * N[:, j_new], sign[j_new] * (A[j_new] @ x - b[j_new]),
                             x, u, active, Q, R, L, p)
+        size = np.linalg.norm(L.T @ x) if np.all(np.isfinite(x)) else np.inf
+        if not size <= GROWTH_LIMIT * max(np.abs(b / norm).max(initial=0.0), c_size, 1e-300):
+            raise QPError(f"convex_qp: the iterate grew to {size:.3g} in the metric of H against data of "
+                          f"{max(np.abs(b / norm).max(initial=0.0), c_size):.3g} (H nearly singular)")
     else:
         raise QPError(f"convex_qp: no solution in {max_steps} steps")
     mult = np.zeros(len(b))
