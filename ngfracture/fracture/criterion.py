@@ -25,7 +25,7 @@ import numpy as np
 from .. import _ngfracture as _ext
 from ..geometry.meshio import mesh_to_arrays
 from ..mechanics.materials import Material
-from .strain import check_mesh_2d, check_positive, element_strain, equivalent_strain, principal, vertex_strain
+from .strain import check_mesh_2d, check_positive, element_strain, equivalent_strain, vertex_strain
 
 __all__ = ["Criterion", "nonlocal_opening", "toughness", "critical_distance", "select"]
 
@@ -263,42 +263,18 @@ class Criterion:
             if strength is not None:
                 scale = np.where(scale > 0, 1.0 / strength, 0.0)
             return vertex_strain(mesh, u, self.measure) * scale[:, None]
-        strain = self._element_tensors(mesh, u) * inv[arrays.regions][:, None]
+        strain = element_strain(mesh, u, self.measure)
+        if self.material is not None:
+            strain = equivalent_strain(mesh, strain, self.material)     # stress / E per triangle
         radii = _per_region(self.radius, names, "critical distance")
         r_region = np.array([0.0] + [radii.get(n) or 0.0 for n in names])
         radius = np.zeros(mesh.nv)
         np.maximum.at(radius, arrays.triangles.ravel(), np.repeat(r_region[arrays.regions], 3))
-        tensors = nonlocal_opening(mesh, strain, radius * (scale > 0), self.ndir)
+        tensors = nonlocal_opening(mesh, strain * inv[arrays.regions][:, None], radius * (scale > 0), self.ndir)
         if strength is not None:
             # the vertex's random strength replaces its region's critical strain
             tensors *= np.where(scale > 0, 1.0 / (strength * np.where(scale > 0, scale, 1.0)), 0.0)[:, None]
         return tensors
-
-    def _element_tensors(self, mesh, u):
-        """The strain per triangle, or stress / E with a material (rows xx, yy, xy)."""
-        strain = element_strain(mesh, u, self.measure)
-        return strain if self.material is None else equivalent_strain(mesh, strain, self.material)
-
-    def element_overstrain(self, mesh, u, arrays=None):
-        """The largest principal value of every triangle's strain (or stress / E) over its
-        region's critical strain: the local field the critical-distance measure reads
-        (0 in regions that never crack).
-
-        Parameters
-        ----------
-        mesh : ngsolve.Mesh
-        u : ngsolve.GridFunction or numpy.ndarray
-        arrays : MeshArrays, optional
-
-        Returns
-        -------
-        numpy.ndarray (ne,)
-        """
-        arrays = mesh_to_arrays(mesh) if arrays is None else arrays
-        critical = _per_region(self.critical, arrays.region_names, "critical strain")
-        inv = np.array([0.0] + [1.0 / critical[n] if critical.get(n) is not None else 0.0
-                                for n in arrays.region_names])
-        return principal(self._element_tensors(mesh, u))[0] * inv[arrays.regions]
 
     def describe(self):
         """What the criterion is, for summaries: kind, critical strains, critical distances.

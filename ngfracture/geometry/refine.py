@@ -57,7 +57,16 @@ class Refinement:
     area: float
 
     def transfer(self, values):
-        """A vertex field (nv_old, ...) on the refined mesh (nv_new, ...)."""
+        """A vertex field on the refined mesh: the P1 interpolant, exact for a P1 field.
+
+        Parameters
+        ----------
+        values : array_like (nv_old, ...)
+
+        Returns
+        -------
+        numpy.ndarray (nv_new, ...)
+        """
         values = np.asarray(values, dtype=float)
         flat = values.reshape(values.shape[0], -1)
         return (self.prolongation @ flat).reshape((self.prolongation.shape[0],) + values.shape[1:])

@@ -3,20 +3,18 @@
 The critical-distance criterion judges the stress at distance r from a tip; it converges
 when the triangles there are small against r. A scene with ``refine`` starts from a
 coarse mesh, and every equilibrium the crack engine is about to judge is first refined
-around the places that can crack:
+around its sharp tips (crack tips and sharp notch tips,
+:func:`ngfracture.geometry.refine.sharp_vertices`) to the target edge length within
+``REFINE_RADIUS`` r of them, once a triangle within ``REFINE_REACH`` r is too long
+(Scene.refinement); the equilibrium is solved again on the refined mesh at the same load,
+and only then does the crack pass split. A crack growing at fixed load is refined after
+each split, so its tip always advances into refined material.
 
-* every sharp tip (crack tips and sharp notch tips, :func:`ngfracture.geometry.refine.sharp_vertices`),
-* every triangle whose local overstrain (``Criterion.element_overstrain``) has reached
-  :data:`REFINE_AT` and differs from a neighbour's by :data:`REFINE_JUMP` or more: a stress
-  concentration on its way to cracking that the mesh does not resolve (a hole's edge, a
-  blunt notch, a bent surface). A body stressed near its strength but uniformly (the
-  plate's ligament) is not refined: there the mesh reads the field right already,
-
-to the target edge length h within ``REFINE_RADIUS`` r of them once a triangle within
-``REFINE_REACH`` r is too long (Scene.refinement), and the equilibrium is solved again on
-the refined mesh at the same load. Only then does the
-crack pass split. A crack growing at fixed load is refined after each split, so its tip
-always advances into refined material.
+Only the tips: the criterion's measure at a point of a smooth field is read right by a
+coarse mesh, and a measure-based indicator refines the whole body where the field is
+near-uniform (the plate at its first crack: the notch tip at 1.07 of its strength, the
+rest of the plate at 0.96). A smooth concentration (a hole) is judged at the initial
+mesh's resolution until it cracks; its crack's tips are refined from then on.
 
 What carries over: the displacement and the per-vertex strength by the refinement's
 prolongation (exact for the P1 displacement); boundary names, regions and crack faces.
@@ -28,26 +26,14 @@ softer) is part of the released energy.
 """
 from typing import NamedTuple
 
-import numpy as np
-
 from ..fracture.fragments import FragmentStatistics
-from ..fracture.strain import principal
 from ..geometry.refine import AREA_ROUNDING, refine_near, sharp_vertices
 from ..mechanics.resultants import load_vector, work_of_forces
 
-__all__ = ["REFINE_AT", "MAX_REFINEMENTS", "Refined", "refine_initial", "refine_equilibrium"]
+__all__ = ["MAX_REFINEMENTS", "Refined", "refine_initial", "refine_equilibrium"]
 
-#: a vertex whose criterion measure reaches this fraction of cracking is refined around
-#: (with the crack tips and sharp notch tips): it may crack at the next equilibrium, and it
-#: must be judged on a mesh that resolves r. A body loaded near its strength but below
-#: this (the plate's ligament at 0.7 while a crack grows) is left as it is
-REFINE_AT = 0.9
-#: ... and reaches this fraction of the largest measure: under a load step that overshoots
-#: (a whole ligament above its strength, its notch tip far above) the vertices that may
-#: split next are the most overstrained ones, one per pass (StepControl split "one"); a
-#: coarse mesh reads a concentration low by less than this
-REFINE_NEAR_MAX = 0.8
-#: refinements of one equilibrium at most (each may reveal a new hot spot to refine around)
+#: refinements of one equilibrium at most (a refinement that needs another is a bisection
+#: closure that reached the zone of a second tip)
 MAX_REFINEMENTS = 4
 
 
@@ -62,19 +48,10 @@ class Refined(NamedTuple):
     refinements: int
 
 
-def _centres(stepper, prob, strength, timings):
-    """Where to refine: the sharp tips (crack tips, notch tips), and the vertices whose
-    criterion measure has reached REFINE_AT and REFINE_NEAR_MAX of the largest."""
+def _centres(prob):
+    """Where to refine: the sharp tips (crack tips, notch tips)."""
     arrays = prob.arrays
-    with timings.timed("strain"):
-        tensors = stepper.criterion.overstrain(prob.mesh, prob.u, strength, arrays=arrays)
-    measure = principal(tensors)[0]
-    hot = measure >= max(REFINE_AT, REFINE_NEAR_MAX * measure.max(initial=0.0))
-    import os
-    if os.environ.get("NGF_GEOMETRIC_ONLY"):
-        hot[:] = False
-    points = arrays.points
-    return np.concatenate([points[sharp_vertices(arrays)], points[hot]])
+    return arrays.points[sharp_vertices(arrays)]
 
 
 def _transferred(refinement, prob, strength):
@@ -144,7 +121,7 @@ def refine_equilibrium(stepper, prob, eq, x, strength, area, method, timings):
         return Refined(prob, eq, strength, area, work, iterations, count)
     h, radius, reach = spec
     for _ in range(MAX_REFINEMENTS):
-        centres = _centres(stepper, prob, strength, timings)
+        centres = _centres(prob)
         with timings.timed("refine"):
             ref = refine_near(prob.mesh, centres, radius, h, reach, arrays=prob.arrays)
         if ref is None:

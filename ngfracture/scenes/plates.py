@@ -82,7 +82,7 @@ def notched_plate_mesh(maxh=0.034, width=1.0, height=1.0, notch_depth=0.04, notc
 
 def plate(maxh=0.034, strain_max=1e-3, dx=None, material=None, critical=GLASS["critical"],
           E=GLASS["E"], nu=GLASS["nu"], notch_maxh=None, radius=PLATE_RADIUS,
-          weibull_m=None, weibull_scale=None, weibull_area=None, seed=None):
+          weibull_m=None, weibull_scale=None, weibull_area=None, seed=None, refine=False):
     """The plate under tension of paper section 4.2 (Fig. 8).
 
     A 1 x 1 plate of glass (E = 5 GPa, nu = 0.18, plane stress, St Venant-Kirchhoff)
@@ -113,6 +113,10 @@ def plate(maxh=0.034, strain_max=1e-3, dx=None, material=None, critical=GLASS["c
         mesh is at most radius / 4 within 2 radius of the tips and along the line between
         them, where the crack runs. None: the paper's one-ring nodal strain (mesh
         dependent: its crack patterns change with maxh).
+    refine : bool
+        Refine ahead of the crack tips during the run (Scene.refine, radius / 4): the mesh
+        is ``maxh`` but for the notch tips, radius / 4 within 3 radius of them, instead of
+        fine along the whole line between them.
     weibull_m, weibull_scale, weibull_area, seed
         Random strength, see :func:`ngfracture.fracture.strength.scene_strength`: a Weibull
         modulus (None: uniform strength), the scale (default: mean = ``critical``), the
@@ -131,7 +135,10 @@ def plate(maxh=0.034, strain_max=1e-3, dx=None, material=None, critical=GLASS["c
         # tip vertex to the next and side cracks start (docs/criterion.md)
         fine = min(maxh, radius / 4)
         notch_maxh = fine if notch_maxh is None else positive("notch_maxh", notch_maxh)
-        mesh = notched_plate_mesh(maxh, notch_maxh=notch_maxh, notch_zone=2 * radius, path_maxh=fine)
+        if refine:          # the notch tips at r/4 by netgen; ahead of the tips by refinement
+            mesh = notched_plate_mesh(maxh, notch_maxh=radius / 4, notch_zone=3 * radius)
+        else:
+            mesh = notched_plate_mesh(maxh, notch_maxh=notch_maxh, notch_zone=2 * radius, path_maxh=fine)
     material = material if material is not None else StVenantKirchhoff(E, nu, plane="stress")
     dx = positive("dx", dx) if dx is not None else critical / 10
     strength, strength_parameters = scene_strength(mesh, ["plate"], critical, weibull_m, weibull_scale,
@@ -147,6 +154,7 @@ def plate(maxh=0.034, strain_max=1e-3, dx=None, material=None, critical=GLASS["c
                  parameters={"maxh": maxh, "strain_max": strain_max, "dx": dx, "critical": critical,
                              "notch_maxh": notch_maxh, "radius": radius,
                              "E": material.E, "nu": material.nu, "model": type(material).__name__,
-                             "notch_depth": 0.04, "notch_width": 0.02, **strength_parameters},
-                 strength=strength)
+                             "notch_depth": 0.04, "notch_width": 0.02, "refine": bool(refine),
+                             **strength_parameters},
+                 strength=strength, refine=bool(refine) or None)
 
