@@ -6,6 +6,7 @@
   crack whose length is within 5 % of the uniform 64x plate's (124k triangles).
 * A run with refinement resumed from a checkpoint equals the uninterrupted run.
 """
+import dataclasses
 import json
 
 import numpy as np
@@ -88,3 +89,18 @@ def test_a_refined_run_resumed_equals_the_uninterrupted_run(tmp_path):
         assert np.array_equal(ga.points, gb.points), n
         assert np.array_equal(ga.point_data["displacement"], gb.point_data["displacement"]), n
     assert pv.read(full / f"step_{b['n_steps']:06d}.vtu").n_cells > scene().mesh.ne      # it did refine
+
+
+@pytest.mark.parametrize("refine, message", [(-0.01, "refine must be True, False, None or a target edge length > 0"),
+                                             ("yes", "refine must be True"),
+                                             (float("nan"), "refine must be True")])
+def test_a_bad_refine_is_named_before_any_work(refine, message, tmp_path):
+    scene = dataclasses.replace(scenes.plate(maxh=0.1), refine=refine)
+    with pytest.raises(ValueError, match=message):
+        Simulation(scene, out=tmp_path / "out")
+    assert not (tmp_path / "out").exists()
+
+
+def test_refinement_needs_a_critical_distance():
+    with pytest.raises(ValueError, match="refine needs the critical-distance criterion"):
+        Simulation(scenes.plate(maxh=0.1, radius=None, refine=True))
