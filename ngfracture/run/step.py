@@ -501,7 +501,8 @@ class LoadStep:
                   "retries": int(log.retries), "failures": list(log.failures),
                   "substeps": int(log.substeps), "method": log.method,
                   "relax_passes": max(len(attempt.split_positions) - 1, 0), "notes": list(log.notes),
-                  "kept_tangent": bool(log.kept_tangent), "overlap_area": float(attempt.overlap)}
+                  "kept_tangent": bool(log.kept_tangent), "overlap_area": float(attempt.overlap),
+                  "triangles": int(attempt.problem.mesh.ne)}     # changes only by refinement (Scene.refine)
         if attempt.first_cracks and not any(h["split_vertices"] for h in state.history):
             # where cracking began: the vertices split by the first pass that split any
             record["initiation"] = attempt.split_positions[0].tolist()
