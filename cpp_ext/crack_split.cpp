@@ -172,6 +172,21 @@ namespace ngfracture
       }
   }
 
+  int CrackSplitter :: NearestInterior (double sign) const
+  {
+    // as better(), on the signed cosine with the half-line sign * t
+    int best = -1;
+    for (size_t i = 0; i < edges.size(); i++)
+      {
+        const Edge & a = edges[i];
+        if (a.count == 1) continue;
+        if (best < 0) { best = int(i); continue; }
+        const Edge & b = edges[best];
+        if (sign * a.side != sign * b.side ? sign * a.side > sign * b.side : a.x < b.x) best = int(i);
+      }
+    return best;
+  }
+
   bool CrackSplitter :: IntoFan (int v, const double * d) const
   {
     const int * S = StarBegin(v);
@@ -250,13 +265,7 @@ namespace ngfracture
       {
         rule |= RULE_TIP | RULE_TIP1;
         // the half of the crack line away from the crack: opposite to the crack faces
-        double sign = edges[bnd[0]].side > 0 ? -1.0 : 1.0;
-        // as better(), on the signed cosine with that half-line
-        auto ahead = [sign] (const Edge & a, const Edge & b)
-          { return sign * a.side != sign * b.side ? sign * a.side > sign * b.side : a.x < b.x; };
-        int e1 = -1;
-        for (size_t i = 0; i < edges.size(); i++)
-          if (edges[i].count != 1 && (e1 < 0 || ahead(edges[i], edges[e1]))) e1 = int(i);
+        int e1 = NearestInterior(edges[bnd[0]].side > 0 ? -1.0 : 1.0);
         if (e1 < 0) { rule |= RULE_NONE; finish(); return; }
         cuts.push_back(edges[e1].x);
       }
@@ -338,11 +347,7 @@ namespace ngfracture
                     double len = std::hypot(bx, by);
                     if (len > 0 && (bx*h[0] + by*h[1]) / len > std::cos(enter_angle)) clear = false;
                   }
-                if (!clear) continue;
-                for (size_t i = 0; i < edges.size(); i++)
-                  if (edges[i].count != 1 && (e2 < 0 || sign * edges[i].side > sign * edges[e2].side ||
-                                              (sign * edges[i].side == sign * edges[e2].side && edges[i].x < edges[e2].x)))
-                    e2 = int(i);
+                if (clear) e2 = NearestInterior(sign);
               }
             if (e2 >= 0) { e1 = e2; rule |= RULE_2D; }
           }

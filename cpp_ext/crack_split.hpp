@@ -104,6 +104,8 @@ namespace ngfracture
     bool SplitAt (int w, const int * cut, int ncut);   // cut: far vertices of removed edges
     void ProcessVertex (int v, const double * dir, double enter_angle, bool single_edge_tips);
     bool ShareTriangle (int v, const Edge & a, const Edge & b) const;
+    // the interior edge of the collected ones nearest the half-line sign * t (-1: none)
+    int NearestInterior (double sign) const;
     // true if the direction d from v points into one of v's triangles (or along its sides)
     bool IntoFan (int v, const double * d) const;
   };

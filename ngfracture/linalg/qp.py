@@ -84,11 +84,13 @@ def convex_qp(H, c, A_eq, b_eq, A_in, b_in, tol=1e-12, max_steps=None):
     sign = np.ones(len(b))              # equalities are entered from the side they miss
     active, u = [], []
     Q, R = np.zeros((n, 0)), np.zeros((0, 0))   # thin QR of the active columns sign_j N[:, j]
-    c_size = np.linalg.norm(sla.solve_triangular(L, c, lower=True))
+    # the data's size in the metric of H (the unconstrained minimiser's, the constraints' offsets)
+    data = max(np.abs(b / norm).max(initial=0.0), np.linalg.norm(sla.solve_triangular(L, c, lower=True)))
+    size = np.linalg.norm(L.T @ x)      # the iterate's
     max_steps = 10 * (n + len(b)) + 100 if max_steps is None else max_steps
     for _ in range(max_steps):
         s = (A @ x - b) / norm          # signed misses, scaled to the metric of H
-        level = tol * max(np.abs(b / norm).max(initial=0.0), np.linalg.norm(L.T @ x), c_size, 1e-300)
+        level = tol * max(data, size, 1e-300)
         todo = [j for j in range(p) if j not in active]
         if todo:
             j_new = todo[0]
@@ -102,9 +104,9 @@ def convex_qp(H, c, A_eq, b_eq, A_in, b_in, tol=1e-12, max_steps=None):
         x, u, Q, R = _enter(j_new, sign[j_new] * N[:, j_new], sign[j_new] * (A[j_new] @ x - b[j_new]),
                             x, u, active, Q, R, L, p)
         size = np.linalg.norm(L.T @ x) if np.all(np.isfinite(x)) else np.inf
-        if not size <= GROWTH_LIMIT * max(np.abs(b / norm).max(initial=0.0), c_size, 1e-300):
+        if not size <= GROWTH_LIMIT * max(data, 1e-300):
             raise QPError(f"convex_qp: the iterate grew to {size:.3g} in the metric of H against data of "
-                          f"{max(np.abs(b / norm).max(initial=0.0), c_size):.3g} (H nearly singular)")
+                          f"{data:.3g} (H nearly singular)")
     else:
         raise QPError(f"convex_qp: no solution in {max_steps} steps")
     mult = np.zeros(len(b))

@@ -120,10 +120,7 @@ def beam(maxh=0.1, radius=0.04, notch=0.3, deflection_max=None, dx=None, E=GLASS
     mesh = notched_beam_mesh(maxh, fine, notch)
     material = StVenantKirchhoff(E, nu, plane="stress")
     peak = E * critical * math.sqrt(2 * math.pi * radius) / (4 * senb_factor(notch))
-    # beam theory: delta = P S^3 / (48 E I), I = 1/12; the notch and shear add to it
-    deflection = 16 * peak / E
-    deflection_max = 8 * deflection if deflection_max is None else positive("deflection_max", deflection_max)
-    dx = deflection / 8 if dx is None else positive("dx", dx)
+    deflection_max, dx = _pad_travel(peak, E, deflection_max, dx)
 
     return Scene(name="beam", mesh=mesh, material=material, critical={"ligament": critical},
                  apply_load=three_point_bending,
@@ -243,9 +240,7 @@ def holed_beam(maxh=0.1, fine=None, radius=0.04, notch=0.2, notch_offset=0.5, ho
     fine = min(maxh, radius / 4) if fine is None else positive("fine", fine)
     mesh = holed_beam_mesh(maxh, fine, notch, notch_offset, holes)
     peak = E * critical * math.sqrt(2 * math.pi * radius) / (4 * senb_factor(notch)) * 2 / (2 - notch_offset)
-    deflection = 16 * peak / E
-    deflection_max = 8 * deflection if deflection_max is None else positive("deflection_max", deflection_max)
-    dx = deflection / 8 if dx is None else positive("dx", dx)
+    deflection_max, dx = _pad_travel(peak, E, deflection_max, dx)
     return Scene(name="holed_beam", mesh=mesh, material=StVenantKirchhoff(E, nu, plane="stress"),
                  critical={"band": critical}, apply_load=three_point_bending, load_max=deflection_max, dx=dx,
                  contact_tol=1e-3 * fine, stop_when_unloaded=True, radius=radius, load_description=BEAM_LOAD,
@@ -253,6 +248,16 @@ def holed_beam(maxh=0.1, fine=None, radius=0.04, notch=0.2, notch_offset=0.5, ho
                  parameters={"maxh": maxh, "fine": fine, "radius": radius, "notch": notch,
                              "notch_offset": notch_offset, "holes": [list(h) for h in holes],
                              "deflection_max": deflection_max, "dx": dx, "E": E, "nu": nu, "critical": critical})
+
+
+def _pad_travel(peak, E, deflection_max, dx):
+    """The final deflection (default eight times the peak load's) and the first increment
+    (default an eighth of the peak's) of a beam of span 4 and height 1 in three-point bending."""
+    # beam theory: delta = P S^3 / (48 E I), I = 1/12; the notch and shear add to it
+    deflection = 16 * peak / E
+    deflection_max = 8 * deflection if deflection_max is None else positive("deflection_max", deflection_max)
+    dx = deflection / 8 if dx is None else positive("dx", dx)
+    return deflection_max, dx
 
 
 def three_point_bending(prob, x):
