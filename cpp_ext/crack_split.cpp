@@ -187,6 +187,71 @@ namespace ngfracture
     return best;
   }
 
+  int CrackSplitter :: NextOnBoundary (int cur, int prev) const
+  {
+    std::vector<std::pair<int,int>> seen;     // cur's neighbours and their triangle counts
+    const int * S = StarBegin(cur);
+    for (int i = 0, m = StarSize(cur); i < m; i++)
+      {
+        int t = S[i], l = Local(t, cur);
+        for (int x : { trigs[3*t+(l+1)%3], trigs[3*t+(l+2)%3] })
+          {
+            auto it = std::find_if(seen.begin(), seen.end(), [x] (const std::pair<int,int> & e) { return e.first == x; });
+            if (it == seen.end()) seen.push_back({x, 1}); else it->second++;
+          }
+      }
+    // boundary neighbours: the far ends of edges in one triangle; two on a plain boundary
+    int next = -1, once = 0;
+    for (auto & e : seen)
+      if (e.second == 1) { once++; if (e.first != prev) next = e.first; }
+    return once == 2 ? next : -1;
+  }
+
+  bool CrackSplitter :: AimAnchor (int v, int a, int b, const double * h, double * anchor) const
+  {
+    // walk both lips from the tip together: on the crack their vertices are twins (bitwise
+    // equal points); where they part (the mouth, a junction) the crack behind ends. The
+    // anchor goes back while the tip lies within one tip edge of the line through it: beyond,
+    // the crack turns there (the criterion's direction changed), and a line from before the
+    // turn would exaggerate it. False where not even the second point behind qualifies.
+    double px = points[2*size_t(v)], py = points[2*size_t(v)+1];
+    double reach = std::hypot(points[2*size_t(a)] - px, points[2*size_t(a)+1] - py);
+    int prev_a = v, prev_b = v;
+    bool found = false;
+    for (int step = 1; step < aim_edges; step++)
+      {
+        int na = NextOnBoundary(a, prev_a), nb = NextOnBoundary(b, prev_b);
+        if (na < 0 || nb < 0 || na == nb || points[2*size_t(na)] != points[2*size_t(nb)] ||
+            points[2*size_t(na)+1] != points[2*size_t(nb)+1])
+          break;
+        double qx = points[2*size_t(na)], qy = points[2*size_t(na)+1];
+        if (std::fabs((px - qx) * h[1] - (py - qy) * h[0]) > reach) break;
+        anchor[0] = qx; anchor[1] = qy;
+        found = true;
+        prev_a = a; prev_b = b; a = na; b = nb;
+      }
+    return found;
+  }
+
+  int CrackSplitter :: NearestToLine (int v, const double * anchor, const double * h) const
+  {
+    double px = points[2*size_t(v)], py = points[2*size_t(v)+1];
+    int best = -1;
+    double best_dist = 0;
+    for (size_t i = 0; i < edges.size(); i++)
+      {
+        const Edge & e = edges[i];
+        if (e.count == 1) continue;
+        double ex = points[2*size_t(e.x)] - px, ey = points[2*size_t(e.x)+1] - py;
+        double len = std::hypot(ex, ey);
+        if (!(len > 0) || (ex*h[0] + ey*h[1]) < std::sqrt(0.5) * len) continue;     // 45 degrees or more off
+        double dist = std::fabs((points[2*size_t(e.x)] - anchor[0]) * h[1] - (points[2*size_t(e.x)+1] - anchor[1]) * h[0]);
+        if (best < 0 || dist < best_dist || (dist == best_dist && e.x < edges[best].x))
+          { best = int(i); best_dist = dist; }
+      }
+    return best;
+  }
+
   bool CrackSplitter :: IntoFan (int v, const double * d) const
   {
     const int * S = StarBegin(v);
@@ -265,7 +330,13 @@ namespace ngfracture
       {
         rule |= RULE_TIP | RULE_TIP1;
         // the half of the crack line away from the crack: opposite to the crack faces
-        int e1 = NearestInterior(edges[bnd[0]].side > 0 ? -1.0 : 1.0);
+        double sign = edges[bnd[0]].side > 0 ? -1.0 : 1.0;
+        int e1 = -1;
+        double norm = std::hypot(tdir[0], tdir[1]);     // the caller's direction need not be unit
+        double anchor[2], h[2] = { sign * tdir[0] / norm, sign * tdir[1] / norm };
+        if (aim_edges > 0 && AimAnchor(v, edges[bnd[0]].x, edges[bnd[1]].x, h, anchor))
+          e1 = NearestToLine(v, anchor, h);
+        if (e1 < 0) e1 = NearestInterior(sign);
         if (e1 < 0) { rule |= RULE_NONE; finish(); return; }
         cuts.push_back(edges[e1].x);
       }

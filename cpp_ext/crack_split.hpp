@@ -59,6 +59,14 @@ namespace ngfracture
     void Run (const int * order, const double * dirs, int n, bool skip_neighbours = false,
               double enter_angle = 0.0, bool single_edge_tips = false);
 
+    // With single_edge_tips: a tip aims along the crack line drawn through the crack's point
+    // up to aim_edges lip edges behind it (AimAnchor; 0 or 1: the edge nearest the line's
+    // direction). On a mesh whose edges take few directions (refined by bisection) the
+    // nearest direction can be the same one tip after tip, and the crack drifts off the
+    // line at that edge's angle; aimed from behind, the tip takes the edge that ends
+    // nearest the line, and the crack zigzags about it.
+    int aim_edges = 0;
+
     // After Run: segments of the new mesh and the fragments.
     void Finish ();
 
@@ -108,6 +116,15 @@ namespace ngfracture
     int NearestInterior (double sign) const;
     // true if the direction d from v points into one of v's triangles (or along its sides)
     bool IntoFan (int v, const double * d) const;
+    // the crack's point 2 to aim_edges lip edges behind the tip v, whose lips start with the
+    // twins a and b (as far as the lips stay twins and the tip lies within one tip edge of
+    // the line through the point along h; false: not even the second point)
+    bool AimAnchor (int v, int a, int b, const double * h, double * anchor) const;
+    // the boundary neighbour of cur other than prev (-1: cur is not on a plain boundary)
+    int NextOnBoundary (int cur, int prev) const;
+    // of v's interior edges less than 45 degrees off the half-line direction h, the one
+    // whose far end lies nearest the line through anchor along h (-1: none)
+    int NearestToLine (int v, const double * anchor, const double * h) const;
   };
 }
 

@@ -192,7 +192,7 @@ Returns
 
   m.def("CrackSplit",
         [] (shared_ptr<netgen::Mesh> ngmesh, iarray vertices, darray directions, std::string crack_name,
-            bool skip_neighbours, double enter_angle, bool single_edge_tips)
+            bool skip_neighbours, double enter_angle, bool single_edge_tips, int aim_edges)
         {
           auto t0 = std::chrono::steady_clock::now();
           MeshArrays a = ExtractArrays(*ngmesh);
@@ -205,6 +205,9 @@ Returns
           CrackSplitter split(a.points.data(), a.nv, a.trigs.data(), a.ne, a.segs.data(), a.ns);
           if (!(enter_angle >= 0 && enter_angle < M_PI / 2))
             throw Exception("ngfracture.CrackSplit: enter_angle must be in [0, pi/2), got " + ToString(enter_angle));
+          if (aim_edges < 0)
+            throw Exception("ngfracture.CrackSplit: aim_edges must be >= 0, got " + ToString(aim_edges));
+          split.aim_edges = aim_edges;
           split.Run(vertices.data(), directions.data(), int(n), skip_neighbours, enter_angle, single_edge_tips);
           split.Finish();
           auto t1 = std::chrono::steady_clock::now();
@@ -234,6 +237,7 @@ Returns
         },
         py::arg("ngmesh"), py::arg("vertices"), py::arg("directions"), py::arg("crack_name") = "crack",
         py::arg("skip_neighbours") = false, py::arg("enter_angle") = 0.0, py::arg("single_edge_tips") = false,
+        py::arg("aim_edges") = 0,
         R"doc(Split vertices of a 2D netgen mesh along the edges most orthogonal to a direction.
 
 Low-level: use ngfracture.crack.split_vertices.

@@ -1,5 +1,7 @@
 """Splitting rules of the paper (section 3) on hand-made meshes, one per rule, and
 cracks that split again: tips, branching, T-junctions, crossings, reaching the boundary."""
+import dataclasses
+
 import numpy as np
 import pytest
 import ngsolve
@@ -300,6 +302,46 @@ def test_single_edge_tip_reaches_the_boundary():
     res3 = fracture.split_vertices(res2.mesh, [vid(4, 2, 1)], X, rules=fracture.GROWTH_RULES)
     assert res3.nfragments == 2
     assert crack_length(res3.mesh) == pytest.approx(8.0, rel=1e-14)
+
+
+def grown_crack(rules, degrees, splits=20):
+    """A crack from the left edge of a grid (edges at 0, 45 and 90 degrees) grown tip by tip
+    with its line at ``degrees``: its tip positions, the first one where it left the edge."""
+    m = grid_mesh(30, 40)
+    res = fracture.split_vertices(m, [vid(30, 0, 10)], Y, rules=rules)
+    theta = np.radians(degrees)
+    d = np.array([[-np.sin(theta), np.cos(theta)]])          # the largest strain, across the line
+    tip = res.record["edges"][0][1]
+    path = [coords(res.mesh)[tip]]
+    for _ in range(splits):
+        res = fracture.split_vertices(res.mesh, [tip], d, rules=rules)
+        assert res.record["rule"][0] & fracture.RULE_TIP1 and res.nfragments == 1
+        tip = res.record["edges"][0][1]
+        path.append(coords(res.mesh)[tip])
+    return np.array(path)
+
+
+@pytest.mark.parametrize("degrees", [10.0, 20.0, 30.0])
+def test_an_aimed_tip_zigzags_about_its_line_where_the_mesh_has_no_edge_along_it(degrees):
+    """Tips aimed from k = 4 lip edges behind (AIMED_GROWTH_RULES, of runs refined ahead of
+    their tips): each new tip is the candidate end nearest the line drawn from the crack
+    k edges back, less than an edge off it, so the crack's direction keeps within atan(1 / (k + 1)) (11.3 degrees) of the line. Aimed
+    from the tip itself, every tip takes the grid direction nearest the line, and the
+    crack leaves the line at that direction's angle (10, 20 and 15 degrees here)."""
+    theta = np.radians(degrees)
+    offset = lambda path: np.abs((path - path[0]) @ np.array([np.sin(theta), -np.cos(theta)]))
+    aimed = grown_crack(fracture.AIMED_GROWTH_RULES, degrees)
+    k = fracture.AIMED_GROWTH_RULES.aim_edges
+    assert k == 4
+    chord = aimed[-1] - aimed[0]
+    assert abs(np.degrees(np.arctan2(chord[1], chord[0])) - degrees) <= np.degrees(np.arctan(1 / (k + 1)))
+    unaimed = grown_crack(fracture.GROWTH_RULES, degrees)
+    assert dataclasses.replace(fracture.AIMED_GROWTH_RULES, aim_edges=0) == fracture.GROWTH_RULES
+    nearest = min(abs(degrees), abs(45.0 - degrees))                      # the grid direction nearest the line
+    assert offset(unaimed)[-1] == pytest.approx(20 * np.sin(np.radians(nearest)) * (1 if degrees < 22.5 else np.sqrt(2)),
+                                                rel=1e-12)
+    with pytest.raises(ValueError, match="aim_edges must be an integer >= 0"):
+        fracture.SplitRules(aim_edges=-1)
 
 
 def test_rule_2d_a_concave_corner_with_a_coarse_fan_starts_its_crack_on_the_nearest_edge():

@@ -19,6 +19,8 @@ import pytest
 import pyvista as pv
 
 ARGS = ["run", "plate", "--maxh", "0.06", "--quiet", "--pictures", "none"]
+#: the plate from a coarse start, refined ahead of its crack tips (Scene.refine) in every step
+REFINED_ARGS = ["run", "plate", "--maxh", "0.1", "--set", "refine=true", "--quiet", "--pictures", "none"]
 
 CHILD = """
 import os, sys, time
@@ -50,8 +52,8 @@ def _env():
     return env
 
 
-def _start(out, cwd, slow=0, resume=False):
-    cmd = [sys.executable, "-c", CHILD, str(slow), *ARGS, "--out", str(out)] + (["--resume"] if resume else [])
+def _start(out, cwd, slow=0, resume=False, args=ARGS):
+    cmd = [sys.executable, "-c", CHILD, str(slow), *args, "--out", str(out)] + (["--resume"] if resume else [])
     return subprocess.Popen(cmd, cwd=cwd, env=_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 
 
@@ -98,6 +100,21 @@ def test_kill_during_a_checkpoint_write_resumes_to_the_same_result(reference, tm
     assert any(p.name.startswith(".tmp_ngf_") for p in out.iterdir())   # the half-done write
     _finish(_start(out, tmp_path, resume=True))
     assert not any(p.name.startswith(".tmp_ngf_") for p in out.iterdir())
+    _compare(out, reference)
+
+
+@pytest.mark.slow
+def test_a_refined_run_killed_during_a_checkpoint_write_resumes_to_the_same_result(tmp_path):
+    reference = tmp_path / "reference"
+    _finish(_start(reference, tmp_path, args=REFINED_ARGS))
+    summary = json.loads((reference / "summary.json").read_text())
+    assert summary["history"][-1]["triangles"] > summary["history"][0]["triangles"] > 0    # it refined
+    out = tmp_path / "run"
+    proc = _start(out, tmp_path, slow=4, args=REFINED_ARGS)      # the fourth checkpoint: the mesh refined at the tips
+    assert proc.stdout.readline().strip() == "WRITING", proc.stderr.read()
+    proc.send_signal(signal.SIGKILL)
+    proc.wait()
+    _finish(_start(out, tmp_path, resume=True, args=REFINED_ARGS))
     _compare(out, reference)
 
 

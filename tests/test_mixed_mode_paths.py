@@ -13,6 +13,11 @@ follows it within a mean distance of 2 r, as one crack (no junction, one tip at 
 * The built-in ``holed_beam``: the offset notch with a hole beside the path; the crack
   passes the hole, drawn towards it, and keeps one tip.
 
+The inclined crack and the offset notch run twice: meshed fine where the reference says
+the crack runs, and from a coarse mesh (maxh 0.1 = 5 r, the crack's own path meshed coarse
+too) refined ahead of the tip as it grows (Scene.refine, r/4): the same bound without
+knowing the path.
+
 The crack graph is read from the run's last VTU and VTP files (:mod:`vtk_crack_util`)."""
 import math
 
@@ -25,6 +30,17 @@ from vtk_crack_util import final_files, read_crack_graph, side_branches
 
 E, NU, EPS, R = 1e9, 0.3, 1e-3, 0.02
 WIDTH, HEIGHT = 1.0, 2.0
+
+
+#: the LEFM references by case: a test that runs twice (band, refined) computes one
+REFERENCES = {}
+
+
+def lefm_reference(case, *args, **kwargs):
+    """edge_crack_path(*args, **kwargs), computed once per case."""
+    if case not in REFERENCES:
+        REFERENCES[case] = edge_crack_path(*args, **kwargs)
+    return REFERENCES[case]
 
 
 def grips(prob, x=1e-3):
@@ -60,12 +76,14 @@ def simulated_path(scene, start, out):
     return grown, graph, result
 
 
-def band_scene(corners, names, start, reference, apply_load, load_max):
-    """The body with its edge crack, meshed at r/4 within 5 r of the reference path."""
-    mesh = cracked_polygon(corners, names, start, 0.1, R / 4, band(reference, R))
+def band_scene(corners, names, start, reference, apply_load, load_max, refine=False):
+    """The body with its edge crack, meshed at r/4 within 5 r of the reference path, or
+    (refine) at 0.1 everywhere and refined ahead of the tip during the run."""
+    mesh = cracked_polygon(corners, names, start, 0.1, 0.1) if refine else \
+        cracked_polygon(corners, names, start, 0.1, R / 4, band(reference, R))
     return nf.Scene(name="mixed", mesh=mesh, material=nf.LinearElastic(E, NU, plane="stress"), critical=EPS,
                     apply_load=apply_load, load_max=load_max, dx=load_max / 32, contact_tol=1e-6, radius=R,
-                    stop_when_unloaded=True)
+                    stop_when_unloaded=True, refine=refine or None)
 
 
 def check_one_crack(grown, graph, r):
@@ -75,16 +93,18 @@ def check_one_crack(grown, graph, r):
 
 
 @pytest.mark.slow
-def test_an_inclined_edge_crack_follows_the_maximum_hoop_stress_path(tmp_path):
+@pytest.mark.parametrize("refine", [False, True], ids=["band", "refined"])
+def test_an_inclined_edge_crack_follows_the_maximum_hoop_stress_path(tmp_path, refine):
     start = np.array([[0.0, 1.0], [0.2 * math.cos(math.pi / 4), 1.0 + 0.2 * math.sin(math.pi / 4)]])
     corners = [(0.0, 0.0), (WIDTH, 0.0), (WIDTH, HEIGHT), (0.0, HEIGHT), tuple(start[0])]
     names = ["bottom", "right", "top", "left", "left"]
-    reference = edge_crack_path(corners, names, start, grips, E, NU, da=0.02, steps=60, maxh=0.1, h_tip=0.002)
+    reference = lefm_reference("inclined", corners, names, start, grips, E, NU, da=0.02, steps=60, maxh=0.1,
+                               h_tip=0.002)
     assert len(reference.points) > 20
-    scene = band_scene(corners, names, start, reference.points, lambda prob, x: grips(prob, x), 4 * EPS)
+    scene = band_scene(corners, names, start, reference.points, lambda prob, x: grips(prob, x), 4 * EPS, refine)
     grown, graph, result = simulated_path(scene, start, tmp_path / "out")
     distance = distance_to_polyline(grown, reference.points)
-    print(f"inclined: mean distance {distance.mean() / R:.3f} r, max {distance.max() / R:.3f} r, {len(grown)} points, "
+    print(f"inclined ({'refined' if refine else 'band'}): mean distance {distance.mean() / R:.3f} r, max {distance.max() / R:.3f} r, {len(grown)} points, "
           f"tips {len(graph['tips'])}, junctions {len(graph['junctions'])}, {result.reason}")
     check_one_crack(grown, graph, R)
     assert distance.mean() < 2 * R
@@ -107,17 +127,19 @@ def three_point_bending(prob, x=1e-3):
 
 
 @pytest.mark.slow
-def test_an_offset_notch_in_three_point_bending_curves_to_the_load_as_lefm_says(tmp_path):
+@pytest.mark.parametrize("refine", [False, True], ids=["band", "refined"])
+def test_an_offset_notch_in_three_point_bending_curves_to_the_load_as_lefm_says(tmp_path, refine):
     corners, names = beam_outline(mouth=1.5)
     start = np.array([[1.5, 0.0], [1.5, 0.2]])
-    reference = edge_crack_path(corners, names, start, three_point_bending, E, NU, da=0.02, steps=60, maxh=0.1,
-                                h_tip=0.002)
+    reference = lefm_reference("offset", corners, names, start, three_point_bending, E, NU, da=0.02, steps=60,
+                               maxh=0.1, h_tip=0.002)
     assert len(reference.points) > 20
-    scene = band_scene(corners, names, start, reference.points, lambda prob, x: three_point_bending(prob, x), 4e-3)
+    scene = band_scene(corners, names, start, reference.points, lambda prob, x: three_point_bending(prob, x), 4e-3,
+                       refine)
     grown, graph, result = simulated_path(scene, start, tmp_path / "out")
     grown = grown[grown[:, 1] <= reference.points[:, 1].max()]      # as far as the reference goes
     distance = distance_to_polyline(grown, reference.points)
-    print(f"offset notch: mean distance {distance.mean() / R:.3f} r, max {distance.max() / R:.3f} r, "
+    print(f"offset notch ({'refined' if refine else 'band'}): mean distance {distance.mean() / R:.3f} r, max {distance.max() / R:.3f} r, "
           f"{len(grown)} points, tips {len(graph['tips'])}, junctions {len(graph['junctions'])}, {result.reason}, "
           f"reference from {reference.points[1]} to {reference.points[-1]}")
     check_one_crack(grown, graph, R)
@@ -135,8 +157,8 @@ def test_a_crack_passing_a_hole_keeps_one_tip_and_the_lefm_path(tmp_path):
              "left"]
     holes = [(x + mid, y, radius) for x, y, radius in p["holes"]]
     start = np.array([[mouth, 0.0], [mouth, p["notch"]]])
-    reference = edge_crack_path(corners, names, start, three_point_bending, p["E"], p["nu"], da=0.02, steps=60,
-                                maxh=0.1, h_tip=0.002, holes=holes)
+    reference = lefm_reference("holed", corners, names, start, three_point_bending, p["E"], p["nu"], da=0.02,
+                               steps=60, maxh=0.1, h_tip=0.002, holes=holes)
     assert len(reference.points) > 20
     grown, graph, result = simulated_path(scene, start, tmp_path / "out")
     grown = grown[grown[:, 1] <= reference.points[:, 1].max()]

@@ -73,7 +73,7 @@ from .strain import check_mesh_2d, check_positive, displacement_order, principal
 
 __all__ = [
     "RULE_1", "RULE_1A", "RULE_1B", "RULE_2", "RULE_2A", "RULE_2B", "RULE_2C", "RULE_2D", "RULE_TIP", "RULE_TIP1",
-    "RULE_NONE", "RULE_NAMES", "SplitRules", "PAPER_RULES", "GROWTH_RULES", "SplitResult", "split_vertices",
+    "RULE_NONE", "RULE_NAMES", "SplitRules", "PAPER_RULES", "GROWTH_RULES", "AIMED_GROWTH_RULES", "SplitResult", "split_vertices",
     "transfer", "transfer_vertex_field", "split_by_tensor", "crack_step", "rule_names",
 ]
 
@@ -108,18 +108,29 @@ class SplitRules:
         ``enter_angle`` of the crack line (rule 2c).
     single_edge_tips : bool
         A crack tip cuts one edge, ahead of the crack (rule tip1), instead of two (rule 1).
+    aim_edges : int
+        With ``single_edge_tips``: the tip cuts the edge, less than 45 degrees off the
+        crack line, whose far end lies nearest the crack line drawn through the crack's
+        point up to ``aim_edges`` lip edges behind the tip (as far back as the tip lies
+        within one tip edge of that line; 0, 1, or not even the second point within it:
+        the edge nearest the line's direction). The crack zigzags about its line instead
+        of running along the one mesh direction nearest it, which on a mesh refined by
+        bisection can be the same for many tips.
 
     Raises
     ------
     ValueError
-        An ``enter_angle`` outside [0, pi/2).
+        An ``enter_angle`` outside [0, pi/2), a negative ``aim_edges``.
     """
     enter_angle: float = 0.0
     single_edge_tips: bool = False
+    aim_edges: int = 0
 
     def __post_init__(self):
         if not (isinstance(self.enter_angle, (int, float)) and 0 <= self.enter_angle < math.pi / 2):
             raise ValueError(f"ngfracture.fracture.split: enter_angle must be in [0, pi/2) radians, got {self.enter_angle!r}")
+        if not (isinstance(self.aim_edges, int) and self.aim_edges >= 0):
+            raise ValueError(f"ngfracture.fracture.split: aim_edges must be an integer >= 0, got {self.aim_edges!r}")
 
 
 PAPER_RULES = SplitRules()
@@ -127,6 +138,12 @@ PAPER_RULES = SplitRules()
 # (flank 14 degrees off in the plate) enter the body, and keeps out a crack line along a
 # straight boundary, whose interior edges are 45 degrees or more off on netgen's meshes.
 GROWTH_RULES = SplitRules(enter_angle=math.radians(30.0), single_edge_tips=True)
+# Runs refined ahead of the tips (Scene.refine): a tip aims from up to 4 lip edges behind
+# it. Bisection gives the refined triangles the few edge directions of each coarse one,
+# and the nearest to the crack line can be the same, 20 degrees off it, tip after tip;
+# aimed, the crack's direction keeps within atan(1/5) = 11 degrees of the line
+# (docs/criterion.md, "Aiming the tip").
+AIMED_GROWTH_RULES = SplitRules(enter_angle=math.radians(30.0), single_edge_tips=True, aim_edges=4)
 
 
 def rule_names(flags):
@@ -233,7 +250,7 @@ def split_vertices(mesh, vertices, directions, crack_name="crack", skip_neighbou
     if not isinstance(rules, SplitRules):
         raise TypeError(f"ngfracture.fracture.split: rules must be a SplitRules, got {type(rules).__name__}")
     r = _ext.CrackSplit(mesh.ngmesh, v, d, crack_name, bool(skip_neighbours), float(rules.enter_angle),
-                      bool(rules.single_edge_tips))
+                      bool(rules.single_edge_tips), int(rules.aim_edges))
     t0 = time.perf_counter()
     # nothing split: keep the very same mesh, so callers keep their spaces and factorisations
     newmesh = mesh if len(r["parent"]) == mesh.nv else ngsolve_mesh(r["ngmesh"], mesh.ne)

@@ -97,12 +97,15 @@ class CrackPass:
         The factorisation the split mesh's solves start from (linalg.bordered.Lineage).
     positions : numpy.ndarray
         Reference positions (k, 2) of the vertices that split.
+    overstrain : float
+        The largest overstrain of the equilibrium it judged (a vertex splits above 1).
     """
     problem: object
     n_split: int
     strength: object
     lineage: object
     positions: np.ndarray
+    overstrain: float
 
 
 @dataclass
@@ -142,6 +145,9 @@ class Attempt:
         Overlap area between the pieces at the end (:mod:`ngfracture.run.invariants`).
     area : float or None
         The reference area of the final mesh (changed only by refinement; None: the scene's).
+    overstrain : float
+        The largest overstrain of the equilibrium the first pass judged (above 1 it splits;
+        below, the load over it is the load at which the body would start to crack).
     """
     problem: object
     x: float
@@ -159,6 +165,7 @@ class Attempt:
     lost_support: str = ""
     overlap: float = 0.0
     area: float = None
+    overstrain: float = 0.0
 
 
 @dataclass

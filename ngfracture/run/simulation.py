@@ -265,7 +265,8 @@ class Simulation:
                 warnings.warn(f"Scene {self.scene.name!r}, step {state.step}: a crack tip lies in triangles of "
                               f"{resolution:.3g} times the critical distance (more than {TIP_RESOLUTION_LIMIT}); "
                               f"the criterion does not resolve the stress there and cracks may branch: refine "
-                              f"the mesh where cracks run", UnresolvedCrackTip, stacklevel=3)
+                              f"the mesh where cracks run, or ahead of the tips during the run "
+                              f"(Scene(refine=True))", UnresolvedCrackTip, stacklevel=3)
         if prob is None:
             prob = stepper.problem(state.mesh, state.x, self.timings, state.u)
             stats = FragmentStatistics(state.mesh)

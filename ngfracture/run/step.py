@@ -36,7 +36,8 @@ import numpy as np
 from ..contact.solver import ContactSolver
 from ..fracture.crack_graph import crack_graph, tip_advances, tip_sizes
 from ..fracture.fragments import FragmentStatistics
-from ..fracture.split import GROWTH_RULES, PAPER_RULES, split_by_tensor, transfer_vertex_field
+from ..fracture.split import AIMED_GROWTH_RULES, GROWTH_RULES, PAPER_RULES, split_by_tensor, transfer_vertex_field
+from ..fracture.strain import principal
 from ..linalg import bordered
 from ..mechanics.tangent import SavedTangent
 from ..mechanics.problem import ElasticProblem
@@ -208,9 +209,13 @@ class LoadStep:
         """
         with timings.timed("strain"):
             tensors = self.criterion.overstrain(prob.mesh, prob.u, strength, arrays=prob.arrays)
+            largest = float(principal(tensors)[0].max(initial=0.0))
         t0 = time.perf_counter()
         # cracks judged at a critical distance grow from their tips (docs/criterion.md)
-        rules = PAPER_RULES if self.criterion.one_ring else GROWTH_RULES
+        if self.criterion.one_ring:
+            rules = PAPER_RULES
+        else:       # bisection's few edge directions need aimed tips (AIMED_GROWTH_RULES)
+            rules = AIMED_GROWTH_RULES if self.scene.refine not in (None, False) else GROWTH_RULES
         res = split_by_tensor(prob.mesh, tensors, 1.0, skip_neighbours=self.control.split == "spread",
                               first_only=self.control.split == "one", rules=rules,
                               check_mesh=False)   # checked when made, or split from a checked mesh
@@ -218,7 +223,7 @@ class LoadStep:
         timings.add("split", time.perf_counter() - t0 - rebuild)
         timings.add("rebuild", rebuild)
         if res.nsplit == 0:
-            return CrackPass(None, 0, strength, None, np.zeros((0, 2)))
+            return CrackPass(None, 0, strength, None, np.zeros((0, 2)), largest)
         positions = res.record["position"][np.diff(res.record["new_offsets"]) > 0]
         # P1: the displacement is a vertex field (component-major), copied through the split
         u = transfer_vertex_field(prob.u.vec.FV().NumPy().reshape(2, -1).T, res).T.reshape(-1)
@@ -227,7 +232,7 @@ class LoadStep:
         inherited = bordered.lineage(tangent.factor, tangent.state, res.parent) if tangent is not None else None
         # the engine split a checked mesh and keeps it valid
         split = self.problem(res.mesh, x, timings, u, check_mesh=False, triangle_piece=res.fragment)
-        return CrackPass(split, res.nsplit, strength, inherited, positions)
+        return CrackPass(split, res.nsplit, strength, inherited, positions, largest)
 
     # -- one load step ----------------------------------------------------------------------------
     def attempt(self, state, dx, method, timings, substeps=1, keep=True):
@@ -280,7 +285,8 @@ class LoadStep:
         return Attempt(relaxed.problem, x, crack.n_split, crack.n_split + relaxed.splits, relaxed.strength,
                        relaxed.contact_keys, relaxed.tangent, work + relaxed.work, relaxed.positions,
                        iterations + relaxed.iterations, merged_notes(notes, relaxed.notes), start is not None,
-                       relaxed.broken_through, relaxed.lost_support, area=relaxed.area)
+                       relaxed.broken_through, relaxed.lost_support, area=relaxed.area,
+                       overstrain=crack.overstrain)
 
     def increment(self, state, x, method, timings, substeps=1, keep=True):
         """The increment's problem at x on the state's mesh and its equilibrium.
@@ -502,7 +508,7 @@ class LoadStep:
                   "substeps": int(log.substeps), "method": log.method,
                   "relax_passes": max(len(attempt.split_positions) - 1, 0), "notes": list(log.notes),
                   "kept_tangent": bool(log.kept_tangent), "overlap_area": float(attempt.overlap),
-                  "triangles": int(attempt.problem.mesh.ne)}     # changes only by refinement (Scene.refine)
+                  "triangles": int(attempt.problem.mesh.ne), "overstrain": attempt.overstrain}     # changes only by refinement (Scene.refine)
         if attempt.first_cracks and not any(h["split_vertices"] for h in state.history):
             # where cracking began: the vertices split by the first pass that split any
             record["initiation"] = attempt.split_positions[0].tolist()
