@@ -109,10 +109,13 @@ def sharp_vertices(arrays):
         u, v = p[b] - p[a], p[c] - p[a]
         np.add.at(angle, a, np.abs(np.arctan2(u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0], (u * v).sum(axis=1))))
     # on the boundary: on an edge of one triangle only (an inner named line is no boundary)
-    edges = np.sort(np.concatenate([t[:, [0, 1]], t[:, [1, 2]], t[:, [2, 0]]]), axis=1)
-    unique, count = np.unique(edges, axis=0, return_counts=True)
+    edges = np.sort(np.concatenate([t[:, [0, 1]], t[:, [1, 2]], t[:, [2, 0]]]), axis=1).astype(np.int64)
+    # one integer per edge: a 1D unique is ten times faster than np.unique(axis=0)
+    unique, count = np.unique(edges[:, 0] * len(p) + edges[:, 1], return_counts=True)
+    once = unique[count == 1]
     on_boundary = np.zeros(len(p), dtype=bool)
-    on_boundary[unique[count == 1].ravel()] = True
+    on_boundary[once // len(p)] = True
+    on_boundary[once % len(p)] = True
     return np.flatnonzero(on_boundary & (angle >= SHARP_ANGLE))
 
 
