@@ -83,10 +83,10 @@ class Scene:
         What the load parameter x is, with its unit (e.g. "total extension of the plate
         (length)"); shown by ``ngfracture scenes`` and written to summary.json.
     refine : bool or float, optional
-        Refine the mesh ahead of crack tips and stress concentrations during the run
+        Refine the mesh ahead of crack tips and sharp notch tips during the run
         (:mod:`ngfracture.run.refinement`): True for a target edge length of r/4, a number
         for that length. Needs a critical distance (radius or toughness). None or False: the
-        mesh is refined only by cracking.
+        mesh changes only by cracking.
     """
     name: str
     mesh: object

@@ -215,7 +215,7 @@ class LoadStep:
         if self.criterion.one_ring:
             rules = PAPER_RULES
         else:       # bisection's few edge directions need aimed tips (AIMED_GROWTH_RULES)
-            rules = AIMED_GROWTH_RULES if self.scene.refine not in (None, False) else GROWTH_RULES
+            rules = AIMED_GROWTH_RULES if self.scene.refinement() is not None else GROWTH_RULES
         res = split_by_tensor(prob.mesh, tensors, 1.0, skip_neighbours=self.control.split == "spread",
                               first_only=self.control.split == "one", rules=rules,
                               check_mesh=False)   # checked when made, or split from a checked mesh
@@ -274,7 +274,7 @@ class LoadStep:
             work += work_of_forces(before, forces, state.u, prob.u.vec.FV().NumPy())
         area = state.area
         if crack is None:
-            # judged on refined material around tips and hot spots (Scene.refine)
+            # judged on material refined around the sharp tips (Scene.refine)
             refined = refine_equilibrium(self, prob, eq, x, state.strength, area, method, timings)
             prob, eq, area = refined.problem, refined.equilibrium, refined.area
             work, iterations = work + refined.work, iterations + refined.iterations
@@ -508,7 +508,8 @@ class LoadStep:
                   "substeps": int(log.substeps), "method": log.method,
                   "relax_passes": max(len(attempt.split_positions) - 1, 0), "notes": list(log.notes),
                   "kept_tangent": bool(log.kept_tangent), "overlap_area": float(attempt.overlap),
-                  "triangles": int(attempt.problem.mesh.ne), "overstrain": attempt.overstrain}     # changes only by refinement (Scene.refine)
+                  "triangles": int(attempt.problem.mesh.ne),      # changes only by refinement (Scene.refine)
+                  "overstrain": attempt.overstrain}
         if attempt.first_cracks and not any(h["split_vertices"] for h in state.history):
             # where cracking began: the vertices split by the first pass that split any
             record["initiation"] = attempt.split_positions[0].tolist()
@@ -527,11 +528,10 @@ class LoadStep:
         State
         """
         strength = None if self.scene.strength is None else np.array(self.scene.strength, dtype=float)
-        mesh, strength = refine_initial(self, self.scene.mesh, strength, timings)
+        mesh, strength, area = refine_initial(self, self.scene.mesh, strength, self.area_initial, timings)
         arrays, mesh = round_trip(mesh)
         prob = self.problem(mesh, 0.0, timings)
         rows = prob.assemble_constraints()
-        area = self.area_initial if mesh.nv == self.scene.mesh.nv else FragmentStatistics(mesh).total_area
         return State(arrays=arrays, u=np.zeros(prob.fes.ndof), x=0.0, dx=float(self.scene.dx), step=0, area=area,
                      external=load_vector(prob) if prob.loads else None,
                      quiet=0, work=0.0, reactions=np.zeros(len(rows.fixed_dofs)),
