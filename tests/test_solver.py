@@ -459,11 +459,12 @@ def test_near_incompressible_converges_or_says_why(cls, nu):
     assert np.linalg.norm(r[free]) < 1e-8 * np.linalg.norm(r[fixed])
 
 
-def test_3d_mesh_is_refused():
+def test_a_3d_mesh_with_a_2d_reduction_is_refused():
     from netgen.csg import unit_cube
     mesh3d = ng.Mesh(unit_cube.GenerateMesh(maxh=0.5))
-    with pytest.raises(ValueError, match="2D meshes; this mesh has dimension 3"):
-        nf.ElasticProblem(mesh3d, nf.LinearElastic(1.0, 0.3))
+    with pytest.raises(ValueError, match="plane stress is a 2D reduction"):
+        nf.ElasticProblem(mesh3d, nf.LinearElastic(1.0, 0.3, plane="stress"))
+    assert nf.ElasticProblem(mesh3d, nf.LinearElastic(1.0, 0.3)).dim == 3
 
 
 @pytest.mark.parametrize("noise, converges", [(1e-9, True), (1e-5, False)])

@@ -96,13 +96,13 @@ def vertex_displacement(u):
     Parameters
     ----------
     u : ngsolve.GridFunction or numpy.ndarray
-        A GridFunction on ``VectorH1`` (vertex dofs are nodal values for every order), or an
-        array of shape (nv, 2) that is returned as a float copy.
+        A GridFunction on ``VectorH1`` of a 2D or 3D mesh (vertex dofs are nodal values for
+        every order), or an array of shape (nv, 2) or (nv, 3) that is returned as a float copy.
 
     Returns
     -------
     numpy.ndarray
-        Shape (nv, 2).
+        Shape (nv, dim).
 
     Raises
     ------
@@ -110,22 +110,24 @@ def vertex_displacement(u):
         If u is neither.
     """
     if isinstance(u, ngsolve.GridFunction):
-        displacement_order(u)
-        nv = u.space.mesh.nv
+        if not isinstance(u.space, ngsolve.VectorH1):
+            raise TypeError("ngfracture.fracture.strain: the displacement must be a GridFunction on an "
+                            f"ngsolve.VectorH1 space, got {type(u.space).__name__}")
+        dim, nv = u.space.mesh.dim, u.space.mesh.nv
         v = u.vec.FV().NumPy()
-        return v.reshape(2, -1)[:, :nv].T.copy()   # component-blocked dofs, vertices first
+        return v.reshape(dim, -1)[:, :nv].T.copy()   # component-blocked dofs, vertices first
     a = np.array(u, dtype=float)
-    if a.ndim != 2 or a.shape[1] != 2:
-        raise TypeError(f"ngfracture.fracture.strain: vertex displacement must have shape (nv, 2), got {a.shape}")
+    if a.ndim != 2 or a.shape[1] not in (2, 3):
+        raise TypeError(f"ngfracture.fracture.strain: vertex displacement must have shape (nv, 2) or (nv, 3), got {a.shape}")
     return a
 
 
 def _vertex_values(mesh, u):
-    """The displacement's vertex values (nv, 2), checked to fit the mesh and to be finite."""
+    """The displacement's vertex values (nv, dim), checked to fit the mesh and to be finite."""
     U = vertex_displacement(u)
-    if U.shape[0] != mesh.nv:
-        raise ValueError(f"ngfracture.fracture.strain: displacement has {U.shape[0]} vertex values, "
-                         f"the mesh has {mesh.nv} vertices")
+    if U.shape != (mesh.nv, mesh.dim):
+        raise ValueError(f"ngfracture.fracture.strain: displacement has {U.shape[0]} vertex values of {U.shape[1]} "
+                         f"components, the mesh has {mesh.nv} vertices in {mesh.dim}D")
     if not np.all(np.isfinite(U)):
         raise ValueError("ngfracture.fracture.strain: displacement has NaN or inf values")
     return U

@@ -34,6 +34,7 @@ import numpy as np
 import ngsolve as ng
 
 from .meshio import MeshArrays, mesh_to_arrays
+from .solid import SolidArrays, is_solid, solid_to_arrays
 
 #: aspect ratio (longest edge / smallest height) above which a triangle is warned about
 SLIVER_ASPECT = 1e3
@@ -48,15 +49,15 @@ class MeshQualityWarning(UserWarning):
 
 
 def validate_mesh(mesh):
-    """Check a 2D triangle mesh; return its arrays.
+    """Check a 2D triangle mesh (or a 3D tetrahedral one, :func:`validate_solid`); return its arrays.
 
     Parameters
     ----------
-    mesh : ngsolve.Mesh or MeshArrays
+    mesh : ngsolve.Mesh, MeshArrays or SolidArrays
 
     Returns
     -------
-    MeshArrays
+    MeshArrays or SolidArrays
         The arrays of the mesh (reused by the caller, so the check costs no extra copy).
 
     Raises
@@ -69,6 +70,8 @@ def validate_mesh(mesh):
     MeshQualityWarning
         If triangles have an aspect ratio above ``SLIVER_ASPECT``; names the worst ones.
     """
+    if isinstance(mesh, SolidArrays) or (isinstance(mesh, ng.Mesh) and is_solid(mesh)):
+        return validate_solid(mesh)
     arrays = _arrays(mesh)
     P = np.asarray(arrays.points, dtype=float)
     T = np.asarray(arrays.triangles, dtype=np.int64)
@@ -212,3 +215,59 @@ def _vs(tri):
 
 def _more(bad):
     return f" ({bad.size - 1} more like it)" if bad.size > 1 else ""
+
+
+def validate_solid(mesh):
+    """Check a 3D tetrahedral mesh; return its arrays.
+
+    Refused: no tetrahedra, non-finite coordinates, vertex numbers out of range, a vertex in
+    no tetrahedron, a tetrahedron of zero volume to rounding (``6|T| <= 64 eps * longest
+    edge^3``) or of negative orientation, a boundary face that is no face of a tetrahedron.
+
+    Parameters
+    ----------
+    mesh : ngsolve.Mesh or SolidArrays
+
+    Returns
+    -------
+    SolidArrays
+
+    Raises
+    ------
+    MeshError
+        On the first defect found, naming it.
+    """
+    a = mesh if isinstance(mesh, SolidArrays) else solid_to_arrays(mesh)
+    P, T = np.asarray(a.points, dtype=float), np.asarray(a.tets, dtype=np.int64)
+    nv = P.shape[0]
+    if T.ndim != 2 or T.shape[1] != 4 or T.size == 0:
+        raise MeshError(f"mesh: the mesh has {nv} vertices but no tetrahedra")
+    if T.min() < 0 or T.max() >= nv:
+        i = int(np.flatnonzero((T < 0) | (T >= nv))[0] // 4)
+        raise MeshError(f"mesh: tetrahedron {i} has vertices {T[i].tolist()}, outside [0, {nv})")
+    bad = np.flatnonzero(~np.all(np.isfinite(P), axis=1))
+    if bad.size:
+        raise MeshError(f"mesh: vertex {bad[0]} has coordinates {P[bad[0]].tolist()}" + _more(bad))
+    bad = np.flatnonzero(np.bincount(T.ravel(), minlength=nv) == 0)
+    if bad.size:
+        raise MeshError(f"mesh: vertex {bad[0]} at {P[bad[0]].tolist()} belongs to no tetrahedron" + _more(bad))
+    x = P[T]
+    e = x[:, 1:] - x[:, :1]
+    det = np.einsum("ij,ij->i", e[:, 0], np.cross(e[:, 1], e[:, 2]))
+    edges = x[:, [0, 0, 0, 1, 1, 2]] - x[:, [1, 2, 3, 2, 3, 3]]
+    longest = np.sqrt(np.einsum("ijk,ijk->ij", edges, edges).max(axis=1))
+    bad = np.flatnonzero(np.abs(det) <= 64 * np.finfo(float).eps * longest ** 3)
+    if bad.size:
+        raise MeshError(f"mesh: tetrahedron {bad[0]} (vertices {_vs(T[bad[0]])}) has zero volume" + _more(bad))
+    bad = np.flatnonzero(det < 0)
+    if bad.size:
+        raise MeshError(f"mesh: tetrahedron {bad[0]} (vertices {_vs(T[bad[0]])}) is negatively oriented" + _more(bad))
+    F = np.sort(np.asarray(a.faces, dtype=np.int64).reshape(-1, 3), axis=1)
+    if F.size:
+        own = np.sort(T[:, [1, 2, 3, 0, 2, 3, 0, 1, 3, 0, 1, 2]].reshape(-1, 3), axis=1)
+        key = np.array([nv * nv, nv, 1], dtype=np.int64)
+        bad = np.flatnonzero(~np.isin(F @ key, own @ key))
+        if bad.size:
+            raise MeshError(f"mesh: boundary face {bad[0]} (vertices {_vs(F[bad[0]])}) is no face of a tetrahedron"
+                            + _more(bad))
+    return a

@@ -21,6 +21,8 @@ import netgen.meshing as nm
 import ngsolve as ng
 import numpy as np
 
+from .solid import solid_to_arrays
+
 
 #: from this many triangles on a netgen mesh's topology is built in NGSolve's task manager
 #: (as ElasticProblem builds its space from PARALLEL_MIN_DOFS // 2): the same numbering,
@@ -133,25 +135,52 @@ class MeshArrays:
                    d[prefix + "seg_bc"], str(d[prefix + "bc_names"]).split("\n"))
 
 
+def simplex_measures(x, elements):
+    """Twice the signed area of every triangle, or six times the signed volume of every
+    tetrahedron (positive for the orientations of MeshArrays and SolidArrays).
+
+    Parameters
+    ----------
+    x : numpy.ndarray, shape (nv, 2) or (nv, 3)
+        Vertex positions.
+    elements : numpy.ndarray of int, shape (ne, 3) or (ne, 4)
+
+    Returns
+    -------
+    numpy.ndarray, shape (ne,)
+    """
+    if x.shape[1] == 3:
+        e = x[np.asarray(elements)]
+        a, b, c = e[:, 1] - e[:, 0], e[:, 2] - e[:, 0], e[:, 3] - e[:, 0]
+        return np.einsum("ij,ij->i", a, np.cross(b, c))
+    # gathers from contiguous coordinate and vertex columns: four times faster than rows of x
+    X, Y = np.ascontiguousarray(x[:, 0]), np.ascontiguousarray(x[:, 1])
+    a, b, c = np.ascontiguousarray(np.asarray(elements).T)
+    xa, ya = X[a], Y[a]
+    return (X[b] - xa) * (Y[c] - ya) - (Y[b] - ya) * (X[c] - xa)
+
+
 def mesh_to_arrays(mesh):
-    """The arrays of an NGSolve (or netgen) 2D triangle mesh.
+    """The arrays of an NGSolve (or netgen) 2D triangle mesh (3D: ``solid.solid_to_arrays``).
 
     Parameters
     ----------
     mesh : ngsolve.Mesh or netgen.meshing.Mesh
-        2D mesh of triangles.
+        2D mesh of triangles, or 3D mesh of tetrahedra.
 
     Returns
     -------
-    MeshArrays
-        New arrays (0-based vertex numbers), elements and segments in mesh order.
+    MeshArrays or SolidArrays
+        New arrays (0-based vertex numbers), elements and segments (faces) in mesh order.
 
     Raises
     ------
     ValueError
-        If the mesh is not 2D or holds elements other than triangles.
+        If the mesh is 1D or holds elements other than triangles (tetrahedra).
     """
     ngmesh = mesh.ngmesh if isinstance(mesh, ng.Mesh) else mesh
+    if ngmesh.dim == 3:
+        return solid_to_arrays(ngmesh)
     if ngmesh.dim != 2:
         raise ValueError(f"mesh_to_arrays needs a 2D mesh, this one has dimension {ngmesh.dim}")
     els = ngmesh.Elements2D().NumPy()

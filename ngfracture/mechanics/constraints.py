@@ -18,53 +18,57 @@ import numpy as np
 import ngsolve as ng
 import scipy.sparse as sp
 
-COMPONENTS = {None: (0, 1), 0: (0,), 1: (1,), "x": (0,), "y": (1,)}
+COMPONENT_NAMES = {"x": 0, "y": 1, "z": 2}
 
 
-def _components(component):
-    try:
-        return COMPONENTS[component]
-    except (KeyError, TypeError):
-        raise ValueError(f"component must be None (both), 0/'x' or 1/'y', got {component!r}") from None
+def _components(component, dim=2):
+    """The components a condition prescribes: all for None, else the one named (0/'x', 1/'y', 2/'z')."""
+    if component is None:
+        return tuple(range(dim))
+    c = COMPONENT_NAMES.get(component, component) if isinstance(component, str) else component
+    if isinstance(c, bool) or not isinstance(c, (int, np.integer)) or not 0 <= c < dim:
+        names = ", ".join(f"{i}/{n!r}" for n, i in list(COMPONENT_NAMES.items())[:dim])
+        raise ValueError(f"component must be None (all) or one of {names}, got {component!r}")
+    return (int(c),)
 
 
-def _dirichlet_value(value, comps):
-    """A Dirichlet value, checked: a 2-vector CoefficientFunction (a CF given; gliding: a
-    scalar CF in one component), or a constant pair (a number or a pair; gliding: the other
-    entry 0)."""
+def _dirichlet_value(value, comps, dim=2):
+    """A Dirichlet value, checked: a dim-vector CoefficientFunction (a CF given; gliding: a
+    scalar CF in one component), or a constant vector (a number or a dim-vector; gliding: the
+    other entries 0)."""
     if isinstance(value, ng.CoefficientFunction):
         if value.dim == 1:
             if len(comps) != 1:
-                raise ValueError("a scalar value needs component=0 or 1 (gliding); give a pair for both")
-            return ng.CF((value, 0)) if comps == (0,) else ng.CF((0, value))
-        if value.dim != 2:
-            raise ValueError(f"a Dirichlet value must have 1 or 2 components, this CoefficientFunction has {value.dim}")
+                raise ValueError("a scalar value needs a component (gliding); give a vector for all components")
+            return ng.CF(tuple(value if c == comps[0] else 0 for c in range(dim)))
+        if value.dim != dim:
+            raise ValueError(f"a Dirichlet value must have 1 or {dim} components, this CoefficientFunction has {value.dim}")
         return value
     arr = np.asarray(value, dtype=float)
     if not np.all(np.isfinite(arr)):
         raise ValueError(f"a Dirichlet value must be finite, got {value!r}")
     if arr.ndim == 0:
-        if len(comps) != 1:
-            return np.array([float(arr), float(arr)])
-        return np.array([float(arr), 0.0]) if comps == (0,) else np.array([0.0, float(arr)])
-    if arr.shape != (2,):
-        raise ValueError(f"a Dirichlet value must be a number or a pair, got {value!r}")
+        out = np.full(dim, float(arr)) if len(comps) != 1 else np.zeros(dim)
+        out[list(comps)] = float(arr)
+        return out
+    if arr.shape != (dim,):
+        raise ValueError(f"a Dirichlet value must be a number or a vector of {dim}, got {value!r}")
     return arr.copy()
 
 
 @dataclass(eq=False)    # value may be an array
 class Dirichlet:
-    """Prescribed displacement on named boundaries (component=None: both; 0 or 1: gliding).
+    """Prescribed displacement on named boundaries (component=None: all; one component: gliding).
 
     Parameters
     ----------
     boundaries : tuple of str
         Boundary names of the mesh.
     value : ngsolve.CoefficientFunction or numpy.ndarray
-        The prescribed displacement: a 2-vector CoefficientFunction, or a constant pair
-        (shape (2,)).
-    component : None, 0/'x' or 1/'y'
-        None prescribes both components, otherwise only that one.
+        The prescribed displacement: a CoefficientFunction with one component per space
+        dimension, or a constant vector (shape (dim,)).
+    component : None, 0/'x', 1/'y' or 2/'z'
+        None prescribes all components, otherwise only that one.
     """
     boundaries: tuple
     value: object
@@ -79,10 +83,10 @@ class PointConstraint:
     ----------
     vertex : int
         Vertex number (0-based).
-    value : (float, float)
-        Prescribed displacement.
-    component : None, 0/'x' or 1/'y'
-        None prescribes both components, otherwise only that one.
+    value : tuple of float
+        Prescribed displacement, one entry per space dimension.
+    component : None, 0/'x', 1/'y' or 2/'z'
+        None prescribes all components, otherwise only that one.
     """
     vertex: int
     value: tuple
@@ -133,6 +137,7 @@ class ConstraintSet:
     def __init__(self, fes, arrays=None):
         self.fes = fes
         self.mesh = fes.mesh
+        self.dim = fes.mesh.dim
         self._arrays = arrays
         self.dirichlet = []
         self.points = []
@@ -140,7 +145,7 @@ class ConstraintSet:
         self._dofs_on = {}  # boundary names -> scalar dofs: the space never changes, assembly repeats
 
     # -- adding constraints (validated at once, before any assembly) ----------------
-    def add_dirichlet(self, boundaries, value=(0.0, 0.0), component=None):
+    def add_dirichlet(self, boundaries, value=0.0, component=None):
         """Prescribe the displacement on one or more named boundaries.
 
         Parameters
@@ -148,9 +153,10 @@ class ConstraintSet:
         boundaries : str or sequence of str
             Boundary names of the mesh; every name must exist.
         value : float, pair, or ngsolve.CoefficientFunction
-            Prescribed displacement (a 2-vector, or a scalar with ``component``).
-        component : None, 0/'x' or 1/'y'
-            None prescribes both components; 0 or 1 only that one (gliding).
+            Prescribed displacement: a vector (one entry per dimension), a number (every
+            component prescribed takes it), or a scalar CoefficientFunction with ``component``.
+        component : None, 0/'x', 1/'y' or 2/'z'
+            None prescribes all components; one of them only that one (gliding).
 
         Raises
         ------
@@ -164,19 +170,19 @@ class ConstraintSet:
         for name in names:
             if not isinstance(name, str) or name not in known:
                 raise ValueError(f"boundary {name!r} does not exist in the mesh; its boundaries are {sorted(known)}")
-        comps = _components(component)
-        self.dirichlet.append(Dirichlet(names, _dirichlet_value(value, comps), component))
+        comps = _components(component, self.dim)
+        self.dirichlet.append(Dirichlet(names, _dirichlet_value(value, comps, self.dim), component))
 
-    def add_point(self, vertex, value=(0.0, 0.0), component=None):
+    def add_point(self, vertex, value=0.0, component=None):
         """Prescribe the displacement of a single vertex.
 
         Parameters
         ----------
         vertex : int
             Vertex number (NGSolve numbering, 0-based).
-        value : float or pair
-            Prescribed displacement.
-        component : None, 0/'x' or 1/'y'
+        value : float or tuple of float
+            Prescribed displacement (a number: every prescribed component takes it).
+        component : None, 0/'x', 1/'y' or 2/'z'
 
         Raises
         ------
@@ -185,10 +191,11 @@ class ConstraintSet:
         """
         if isinstance(vertex, bool) or not isinstance(vertex, (int, np.integer)) or not 0 <= vertex < self.mesh.nv:
             raise ValueError(f"vertex {vertex!r} does not exist; the mesh has {self.mesh.nv} vertices")
-        comps = _components(component)
-        arr = np.broadcast_to(np.asarray(value, dtype=float), (2,)) if np.ndim(value) == 0 else np.asarray(value, float)
-        if arr.shape != (2,) or not np.all(np.isfinite(arr)):
-            raise ValueError(f"point constraint value must be a finite number or pair, got {value!r}")
+        _components(component, self.dim)
+        d = self.dim
+        arr = np.broadcast_to(np.asarray(value, dtype=float), (d,)) if np.ndim(value) == 0 else np.asarray(value, float)
+        if arr.shape != (d,) or not np.all(np.isfinite(arr)):
+            raise ValueError(f"point constraint value must be a finite number or a vector of {d}, got {value!r}")
         self.points.append(PointConstraint(int(vertex), tuple(arr), component))
 
     def add_rows(self, C, g, label="rows"):
@@ -240,7 +247,7 @@ class ConstraintSet:
             If two conditions prescribe different values on one dof, or the single-dof
             rows prescribe every dof (nothing left to solve for).
         """
-        n = self.fes.ndof // 2
+        n = self.fes.ndof // self.dim
         pieces = []   # (dofs, values, source), merged below
         work = None
         for cond in self.dirichlet:
@@ -250,7 +257,7 @@ class ConstraintSet:
                 # a constant: its value at the vertex dofs, zero at the higher-order ones (what
                 # Set() gives, without the projection's rounding)
                 vertex = scalar_dofs < self.mesh.nv
-                for c in _components(cond.component):
+                for c in _components(cond.component, self.dim):
                     pieces.append((c * n + scalar_dofs, np.where(vertex, cond.value[c], 0.0), source))
                 continue
             if work is None:
@@ -260,13 +267,13 @@ class ConstraintSet:
             # NGSolve's Set() on the boundary: nodal at vertices, projection for edge dofs
             work.Set(cond.value, ng.BND, definedon=region)
             data = work.vec.FV().NumPy()
-            for c in _components(cond.component):
+            for c in _components(cond.component, self.dim):
                 dofs = c * n + scalar_dofs
                 if not np.all(np.isfinite(data[dofs])):
                     raise ValueError(f"{source}: the prescribed value is NaN or inf on the boundary")
                 pieces.append((dofs, data[dofs].copy(), source))
         for pc in self.points:
-            for c in _components(pc.component):
+            for c in _components(pc.component, self.dim):
                 pieces.append((np.array([c * n + pc.vertex]), np.array([pc.value[c]]),
                                f"point constraint at vertex {pc.vertex}"))
         # values that agree to rounding (NGSolve's Set() leaves ~1e-17 at corners) are one value
@@ -300,8 +307,9 @@ class ConstraintSet:
         if key not in self._dofs_on:
             a = self._arrays
             if a is not None and self.fes.globalorder == 1:
-                # first order: the dofs are the vertices of the boundary's segments
-                segments = np.concatenate([a.boundary_segments(name) for name in key])
+                # first order: the dofs are the vertices of the boundary's segments (faces in 3D)
+                of = a.boundary_faces if self.dim == 3 else a.boundary_segments
+                segments = np.concatenate([of(name).reshape(-1) for name in key])
                 self._dofs_on[key] = np.unique(segments.astype(np.int64))
             else:
                 names = set(key)

@@ -1,9 +1,11 @@
-"""Hyperelastic materials in 2D, as strain-energy densities for NGSolve.
+"""Hyperelastic materials, as strain-energy densities for NGSolve.
 
 Every material maps the displacement gradient ``H = grad u`` (a 2x2
-CoefficientFunction) to a strain-energy density per unit reference area (unit
-thickness).  NGSolve differentiates the energy twice, which gives the residual
-and the consistent tangent of the Newton solver.
+CoefficientFunction, 3x3 on a 3D mesh) to a strain-energy density per unit reference
+area (unit thickness; per unit volume in 3D).  NGSolve differentiates the energy twice,
+which gives the residual and the consistent tangent of the Newton solver.  On a 3D mesh
+the material is the 3D one: plane strain's Lame parameters are the 3D ones, plane stress
+is refused.
 
 Plane strain uses the Lame parameters of the 3D material.  Plane stress uses
 ``lambda* = 2 lambda mu / (lambda + 2 mu)``: exact for the linear and the
@@ -193,7 +195,7 @@ class Material:
         ngsolve.CoefficientFunction
             Symmetric 2x2 true stress in the current configuration.
         """
-        F = ng.Id(2) + H
+        F = ng.Id(H.dims[0]) + H
         return (1.0 / ng.Det(F)) * self.first_piola(H) * F.trans
 
 
@@ -266,7 +268,7 @@ class LinearElastic(Material):
             2x2 stress.
         """
         eps = small_strain(H)
-        return 2 * self.mu * eps + self.lam * ng.Trace(eps) * ng.Id(2)
+        return 2 * self.mu * eps + self.lam * ng.Trace(eps) * ng.Id(H.dims[0])
 
     def cauchy_stress(self, H):
         """The linear stress, the same as :meth:`first_piola` (no division by det F).
@@ -335,8 +337,8 @@ class StVenantKirchhoff(Material):
             2x2 stress per unit reference length.
         """
         Egl = green_lagrange(H)
-        S = 2 * self.mu * Egl + self.lam * ng.Trace(Egl) * ng.Id(2)
-        return (ng.Id(2) + H) * S
+        S = 2 * self.mu * Egl + self.lam * ng.Trace(Egl) * ng.Id(H.dims[0])
+        return (ng.Id(H.dims[0]) + H) * S
 
 
 class NeoHookean(Material):
@@ -375,9 +377,9 @@ class NeoHookean(Material):
         ngsolve.CoefficientFunction
             Scalar energy per unit reference area; not finite where det F <= 0.
         """
-        F = ng.Id(2) + H
+        F = ng.Id(H.dims[0]) + H
         J = ng.Det(F)
-        # tr C - 2 = 2 tr H + H:H, written so that it keeps digits at tiny strains
+        # tr C - d = 2 tr H + H:H (d the dimension), written so that it keeps digits at tiny strains
         trC_minus_2 = 2 * ng.Trace(H) + ng.InnerProduct(H, H)
         return 0.5 * self.mu * trC_minus_2 - self.mu * ng.log(J) + 0.5 * self.lam * ng.log(J) ** 2
 
@@ -394,7 +396,7 @@ class NeoHookean(Material):
         ngsolve.CoefficientFunction
             2x2 stress per unit reference length; undefined where det F <= 0.
         """
-        F = ng.Id(2) + H
+        F = ng.Id(H.dims[0]) + H
         J = ng.Det(F)
         FinvT = ng.Inv(F).trans
         return self.mu * (F - FinvT) + self.lam * ng.log(J) * FinvT
@@ -450,9 +452,14 @@ def region_materials(mesh, material):
     Raises
     ------
     ValueError
-        If a value is not a Material, a region has none, or a name is not a region.
+        If a value is not a Material, a region has none, or a name is not a region; on a 3D
+        mesh, a material in plane stress.
     """
     regions = set(mesh.GetMaterials())
+    given = [material] if isinstance(material, Material) else material.values() if isinstance(material, dict) else []
+    if mesh.dim == 3 and any(isinstance(m, Material) and m.plane != "strain" for m in given):
+        raise ValueError("a 3D mesh needs materials with plane='strain' (the 3D Lame parameters); "
+                         "plane stress is a 2D reduction")
     if isinstance(material, Material):
         return {name: material for name in sorted(regions)}
     if not isinstance(material, dict):

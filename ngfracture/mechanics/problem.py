@@ -23,27 +23,25 @@ from ..fracture.strain import vertex_displacement
 from ..linalg.sparse import to_scipy
 from .materials import region_materials
 from ..geometry.meshcheck import validate_mesh
-from ..geometry.meshio import mesh_to_arrays
+from ..geometry.meshio import mesh_to_arrays, simplex_measures
 from .newton import NewtonSolver
 from .pressure import check_no_overlap, oriented_segments, pressure_stiffness, total_pressure_forces
 
 
-def _double_areas(x, elements):
-    """Twice the signed area of every triangle (gathers from contiguous coordinate and
-    vertex columns: four times faster than gathering rows of x)."""
-    X, Y = np.ascontiguousarray(x[:, 0]), np.ascontiguousarray(x[:, 1])
-    a, b, c = np.ascontiguousarray(np.asarray(elements).T)
-    xa, ya = X[a], Y[a]
-    return (X[b] - xa) * (Y[c] - ya) - (Y[b] - ya) * (X[c] - xa)
+#: where det F of a higher-order element is sampled: vertices, edge midpoints, centroid
+DET_F_POINTS = {2: [(0, 0), (1, 0), (0, 1), (0.5, 0), (0.5, 0.5), (0, 0.5), (1 / 3, 1 / 3)],
+                3: [(0, 0, 0), (1, 0, 0), (0, 1, 0), (0, 0, 1), (0.5, 0, 0), (0, 0.5, 0), (0, 0, 0.5),
+                    (0.5, 0.5, 0), (0.5, 0, 0.5), (0, 0.5, 0.5), (0.25, 0.25, 0.25)]}
 
 
 class ElasticProblem:
-    """Geometrically nonlinear 2D elasticity on a mesh, with Lagrange-multiplier constraints.
+    """Geometrically nonlinear elasticity on a mesh, with Lagrange-multiplier constraints.
 
     Parameters
     ----------
     mesh : ngsolve.Mesh
-        A 2D mesh of triangles.
+        A 2D mesh of triangles, or a 3D mesh of tetrahedra (plane-strain materials only:
+        their Lame parameters are the 3D ones).
     material : Material or dict of str -> Material
         LinearElastic, StVenantKirchhoff or NeoHookean; a dict gives one per material
         region of the mesh (every region needs one).
@@ -81,6 +79,7 @@ class ElasticProblem:
     """
 
     def __init__(self, mesh, material, order=1, check_mesh=True, triangle_piece=None):
+        self.dim = mesh.dim
         arrays = validate_mesh(mesh) if check_mesh else mesh_to_arrays(mesh)
         self.materials = region_materials(mesh, material)
         if isinstance(order, bool) or not isinstance(order, int) or order < 1:
@@ -99,8 +98,7 @@ class ElasticProblem:
         self._pressures = []  # (boundary, p, its segments)
         self._form = None
         self.arrays = arrays
-        self._elements = arrays.triangles
-        self._points = arrays.points
+        self._elements, self._points = (arrays.tets if self.dim == 3 else arrays.triangles), arrays.points
         self._regions = arrays.regions, arrays.region_names
         self._internal = None     # the C++ kernel's per-element data, made at first need
         self._reference_areas = None
@@ -109,31 +107,32 @@ class ElasticProblem:
                         else rigid.pieces_of_triangles(self._elements, mesh.nv, triangle_piece))
 
     # -- set-up ---------------------------------------------------------------------
-    def add_dirichlet(self, boundaries, value=(0.0, 0.0), component=None):
+    def add_dirichlet(self, boundaries, value=0.0, component=None):
         """Prescribe the displacement on named boundaries; see ConstraintSet.add_dirichlet.
 
         Parameters
         ----------
         boundaries : str or sequence of str
             Boundary names of the mesh.
-        value : float, pair, or ngsolve.CoefficientFunction
-            Prescribed displacement (a scalar needs ``component``).
-        component : None, 0/'x' or 1/'y'
-            None prescribes both components; 0 or 1 only that one (gliding).
+        value : float, vector, or ngsolve.CoefficientFunction
+            Prescribed displacement (a number: every prescribed component takes it; a
+            scalar CoefficientFunction needs ``component``).
+        component : None, 0/'x', 1/'y' or 2/'z'
+            None prescribes all components; one of them only that one (gliding).
         """
         self.constraints.add_dirichlet(boundaries, value, component)
 
-    def add_point_constraint(self, vertex, value=(0.0, 0.0), component=None):
+    def add_point_constraint(self, vertex, value=0.0, component=None):
         """Prescribe the displacement of one vertex; see ConstraintSet.add_point.
 
         Parameters
         ----------
         vertex : int
             Vertex number (0-based).
-        value : float or pair
+        value : float or vector
             Prescribed displacement.
-        component : None, 0/'x' or 1/'y'
-            None prescribes both components; 0 or 1 only that one.
+        component : None, 0/'x', 1/'y' or 2/'z'
+            None prescribes all components; one of them only that one.
         """
         self.constraints.add_point(vertex, value, component)
 
@@ -142,8 +141,8 @@ class ElasticProblem:
 
         Parameters
         ----------
-        f : pair of float or ngsolve.CoefficientFunction
-            Force per unit reference area (2-vector).
+        f : vector of float or ngsolve.CoefficientFunction
+            Force per unit reference area (volume in 3D), one component per dimension.
         """
         self._loads.append(("volume", ng.CF(tuple(f)) if not isinstance(f, ng.CoefficientFunction) else f, None))
         self._form = self._internal = None
@@ -157,8 +156,8 @@ class ElasticProblem:
         ----------
         boundary : str
             Boundary name of the mesh.
-        t : pair of float or ngsolve.CoefficientFunction
-            Traction per unit reference length (2-vector).
+        t : vector of float or ngsolve.CoefficientFunction
+            Traction per unit reference length (area in 3D), one component per dimension.
 
         Raises
         ------
@@ -188,14 +187,15 @@ class ElasticProblem:
         Raises
         ------
         ValueError
-            An unknown boundary, a pressure that is not finite, or an order > 1 (P1 only).
+            An unknown boundary, a pressure that is not finite, an order > 1 or a 3D mesh
+            (P1 triangles only).
         """
         if boundary not in self.mesh.GetBoundaries():
             raise ValueError(f"boundary {boundary!r} does not exist in the mesh; its boundaries are {sorted(set(self.mesh.GetBoundaries()))}")
         if isinstance(p, bool) or not isinstance(p, (int, float)) or not np.isfinite(p):
             raise ValueError(f"pressure must be a finite number, got {p!r}")
-        if self.order != 1:
-            raise ValueError("pressure loads need a first-order space (order=1)")
+        if self.order != 1 or self.dim != 2:
+            raise ValueError("pressure loads need a first-order space (order=1) on 2D meshes; use add_traction in 3D")
         segments = check_no_overlap(self._pressures, boundary, oriented_segments(self.arrays, boundary, bool(crack_faces)))
         self._pressures.append((boundary, float(p), segments))
         self._linear_K = self._last_residual = None
@@ -234,7 +234,7 @@ class ElasticProblem:
         if not self.nonlinear:
             return self._points
         at = self.u.vec.FV().NumPy() if u is None else np.asarray(u, dtype=float)
-        return self._points + at.reshape(2, -1)[:, :self.mesh.nv].T
+        return self._points + at.reshape(self.dim, -1)[:, :self.mesh.nv].T
 
     # -- the discrete operators ----------------------------------------------------------
     #: below this many dofs assembly runs serially: starting NGSolve's task manager costs
@@ -382,7 +382,8 @@ class ElasticProblem:
         if self._internal is None:
             regions, names = self._regions
             laws = [self.materials[n] for n in names]
-            if self.order != 1 or any(m.kernel is None for m in laws):
+            # the kernels are those of P1 triangles: tetrahedra take NGSolve's Apply
+            if self.order != 1 or self.dim != 2 or any(m.kernel is None for m in laws):
                 self._internal = False
             else:
                 r = regions - 1                   # 1-based region numbers
@@ -444,8 +445,8 @@ class ElasticProblem:
         if u is None:
             x = self._points + vertex_displacement(self.u)
         else:    # component-blocked dofs, vertices first (as vertex_displacement reads them)
-            x = self._points + np.asarray(u, dtype=float).reshape(2, -1)[:, :self.mesh.nv].T
-        return rigid.analyse_support(x, self._elements, self.fes.ndof // 2, self.fes.ndof, rows.fixed_dofs,
+            x = self._points + np.asarray(u, dtype=float).reshape(self.dim, -1)[:, :self.mesh.nv].T
+        return rigid.analyse_support(x, self._elements, self.fes.ndof // self.dim, self.fes.ndof, rows.fixed_dofs,
                                      self.fragments())
 
     def floating_bodies(self, rows, support=None):
@@ -505,14 +506,13 @@ class ElasticProblem:
             det F = current / reference area for order 1; NaN where F is not finite.
         """
         if self.order == 1:
-            # F is constant on a P1 triangle: det F = current area / reference area (numpy)
+            # F is constant on a P1 element: det F = current / reference area or volume (numpy)
             if self._reference_areas is None:
-                self._reference_areas = _double_areas(self._points, self._elements)
-            x = self._points + vertex_displacement(self.u)
-            return _double_areas(x, self._elements) / self._reference_areas
-        pts = [(0, 0), (1, 0), (0, 1), (0.5, 0), (0.5, 0.5), (0, 0.5), (1 / 3, 1 / 3)]
+                self._reference_areas = simplex_measures(self._points, self._elements)
+            return simplex_measures(self._points + vertex_displacement(self.u), self._elements) / self._reference_areas
+        pts = DET_F_POINTS[self.dim]
         ir = ng.IntegrationRule(pts, [0.0] * len(pts))
-        F = ng.Id(2) + ng.Grad(self.u)
+        F = ng.Id(self.dim) + ng.Grad(self.u)
         vals = ng.Det(F)(self.mesh.MapToAllElements(ir, ng.VOL)).reshape(self.mesh.ne, len(pts))
         return vals.min(axis=1)
 

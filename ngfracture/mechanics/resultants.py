@@ -70,9 +70,16 @@ def work_of_forces(f_start, f_end, u_start, u_end):
 
 
 def _boundary_dofs(problem, name):
-    """Scalar (vertex) dofs of a boundary, and its segments' vertex pairs."""
+    """Scalar (vertex) dofs of a boundary, its segments (faces in 3D), and the length (area)
+    of each."""
+    X = problem.arrays.points
+    if problem.dim == 3:
+        faces = problem.arrays.boundary_faces(name)
+        x = X[faces]
+        size = 0.5 * np.linalg.norm(np.cross(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0]), axis=1)
+        return np.unique(faces), faces, size
     segments = problem.arrays.boundary_segments(name)
-    return np.unique(segments), segments
+    return np.unique(segments), segments, np.hypot(*(X[segments[:, 1]] - X[segments[:, 0]]).T)
 
 
 def boundary_resultants(problem, out_of_balance):
@@ -81,7 +88,7 @@ def boundary_resultants(problem, out_of_balance):
     The force on a boundary with prescribed displacement is the sum of the reactions at
     its fixed dofs (a corner shared by two such boundaries counts for both); on a boundary
     with a traction, the resultant of the traction. The displacement is the mean over the
-    boundary's length of the P1 displacement.
+    boundary's length (area in 3D) of the P1 displacement.
 
     Parameters
     ----------
@@ -93,28 +100,27 @@ def boundary_resultants(problem, out_of_balance):
     Returns
     -------
     dict of str -> dict
-        ``{"force": [Fx, Fy], "displacement": [ux, uy]}`` per boundary name, sorted.
+        ``{"force": [Fx, Fy(, Fz)], "displacement": [ux, uy(, uz)]}`` per boundary name, sorted.
     """
     rows = problem.assemble_constraints()
     fixed = np.zeros(problem.fes.ndof, dtype=bool)
     fixed[rows.fixed_dofs] = True
-    n = problem.fes.ndof // 2
+    d = problem.dim
+    n = problem.fes.ndof // d
     U = vertex_displacement(problem.u)
-    X = problem.arrays.points
     names = {name for cond in problem.constraints.dirichlet for name in cond.boundaries}
     loaded = {r for kind, _, r in problem.loads if kind in ("boundary", "pressure")}
     out = {}
     for name in sorted(names | loaded):
-        dofs, segments = _boundary_dofs(problem, name)
+        dofs, cells, size = _boundary_dofs(problem, name)
         if name in loaded:
             f = load_vector(problem, name)
-            force = [math.fsum(f[c * n + dofs]) for c in (0, 1)]
+            force = [math.fsum(f[c * n + dofs]) for c in range(d)]
         else:
-            force = [-math.fsum(out_of_balance[c * n + dofs][fixed[c * n + dofs]]) for c in (0, 1)]
-        length = np.hypot(*(X[segments[:, 1]] - X[segments[:, 0]]).T)
-        mid = 0.5 * (U[segments[:, 0]] + U[segments[:, 1]])
-        mean = (length @ mid) / max(length.sum(), 1e-300)
-        out[name] = {"force": [float(force[0]), float(force[1])], "displacement": [float(mean[0]), float(mean[1])]}
+            force = [-math.fsum(out_of_balance[c * n + dofs][fixed[c * n + dofs]]) for c in range(d)]
+        mid = U[cells].mean(axis=1)
+        mean = (size @ mid) / max(size.sum(), 1e-300)
+        out[name] = {"force": [float(v) for v in force], "displacement": [float(v) for v in mean]}
     return out
 
 
@@ -148,7 +154,7 @@ def unsupported_pieces(problem, contact_holds=True):
     modes = problem.support(rows).modes.tocsc()
     if modes.shape[1] == 0 or not np.any(forces):
         return ""
-    nv, n = problem.mesh.nv, problem.fes.ndof // 2
+    nv, n = problem.mesh.nv, problem.fes.ndof // problem.dim
     _, piece = problem.fragments()
     touched = np.unique(rows.C.tocoo().col % n) if rows.C.nnz and contact_holds else np.zeros(0, dtype=np.int64)
     held = set(piece[touched[touched < nv]].tolist())

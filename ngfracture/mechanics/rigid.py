@@ -51,12 +51,12 @@ def numerical_rank(s, rtol=RANK_RTOL):
 
 
 def pieces(elements, nv):
-    """Connected components of a triangle mesh (through shared vertices).
+    """Connected components of a triangle or tetrahedral mesh (through shared vertices).
 
     Parameters
     ----------
-    elements : numpy.ndarray of int, shape (ne, 3)
-        Triangle vertex numbers.
+    elements : numpy.ndarray of int, shape (ne, 3) or (ne, 4)
+        Triangle or tetrahedron vertex numbers.
     nv : int
         Number of vertices (a vertex in no triangle is a piece of its own).
 
@@ -67,9 +67,10 @@ def pieces(elements, nv):
     piece : numpy.ndarray of int, shape (nv,)
         Piece id of every vertex.
     """
-    # two edges per triangle connect its three vertices
-    rows = np.concatenate([elements[:, 0], elements[:, 1]])
-    cols = np.concatenate([elements[:, 1], elements[:, 2]])
+    # a chain of edges through an element's vertices connects them
+    k = elements.shape[1]
+    rows = np.concatenate([elements[:, j] for j in range(k - 1)])
+    cols = np.concatenate([elements[:, j + 1] for j in range(k - 1)])
     graph = sp.coo_matrix((np.ones(rows.size, dtype=np.int8), (rows, cols)), shape=(nv, nv))
     return connected_components(graph, directed=False)
 
@@ -104,7 +105,7 @@ def pieces_of_triangles(elements, nv, triangle_piece):
     if tp.shape != (len(elements),):
         raise ValueError(f"triangle_piece must have one entry per triangle ({len(elements)}), got shape {tp.shape}")
     piece = np.full(nv, -1, dtype=np.int64)
-    piece[elements.ravel()] = np.repeat(tp, 3)
+    piece[elements.ravel()] = np.repeat(tp, elements.shape[1])
     if np.any(piece[elements] != tp[:, None]):
         raise ValueError("triangle_piece gives triangles that share a vertex different pieces")
     if nv and piece.min() < 0:
@@ -119,12 +120,12 @@ def pieces_of_triangles(elements, nv, triangle_piece):
 
 
 def piece_modes(x, verts, n):
-    """The three rigid modes of one piece as dense columns over its vertex dofs.
+    """The rigid modes of one piece (3 in 2D, 6 in 3D) as dense columns over its vertex dofs.
 
     Parameters
     ----------
-    x : numpy.ndarray, shape (nv, 2)
-        Vertex positions at which the modes are taken.
+    x : numpy.ndarray, shape (nv, d)
+        Vertex positions at which the modes are taken (d = 2 or 3).
     verts : numpy.ndarray of int, shape (k,)
         The vertices of the piece.
     n : int
@@ -132,21 +133,39 @@ def piece_modes(x, verts, n):
 
     Returns
     -------
-    dofs : numpy.ndarray of int, shape (2 k,)
-        The x dofs then the y dofs of verts.
-    M : numpy.ndarray, shape (2 k, 3)
-        Translation x, translation y, rotation about the centroid (scaled by the piece
-        size for conditioning).
+    dofs : numpy.ndarray of int, shape (d k,)
+        The x dofs, then the y dofs (then the z dofs) of verts.
+    M : numpy.ndarray, shape (d k, 3) or (d k, 6)
+        The translations, then the rotations about the centroid (about z in 2D; about x, y
+        and z in 3D), scaled by the piece size for conditioning.
     """
     p = x[verts]
     rel = (p - p.mean(axis=0)) / max(np.ptp(p, axis=0).max(), 1e-300)
-    k = verts.size
-    M = np.zeros((2 * k, 3))
-    M[:k, 0] = 1.0
-    M[k:, 1] = 1.0
-    M[:k, 2] = -rel[:, 1]
-    M[k:, 2] = rel[:, 0]
-    return np.concatenate([verts, n + verts]), M
+    k, d = verts.size, x.shape[1]
+    M = np.zeros((d * k, rigid_mode_count(d)))
+    for c in range(d):
+        M[c * k:(c + 1) * k, c] = 1.0
+    # a rotation about axis a moves component b by -rel_c and component c by rel_b
+    axes = [(2, 0, 1)] if d == 2 else [(0, 1, 2), (1, 2, 0), (2, 0, 1)]
+    for j, (_, b, c) in enumerate(axes, start=d):
+        M[b * k:(b + 1) * k, j] = -rel[:, c]
+        M[c * k:(c + 1) * k, j] = rel[:, b]
+    return np.concatenate([c * n + verts for c in range(d)]), M
+
+
+def rigid_mode_count(dim):
+    """The number of rigid modes of a free body: 3 in 2D, 6 in 3D.
+
+    Parameters
+    ----------
+    dim : int
+        2 or 3.
+
+    Returns
+    -------
+    int
+    """
+    return dim * (dim + 1) // 2
 
 
 @dataclass
@@ -208,7 +227,7 @@ def analyse_support(x, elements, n, ndof, fixed_dofs, components=None):
             rank = numerical_rank(s)
             free_modes = vt[rank:].T
         else:
-            free_modes = np.eye(3)
+            free_modes = np.eye(M.shape[1])
         if free_modes.shape[1] == 0:
             continue
         N = M @ free_modes
