@@ -234,8 +234,9 @@ def _run_run(args):
         sys.stderr.write("\n")
     closing = sys.stderr if mode == "json" else sys.stdout    # stdout stays JSON lines only
     s = result.summary
-    print(f"{scene.name}: {s['n_steps']} steps, {s['n_split_vertices']} split vertices, crack length "
-          f"{s['crack_length']:.4g}, {s['n_fragments']} fragments, {s['timings']['wall']:.1f} s; "
+    crack = f"crack length {s['crack_length']:.4g}" if "crack_length" in s else f"crack area {s['crack_area']:.4g}"
+    print(f"{scene.name}: {s['n_steps']} steps, {s['n_split_vertices']} split vertices, {crack}, "
+          f"{s['n_fragments']} fragments, {s['timings']['wall']:.1f} s; "
           f"{result.reason}: {result.message}", file=closing)
     if s.get("pictures", {}).get("final_error"):
         print(f"final.png was not drawn: {s['pictures']['final_error']}", file=sys.stderr)
@@ -290,7 +291,7 @@ def _run_render(args):
         raise ValueError(f"{folder} is not a folder")
     state, _ = load_state(folder)
     # the checkpoint's vector is in VectorH1 layout: components blocked, vertex dofs first
-    u = np.asarray(state.u).reshape(2, -1)[:, :state.mesh.nv].T
+    u = np.asarray(state.u).reshape(state.mesh.dim, -1)[:, :state.mesh.nv].T
     stats = FragmentStatistics(state.mesh)
     scale = picture_scale(state.arrays.points, u)      # as the run draws it
     pictures = final_pictures(folder, state.mesh, u, stats, scale, sizes_min_fragments=1)   # asked for: both

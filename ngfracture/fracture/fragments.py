@@ -16,8 +16,17 @@ import numpy as np
 from ..mechanics import rigid
 from .._ngfracture import ElementAreas
 from ..geometry.meshio import check_mesh, element_vertices
+from ..geometry.solid import solid_to_arrays, tet_volumes
 
 __all__ = ["FragmentStatistics", "fragment_ids"]
+
+
+def _elements(mesh):
+    """The elements' vertex numbers: triangles, or tetrahedra of a 3D mesh."""
+    if getattr(mesh, "dim", None) == 3:
+        return solid_to_arrays(mesh).tets
+    check_mesh(mesh)
+    return element_vertices(mesh)
 
 
 def fragment_ids(mesh):
@@ -29,15 +38,14 @@ def fragment_ids(mesh):
     Parameters
     ----------
     mesh : ngsolve.Mesh
-        2D triangle mesh.
+        2D triangle mesh, or 3D tetrahedral mesh.
 
     Returns
     -------
     numpy.ndarray
         Shape (ne,), int64, values 0 .. count-1.
     """
-    check_mesh(mesh)
-    T = element_vertices(mesh)
+    T = _elements(mesh)
     # pieces of the vertex graph; a triangle belongs to the piece of any of its vertices
     _, comp = rigid.pieces(T, mesh.nv)
     labels = comp[T[:, 0]]
@@ -55,13 +63,14 @@ class FragmentStatistics:
     Parameters
     ----------
     mesh : ngsolve.Mesh
-        2D triangle mesh in the reference configuration.
+        2D triangle mesh (or 3D tetrahedral mesh: areas are then volumes) in the reference
+        configuration.
     fragment : array_like of int, optional
         Fragment id per triangle (shape (ne,)), e.g. ``SplitResult.fragment``. Any
         integer labels are accepted; they are kept in ``ids``. If omitted they are
         computed with :func:`fragment_ids`.
     u : array_like, optional
-        Vertex displacement (nv, 2); if given, ``deformed_centroids`` is filled.
+        Vertex displacement (nv, dim); if given, ``deformed_centroids`` is filled.
 
     Attributes
     ----------
@@ -90,8 +99,8 @@ class FragmentStatistics:
     """
 
     def __init__(self, mesh, fragment=None, u=None):
-        check_mesh(mesh)
-        ne = mesh.ne
+        T = _elements(mesh)
+        ne, d = mesh.ne, mesh.dim
         if fragment is None:
             frag = fragment_ids(mesh)
         else:
@@ -105,24 +114,23 @@ class FragmentStatistics:
         index = index.reshape(-1)
         self.count = len(self.ids)
         self.fragment = frag
-        self.element_areas = np.asarray(ElementAreas(mesh))
+        X = mesh.ngmesh.Coordinates()[:, :d]
+        self.element_areas = tet_volumes(X, T) if d == 3 else np.asarray(ElementAreas(mesh))
         a = self.element_areas
         self.total_area = math.fsum(a)
         self.areas = np.bincount(index, weights=a, minlength=self.count)
         self.ntriangles = np.bincount(index, minlength=self.count)
-        T = element_vertices(mesh)
-        X = mesh.ngmesh.Coordinates()[:, :2]
         self.centroids = self._centroids(X[T].mean(axis=1), a, index)
         self.deformed_centroids = None
         if u is not None:
             U = np.asarray(u, dtype=float)
-            if U.shape != (mesh.nv, 2):
-                raise ValueError(f"FragmentStatistics: displacement must have shape ({mesh.nv}, 2), got {U.shape}")
+            if U.shape != (mesh.nv, d):
+                raise ValueError(f"FragmentStatistics: displacement must have shape ({mesh.nv}, {d}), got {U.shape}")
             self.deformed_centroids = self._centroids((X + U)[T].mean(axis=1), a, index)
 
     def _centroids(self, element_centres, a, index):
         c = np.column_stack([np.bincount(index, weights=a * element_centres[:, k], minlength=self.count)
-                             for k in range(2)])
+                             for k in range(element_centres.shape[1])])
         return c / self.areas[:, None]
 
     def summary(self):

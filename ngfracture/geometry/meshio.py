@@ -21,7 +21,7 @@ import netgen.meshing as nm
 import ngsolve as ng
 import numpy as np
 
-from .solid import solid_to_arrays
+from .solid import SolidArrays, solid_mesh, solid_to_arrays
 
 
 #: from this many triangles on a netgen mesh's topology is built in NGSolve's task manager
@@ -78,6 +78,8 @@ class MeshArrays:
     segments: np.ndarray
     seg_bc: np.ndarray
     bc_names: list
+
+    dim = 2
 
     def as_dict(self, prefix="mesh_"):
         """Arrays for a checkpoint (names are stored as one '\\n'-joined string each).
@@ -205,8 +207,8 @@ def mesh_from_arrays(arrays):
 
     Parameters
     ----------
-    arrays : MeshArrays
-        The mesh; boundary names and material names are kept.
+    arrays : MeshArrays or SolidArrays
+        The mesh; boundary names and material names are kept (3D: ``solid.solid_mesh``).
 
     Returns
     -------
@@ -217,6 +219,8 @@ def mesh_from_arrays(arrays):
     ValueError
         On inconsistent shapes or out-of-range indices.
     """
+    if isinstance(arrays, SolidArrays):
+        return solid_mesh(arrays)
     a = arrays
     pts = np.asarray(a.points, dtype=float)
     tris = np.asarray(a.triangles, dtype=np.int64)

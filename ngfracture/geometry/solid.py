@@ -24,7 +24,7 @@ import netgen.meshing as nm
 import ngsolve as ng
 import numpy as np
 
-__all__ = ["SolidArrays", "solid_to_arrays", "solid_mesh", "tet_volumes", "total_volume", "is_solid"]
+__all__ = ["SolidArrays", "solid_to_arrays", "solid_mesh", "tet_volumes", "total_volume", "is_solid", "crack_area"]
 
 #: from this many tetrahedra NGSolve builds a mesh's topology in its task manager
 PARALLEL_MIN_TETS = 20000
@@ -273,3 +273,23 @@ def total_volume(points, tets):
     float
     """
     return math.fsum(tet_volumes(points, tets))
+
+
+def crack_area(arrays, name="crack"):
+    """The crack's area in the reference configuration: half the area of its faces (both lips).
+
+    Parameters
+    ----------
+    arrays : SolidArrays
+    name : str
+        The crack faces' boundary name.
+
+    Returns
+    -------
+    float
+    """
+    faces = arrays.boundary_faces(name)
+    if len(faces) == 0:
+        return 0.0
+    x = np.asarray(arrays.points, dtype=float)[faces]
+    return 0.25 * math.fsum(np.linalg.norm(np.cross(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0]), axis=1))

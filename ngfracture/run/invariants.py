@@ -5,9 +5,9 @@ one that breaks an invariant is not accepted but retried as a failed solve is (f
 then a smaller increment), and when the retries run out the run ends with the invariant,
 the step and the size of the violation in its reason.
 
-* **Area**: splitting copies vertices and renumbers triangles, it never moves a
-  coordinate, so ``math.fsum`` of the reference triangle areas equals the scene's to the
-  last bit.
+* **Area** (volume in 3D): splitting copies vertices and renumbers triangles, it never
+  moves a coordinate, so ``math.fsum`` of the reference triangle areas (tetrahedron
+  volumes) equals the scene's to the last bit.
 * **No inverted triangle**: every triangle of the deformed configuration keeps a positive
   area (for P1, det F > 0). The nonlinear models' Newton solves check det F at every
   iterate; the linear model has no such notion, so this is where an inverted triangle
@@ -18,7 +18,8 @@ the step and the size of the violation in its reason.
   below 1e-10 of its detection threshold, a length; the overlap of the polygonal lips that
   remains is of second order in that (the scenes end with 1e-16 of the area or less,
   docs/verification.md). A run without contact (``contact="never"``) is held to the same
-  bound: pieces that only separate never overlap.
+  bound: pieces that only separate never overlap. In 3D the overlap is not measured:
+  contact is two-dimensional, and a 3D scene with contact is refused.
 
 The checks cost a few percent of a run (docs/performance.md): the overlap is measured only
 where there are cracks or separate bodies.
@@ -79,9 +80,10 @@ def check_state(problem, area_initial, with_overlap):
     worst = int(np.argmin(det_f))
     if not det_f[worst] > 0:
         return Violation("inverted_element", float(det_f[worst]),
-                         f"triangle {worst} is inverted in the deformed configuration (det F "
+                         f"{'tetrahedron' if problem.dim == 3 else 'triangle'} {worst} is inverted in the deformed configuration (det F "
                          f"{det_f[worst]:.3g})"), 0.0
-    overlap = fragment_overlap_area(problem) if with_overlap else 0.0
+    # 3D: pieces that only separate (contact is two-dimensional, Scene refuses it in 3D)
+    overlap = fragment_overlap_area(problem) if with_overlap and problem.dim == 2 else 0.0
     if not overlap <= OVERLAP_TOL * area_initial:
         return Violation("overlap", overlap,
                          f"pieces overlap by {overlap:.3g} ({overlap / area_initial:.2g} of the area; "

@@ -52,12 +52,15 @@ def prescribed_increment(dofs_a, values_a, dofs_b, values_b):
 
 def _rigid_misfit(points, vertex, component, increment):
     """Largest miss of the least-squares rigid motion (reference coordinates) on these fixed dofs."""
-    centred = points[vertex] - points[vertex].mean(axis=0)   # conditions the rotation column
-    A = np.zeros((len(vertex), 3))
-    A[component == 0, 0] = 1.0
-    A[component == 1, 1] = 1.0
-    # infinitesimal rotation w: u = w (-y, x)
-    A[:, 2] = np.where(component == 0, -centred[:, 1], centred[:, 0])
+    centred = points[vertex] - points[vertex].mean(axis=0)   # conditions the rotation columns
+    d = points.shape[1]
+    A = np.zeros((len(vertex), rigid.rigid_mode_count(d)))
+    for c in range(d):
+        A[component == c, c] = 1.0
+    # infinitesimal rotation about axis a: component b moves by -x_c, component c by x_b
+    axes = [(0, 1)] if d == 2 else [(1, 2), (2, 0), (0, 1)]
+    for j, (b, c) in enumerate(axes, start=d):
+        A[:, j] = np.where(component == b, -centred[:, c], np.where(component == c, centred[:, b], 0.0))
     coef = np.linalg.lstsq(A, increment, rcond=None)[0]
     return float(np.max(np.abs(A @ coef - increment), initial=0.0))
 
@@ -67,10 +70,10 @@ def deformed_fragments(points, triangles, dofs, increment):
 
     Parameters
     ----------
-    points : numpy.ndarray, shape (nv, 2)
+    points : numpy.ndarray, shape (nv, 2) or (nv, 3)
         Reference coordinates of the vertices.
-    triangles : numpy.ndarray of int, shape (ne, 3)
-        Vertex numbers of the triangles (0-based).
+    triangles : numpy.ndarray of int, shape (ne, 3) or (ne, 4)
+        Vertex numbers of the triangles (tetrahedra in 3D, 0-based).
     dofs, increment : numpy.ndarray
         Fixed dofs of the P1 VectorH1 space on this mesh (component c of vertex i is
         dof ``c * nv + i``) and the change of their prescribed values
@@ -79,7 +82,7 @@ def deformed_fragments(points, triangles, dofs, increment):
     Returns
     -------
     piece : numpy.ndarray of int, shape (nv,)
-        Fragment of every vertex (connected through triangles).
+        Fragment of every vertex (connected through elements).
     deformed : numpy.ndarray of bool, shape (number of fragments,)
         True for a fragment that the prescribed increments strain.
 
@@ -88,10 +91,10 @@ def deformed_fragments(points, triangles, dofs, increment):
     ValueError
         If a dof is not a vertex dof of a P1 space on this mesh.
     """
-    nv = len(points)
+    nv, d = points.shape
     dofs = np.asarray(dofs, dtype=np.int64)
-    if dofs.size and (dofs.min() < 0 or dofs.max() >= 2 * nv):
-        raise ValueError(f"fixed dofs must be P1 vertex dofs (0 .. {2 * nv - 1}) of the {nv}-vertex mesh")
+    if dofs.size and (dofs.min() < 0 or dofs.max() >= d * nv):
+        raise ValueError(f"fixed dofs must be P1 vertex dofs (0 .. {d * nv - 1}) of the {nv}-vertex mesh")
     count, piece = rigid.pieces(np.asarray(triangles), nv)
     deformed = np.zeros(count, dtype=bool)
     vertex, component = dofs % nv, dofs // nv

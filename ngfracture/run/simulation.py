@@ -27,6 +27,7 @@ from . import checkpoint
 from .control import StepControl
 from .files import RunFiles, check_folder, read_resumable
 from .scene import Scene
+from ..geometry.solid import crack_area
 from .state import crack_length
 from .step import LoadStep
 from .timings import Timings
@@ -303,9 +304,23 @@ class Simulation:
         if on_step is not None:
             on_step(accepted)
 
-    def _summary(self, state, prob, stats, area_initial, reason, message, wall):
+    def _extent(self, state, prob, stats, area_initial):
+        """The summary's cracks, fragments and mesh size: lengths and areas, or areas and volumes in 3D."""
+        if prob.dim == 3:
+            return {"crack_area": crack_area(state.arrays), "n_fragments": int(stats.count),
+                    "fragment_volumes": stats.areas.tolist(), "volume_initial": area_initial,
+                    "volume_final": stats.total_area, "n_vertices": int(prob.mesh.nv), "n_tetrahedra": int(prob.mesh.ne)}
         hist = state.history
         overlap = fragment_overlap_area(prob) if stats.count > 1 or self.scene.contact else 0.0
+        return {"crack_length": crack_length(state.arrays), "crack_graph": crack_graph(state.arrays).summary(),
+                "max_tip_resolution": max((h.get("tip_resolution", 0.0) for h in hist), default=0.0),
+                "n_fragments": int(stats.count), "fragment_areas": stats.areas.tolist(),
+                "area_initial": area_initial, "area_final": stats.total_area,
+                "max_overlap_area": overlap,
+                "n_vertices": int(prob.mesh.nv), "n_triangles": int(prob.mesh.ne)}
+
+    def _summary(self, state, prob, stats, area_initial, reason, message, wall):
+        hist = state.history
         return {
             "scene": self.scene.name, "parameters": self.scene.parameters,
             "load_description": self.scene.load_description,
@@ -314,13 +329,7 @@ class Simulation:
             "reason": reason, "message": message,
             "n_steps": state.step, "load": state.x,
             "n_split_vertices": int(sum(h["split_vertices"] for h in hist)),
-            "crack_length": crack_length(state.arrays),
-            "crack_graph": crack_graph(state.arrays).summary(),
-            "max_tip_resolution": max((h.get("tip_resolution", 0.0) for h in hist), default=0.0),
-            "n_fragments": int(stats.count), "fragment_areas": stats.areas.tolist(),
-            "area_initial": area_initial, "area_final": stats.total_area,
-            "max_overlap_area": overlap,
-            "n_vertices": int(prob.mesh.nv), "n_triangles": int(prob.mesh.ne),
+            **self._extent(state, prob, stats, area_initial),
             "crack_initiation": next((h["initiation"] for h in hist if "initiation" in h), []),
             "energy": [{k: h[k] for k in ("step", "x", "elastic_energy", "external_work", "released_energy")}
                        for h in hist],

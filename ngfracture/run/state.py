@@ -12,8 +12,9 @@ import numpy as np
 
 from . import checkpoint
 from ..geometry.meshio import MeshArrays, mesh_from_arrays, mesh_to_arrays
+from ..geometry.solid import SolidArrays, crack_area
 
-__all__ = ["State", "round_trip", "crack_length", "json_round_trip", "save_state", "load_state"]
+__all__ = ["State", "round_trip", "crack_length", "crack_extent", "json_round_trip", "save_state", "load_state"]
 
 
 @dataclass
@@ -94,6 +95,23 @@ def round_trip(mesh):
     """
     arrays = mesh_to_arrays(mesh)
     return arrays, mesh_from_arrays(arrays)
+
+
+def crack_extent(arrays):
+    """The crack's extent for a step's record: its length in 2D, its area in 3D.
+
+    Parameters
+    ----------
+    arrays : MeshArrays or SolidArrays
+
+    Returns
+    -------
+    (str, float)
+        ``("crack_length", length)`` or ``("crack_area", area)``.
+    """
+    if arrays.dim == 3:
+        return "crack_area", crack_area(arrays)
+    return "crack_length", crack_length(arrays)
 
 
 def crack_length(arrays):
@@ -184,7 +202,8 @@ def load_state(folder):
     """
     arrays, header = checkpoint.latest(folder)
     meta = dict(header.get("meta", header))
-    state = State(arrays=MeshArrays.from_dict(arrays), u=arrays["u"], x=meta.pop("x"), dx=meta.pop("dx"),
+    kind = SolidArrays if "mesh_tets" in arrays else MeshArrays
+    state = State(arrays=kind.from_dict(arrays), u=arrays["u"], x=meta.pop("x"), dx=meta.pop("dx"),
                   step=meta.pop("step"), quiet=meta.pop("quiet"), work=meta.pop("work"),
                   reactions=arrays["reactions"], fixed_values=arrays["fixed_values"],
                   fixed_dofs=arrays["fixed_dofs"], peak_energy=meta.pop("peak_energy"),

@@ -46,7 +46,8 @@ from .loadpath import load_path_cut, prescribed_increment
 from .invariants import check_state
 from .records import (AcceptedStep, Attempt, CrackPass, Equilibrium, StepFailed, StepLog, StepOutcome, TooManyCracks,
                       merged_notes)
-from .state import State, crack_length, round_trip
+from .solid_pass import solid_crack_pass
+from .state import State, crack_extent, round_trip
 from . import tangents
 from .growth import critical_event, relax
 from .refinement import refine_equilibrium, refine_initial
@@ -120,7 +121,7 @@ class LoadStep:
         -------
         bool
         """
-        if self.contact == "never":
+        if self.contact == "never" or mesh.dim == 3:      # contact is 2D (Scene refuses it in 3D)
             return False
         return self.scene.contact or "crack" in mesh.GetBoundaries()
 
@@ -210,6 +211,8 @@ class LoadStep:
         with timings.timed("strain"):
             tensors = self.criterion.overstrain(prob.mesh, prob.u, strength, arrays=prob.arrays)
             largest = float(principal(tensors)[0].max(initial=0.0))
+        if prob.dim == 3:
+            return solid_crack_pass(self, prob, x, strength, tensors, largest, timings)
         t0 = time.perf_counter()
         # cracks judged at a critical distance grow from their tips (docs/criterion.md)
         if self.criterion.one_ring:
@@ -473,14 +476,14 @@ class LoadStep:
         new_dx = dx
         if quiet >= self.control.grow_after:
             new_dx, quiet = min(dx * self.control.grow, self.control.dx_max), 0
-        record = self._record(state, attempt, dx, log, energy, work, crack_length(arrays), stats.count)
+        record = self._record(state, attempt, dx, log, energy, work, crack_extent(arrays), stats.count)
         record["boundaries"] = boundary_resultants(prob, out_of_balance)
-        r = self.criterion.smallest_radius
-        graph = crack_graph(arrays, branches=False) if attempt.total_cracks or r is not None else None
-        if attempt.total_cracks:      # each tip's advance over the step (reference length)
+        r, flat = self.criterion.smallest_radius, arrays.dim == 2      # the crack graph is 2D
+        graph = crack_graph(arrays, branches=False) if flat and (attempt.total_cracks or r is not None) else None
+        if attempt.total_cracks and flat:      # each tip's advance over the step (reference length)
             points, advances = tip_advances(state.arrays, arrays, graph=graph)
             record["tips"] = [{"position": p, "advanced": a} for p, a in zip(points.tolist(), advances.tolist())]
-        if r is not None:
+        if r is not None and flat:
             # how finely the mesh resolves the criterion at the crack tips (h / r)
             _, sizes = tip_sizes(arrays, graph=graph)
             record["tip_resolution"] = float(sizes.max(initial=0.0) / r)
@@ -498,11 +501,11 @@ class LoadStep:
         return AcceptedStep(new, record, prob, stats, attempt)
 
     @staticmethod
-    def _record(state, attempt, dx, log, energy, work, length, fragments):
+    def _record(state, attempt, dx, log, energy, work, extent, fragments):
         """The history record of an accepted step."""
         record = {"step": state.step + 1, "x": attempt.x, "dx": dx, "new_cracks_first_pass": int(attempt.first_cracks),
                   "split_vertices": int(attempt.total_cracks), "elastic_energy": energy, "external_work": work,
-                  "released_energy": work - energy, "crack_length": length,
+                  "released_energy": work - energy, extent[0]: extent[1],
                   "fragments": int(fragments), "newton_iterations": int(attempt.iterations),
                   "retries": int(log.retries), "failures": list(log.failures),
                   "substeps": int(log.substeps), "method": log.method,
@@ -553,7 +556,7 @@ class LoadStep:
         last = state.history[-1]
         if last["fragments"] > 1 and self.cut_through(state.arrays, state.mesh, state, timings):
             return "the body is broken through (no fragment connects boundaries the load moves apart)"
-        if last["crack_length"] > 0 and last["elastic_energy"] < self.control.unloaded_fraction * state.peak_energy:
+        if last.get("crack_length", last.get("crack_area")) > 0 and last["elastic_energy"] < self.control.unloaded_fraction * state.peak_energy:
             return "the body is broken through (elastic energy released)"
         return ""
 
@@ -577,5 +580,5 @@ class LoadStep:
         unloaded = self.problem(mesh, 0.0, timings).assemble_constraints()
         dofs, increment = prescribed_increment(unloaded.fixed_dofs, unloaded.fixed_values,
                                                loaded.fixed_dofs, loaded.fixed_values)
-        return load_path_cut(arrays.points, arrays.triangles, dofs, increment)
+        return load_path_cut(arrays.points, arrays.tets if arrays.dim == 3 else arrays.triangles, dofs, increment)
 

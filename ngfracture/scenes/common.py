@@ -16,10 +16,13 @@ FIRST_CRACK = 1.5 * GLASS["critical"] * HOLE
 #: it sets the toughness K_c = E critical sqrt(2 pi r)); each scene's value keeps its default
 #: mesh fine enough (h <= r/4 where the plate's crack runs, h <= r/2 in the disks)
 PLATE_RADIUS, DISK_RADIUS, DISINTEGRATION_RADIUS = 0.04, 0.12, 0.16
+#: the notched bar's critical distance (3D): its default mesh is r/2 at the crack plane
+BAR_RADIUS = 0.08
 
 #: the load parameters, for Scene.load_description and the command line's --help
 PLATE_LOAD = "total extension of the unit plate (length; equals the mean strain)"
 DISK_LOAD = "radial displacement of the core's inner boundary (length; the disk's radius is 1)"
+BAR_LOAD = "extension of the bar (length; the bar is 2 long)"
 BEAM_LOAD = "downward displacement of the loading pad on the beam's top (length; the beam's height is 1)"
 
 

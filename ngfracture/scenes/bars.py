@@ -1,0 +1,127 @@
+"""A notched bar in tension: the 3D scene whose crack is one plane across the ligament."""
+import numpy as np
+from netgen.csg import CSGeometry, OrthoBrick, Plane, Pnt, Vec
+import netgen.meshing as nm
+import ngsolve as ng
+
+from ..mechanics.materials import StVenantKirchhoff
+from ..run.scene import Scene
+from .common import BAR_LOAD, BAR_RADIUS, GLASS, positive
+
+__all__ = ["notched_bar_mesh", "bar3d"]
+
+
+def notched_bar_mesh(maxh, fine, length=2.0, width=1.0, thickness=0.5, notch=0.2, notch_width=0.02):
+    """A bar with a through-thickness edge notch at mid-length, meshed by netgen.
+
+    The bar spans x in [0, length], y in [0, width], z in [0, thickness]; the notch, a slot
+    of ``notch_width`` across x = length/2, runs from y = 0 to y = ``notch`` through the
+    whole thickness. Boundaries: ``left`` (x = 0), ``right`` (x = length), ``notch`` (the
+    slot's faces) and ``side``; region ``glass``. The mesh is ``fine`` within two ``fine``
+    of the mid-plane x = length/2 (where the crack runs), ``maxh`` elsewhere.
+
+    Parameters
+    ----------
+    maxh, fine : float
+        Mesh sizes away from and at the crack plane (> 0).
+    length, width, thickness, notch, notch_width : float
+        The bar's dimensions (> 0; notch < width, notch_width < length).
+
+    Returns
+    -------
+    ngsolve.Mesh
+
+    Raises
+    ------
+    ValueError
+        A size that is not a finite number > 0, or a notch as deep as the bar.
+    """
+    maxh, fine = positive("maxh", maxh), positive("fine", fine)
+    L, W, T = positive("length", length), positive("width", width), positive("thickness", thickness)
+    a, w = positive("notch", notch), positive("notch_width", notch_width)
+    if a >= W or w >= L:
+        raise ValueError(f"the notch ({a} deep, {w} wide) must be shallower than the width {W} and narrower "
+                         f"than the length {L}")
+    geo = CSGeometry()
+    # a brick larger than the bar cut by named planes: a plane on a brick's face would not name it
+    box = (OrthoBrick(Pnt(-1, -1, -1), Pnt(L + 1, W + 1, T + 1)).bc("side")
+           * Plane(Pnt(0, 0, 0), Vec(-1, 0, 0)).bc("left") * Plane(Pnt(L, 0, 0), Vec(1, 0, 0)).bc("right")
+           * Plane(Pnt(0, 0, 0), Vec(0, -1, 0)).bc("side") * Plane(Pnt(0, W, 0), Vec(0, 1, 0)).bc("side")
+           * Plane(Pnt(0, 0, 0), Vec(0, 0, -1)).bc("side") * Plane(Pnt(0, 0, T), Vec(0, 0, 1)).bc("side"))
+    slot = OrthoBrick(Pnt(L / 2 - w / 2, -1, -1), Pnt(L / 2 + w / 2, a, T + 1)).bc("notch")
+    geo.Add((box - slot).mat("glass"))
+    mp = nm.MeshingParameters(maxh=maxh)
+    for y in np.arange(0.0, W + fine / 2, fine):
+        for z in np.arange(0.0, T + fine / 2, fine):
+            for x in (L / 2 - 2 * fine, L / 2, L / 2 + 2 * fine):
+                mp.RestrictH(x=x, y=y, z=z, h=fine)
+    return ng.Mesh(geo.GenerateMesh(mp=mp))
+
+
+def bar3d(maxh=0.15, fine=None, strain_max=2e-3, dx=None, material=None, critical=GLASS["critical"],
+          E=GLASS["E"], nu=GLASS["nu"], radius=BAR_RADIUS, notch=0.2, thickness=0.5):
+    """A notched glass bar pulled along its axis: one crack across the ligament (3D).
+
+    A 2 x 1 x ``thickness`` bar of glass (St Venant-Kirchhoff, E = 5 GPa, nu = 0.18) with a
+    through-thickness edge notch of depth ``notch`` at mid-length. Both ends glide: u_x = 0
+    at x = 0 and u_x = x at x = 2, the other components free; the three rigid modes this
+    leaves (translations in y and z, rotation about the axis) are held at two corners of
+    the left end. x is the extension of the bar.
+
+    Parameters
+    ----------
+    maxh : float
+        Mesh size away from the crack plane.
+    fine : float, optional
+        Mesh size within two of it of the mid-plane; default radius / 2.
+    strain_max : float
+        Final mean strain x / 2 (the run stops once the bar is broken through).
+    dx : float, optional
+        First increment of x; default a fifth of the critical extension of the unnotched bar.
+    material : Material, optional
+        Replaces the St Venant-Kirchhoff material of ``E`` and ``nu``.
+    critical : float
+        Critical principal strain.
+    E, nu : float
+        Young's modulus (Pa) and Poisson's ratio.
+    radius : float
+        Critical distance of the crack criterion.
+    notch, thickness : float
+        Notch depth and bar thickness (the width is 1).
+
+    Returns
+    -------
+    Scene
+
+    Raises
+    ------
+    ValueError
+        A parameter that is not a finite number > 0.
+    """
+    maxh, strain_max = positive("maxh", maxh), positive("strain_max", strain_max)
+    radius = positive("radius", radius)
+    fine = radius / 2 if fine is None else positive("fine", fine)
+    mesh = notched_bar_mesh(maxh, fine, thickness=thickness, notch=notch)
+    material = material if material is not None else StVenantKirchhoff(E, nu)
+    dx = positive("dx", dx) if dx is not None else 2 * critical / 5
+    corners = _left_corners(mesh)
+
+    def apply_load(prob, x):
+        prob.add_dirichlet("left", 0.0, component="x")
+        prob.add_dirichlet("right", x, component="x")
+        prob.add_point_constraint(corners[0], 0.0, component="y")
+        prob.add_point_constraint(corners[0], 0.0, component="z")
+        prob.add_point_constraint(corners[1], 0.0, component="z")
+
+    return Scene(name="bar3d", mesh=mesh, material=material, critical=critical, apply_load=apply_load,
+                 load_max=2 * strain_max, dx=dx, contact_tol=1e-3 * fine, stop_when_unloaded=True,
+                 radius=radius, load_description=BAR_LOAD,
+                 parameters={"maxh": maxh, "fine": fine, "strain_max": strain_max, "dx": dx, "critical": critical,
+                             "radius": radius, "E": material.E, "nu": material.nu, "model": type(material).__name__,
+                             "notch_depth": notch, "thickness": thickness})
+
+
+def _left_corners(mesh):
+    """The vertices at the left end's corners (0, 0, 0) and (0, 1, 0)."""
+    P = mesh.ngmesh.Coordinates()
+    return [int(np.argmin(np.linalg.norm(P - q, axis=1))) for q in ([0.0, 0.0, 0.0], [0.0, 1.0, 0.0])]
