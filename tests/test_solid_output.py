@@ -11,6 +11,7 @@ import colorsys
 import itertools
 import os
 import struct
+import types
 import xml.etree.ElementTree as ET
 
 import numpy as np
@@ -228,6 +229,15 @@ def test_final_png_shows_both_fragments(cracked, tmp_path, monkeypatch):
         output.render_png(arrays, U, fragment, p)
     with pytest.raises(ValueError, match="95 fragment numbers for 96 tetrahedra"):
         output.render_png(arrays, U, fragment[:-1], tmp_path / "x.png")
+
+
+def test_final_pictures_of_a_3d_run(cracked, tmp_path):
+    arrays, fragment, U = cracked
+    stats = types.SimpleNamespace(fragment=fragment, count=2, areas=np.array([1.0, 1.0]))
+    scale = output.picture_scale(arrays.points, U)
+    pictures = output.final_pictures(tmp_path, solid_mesh(arrays), U, stats, scale)
+    assert pictures == {"final": "final.png", "displacement_scale": scale}
+    assert png_size(tmp_path / "final.png") == (1200, 900) and os.listdir(tmp_path) == ["final.png"]
 
 
 def test_render_failure_is_a_render_error(cracked, tmp_path, monkeypatch):
