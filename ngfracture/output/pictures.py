@@ -1,5 +1,8 @@
 """Pictures of a run without a display: the deformed pieces (Pillow), the fragment sizes (matplotlib).
 
+The pieces of a 3D run are drawn by :mod:`ngfracture.output.solid_pictures`; ``render_png``
+and ``final_pictures`` take both.
+
     render_png(mesh, u, stats.fragment, "out/run/final.png")
     plot_fragment_sizes(stats.areas, "out/run/fragment_sizes.png")
 """
@@ -9,10 +12,11 @@ from pathlib import Path
 import numpy as np
 
 from .atomic import write_bytes
-from .vtk import displacement_values, vertex_arrays
+from .vtk import displacement_values, is_tetrahedral, vertex_arrays
 
 __all__ = ["RenderError", "picture_scale", "render_png", "fragment_size_bins", "plot_fragment_sizes",
-           "final_pictures", "SIZES_MIN_FRAGMENTS"]
+           "final_pictures", "SIZES_MIN_FRAGMENTS", "FRAGMENT_COLOURS", "SUPERSAMPLING",
+           "picture_pixels"]
 
 
 class RenderError(RuntimeError):
@@ -20,12 +24,13 @@ class RenderError(RuntimeError):
 
 
 #: render_png draws at this multiple of the picture's size and reduces (antialiasing)
-_SUPERSAMPLING = 2
+SUPERSAMPLING = 2
 
 
-_FRAGMENT_COLOURS = ["#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2",
-                     "#7f7f7f", "#bcbd22", "#17becf", "#aec7e8", "#ffbb78", "#98df8a", "#ff9896",
-                     "#c5b0d5", "#c49c94", "#f7b6d2", "#c7c7c7", "#dbdb8d", "#9edae5"]
+#: the colours of fragments 0, 1, 2, ... (cycled)
+FRAGMENT_COLOURS = ["#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2",
+                    "#7f7f7f", "#bcbd22", "#17becf", "#aec7e8", "#ffbb78", "#98df8a", "#ff9896",
+                    "#c5b0d5", "#c49c94", "#f7b6d2", "#c7c7c7", "#dbdb8d", "#9edae5"]
 
 
 def picture_scale(points, u):
@@ -48,6 +53,31 @@ def picture_scale(points, u):
     return 0.02 * size / umax if umax > 0 else 1.0
 
 
+def picture_pixels(xy, width, height):
+    """Pixel coordinates of points fitted into a picture drawn at ``SUPERSAMPLING`` times its size.
+
+    Parameters
+    ----------
+    xy : numpy.ndarray, shape (n, 2)
+        Coordinates on the picture's plane (x right, y up).
+    width, height : int
+        The picture's size in pixels (before supersampling).
+
+    Returns
+    -------
+    numpy.ndarray, shape (n, 2)
+        Pixel x, y (y down) on the supersampled canvas: the points' bounding box centred,
+        equal aspect, 2 % margins.
+    """
+    ss = SUPERSAMPLING
+    lo, hi = xy.min(axis=0), xy.max(axis=0)
+    span = np.maximum(hi - lo, 1e-300)
+    zoom = ss * 0.96 * min(width / span[0], height / span[1])     # 2 % margins, equal aspect
+    centre = 0.5 * (lo + hi)
+    return np.column_stack([ss * width / 2 + zoom * (xy[:, 0] - centre[0]),
+                            ss * height / 2 - zoom * (xy[:, 1] - centre[1])])
+
+
 def render_png(mesh, u, fragment, path, window_size=(1200, 900), scale=1.0, crack_boundary="crack",
                line_width=2.0, force=False):
     """A PNG of the deformed configuration coloured by fragment, crack faces drawn in black.
@@ -58,7 +88,7 @@ def render_png(mesh, u, fragment, path, window_size=(1200, 900), scale=1.0, crac
     Parameters
     ----------
     mesh : ngsolve.Mesh
-        2D triangle mesh, reference configuration.
+        2D triangle mesh, reference configuration (3D: :func:`.solid_pictures.render_solid_png`).
     u : ngsolve.GridFunction or numpy.ndarray or None
         Displacement (None: the reference configuration).
     fragment : array_like of int
@@ -90,6 +120,9 @@ def render_png(mesh, u, fragment, path, window_size=(1200, 900), scale=1.0, crac
     FileExistsError
         ``path`` exists and not ``force``.
     """
+    if is_tetrahedral(mesh):
+        from .solid_pictures import render_solid_png
+        return render_solid_png(mesh, u, fragment, path, window_size, scale, crack_boundary, force)
     path = Path(path)
     if path.exists() and not force:
         raise FileExistsError(f"render_png: {path} exists; pass force=True to overwrite it")
@@ -103,16 +136,11 @@ def render_png(mesh, u, fragment, path, window_size=(1200, 900), scale=1.0, crac
     try:
         from PIL import Image, ImageDraw
         # drawn at twice the size and reduced: smooth edges without an antialiasing rasteriser
-        ss = _SUPERSAMPLING
-        lo, hi = X.min(axis=0), X.max(axis=0)
-        span = np.maximum(hi - lo, 1e-300)
-        zoom = ss * 0.96 * min(width / span[0], height / span[1])     # 2 % margins, equal aspect
-        centre = 0.5 * (lo + hi)
-        pixels = np.column_stack([ss * width / 2 + zoom * (X[:, 0] - centre[0]),
-                                  ss * height / 2 - zoom * (X[:, 1] - centre[1])])
+        ss = SUPERSAMPLING
+        pixels = picture_pixels(X, width, height)
         image = Image.new("RGB", (ss * width, ss * height), "white")
         draw = ImageDraw.Draw(image)
-        colours = [_FRAGMENT_COLOURS[f % len(_FRAGMENT_COLOURS)] for f in fragment.tolist()]
+        colours = [FRAGMENT_COLOURS[f % len(FRAGMENT_COLOURS)] for f in fragment.tolist()]
         # outlines in the face colour: no white seams between triangles of one fragment
         for corners, colour in zip(pixels[a.triangles].tolist(), colours):
             draw.polygon([tuple(p) for p in corners], fill=colour, outline=colour)

@@ -6,9 +6,10 @@
 Files of a :class:`TimeSeriesWriter` folder
 -------------------------------------------
 ``step_NNNNNN.vtu``
-    The mesh, its displacement, strain, regions and fragments (:mod:`ngfracture.output.vtk`).
+    The mesh, its displacement, strain, regions and fragments (:mod:`ngfracture.output.vtk`;
+    tetrahedra of a 3D mesh: :mod:`ngfracture.output.solid_vtk`).
 ``cracks_NNNNNN.vtp``
-    The crack faces as line cells with their displacement.
+    The crack faces with their displacement: line cells in 2D, triangles in 3D.
 ``results.pvd``, ``cracks.pvd``
     Collections listing the steps with time = load parameter; open these in ParaView
     (File > Open) or ``pyvista.get_reader``. Rewritten atomically after every step.
@@ -23,7 +24,8 @@ import numpy as np
 
 from . import vtkxml
 from .atomic import TEMPORARY_PREFIX, fsync_folder, write_bytes, write_file
-from .vtk import crack_fields, mesh_fields, region_names, vertex_arrays, vtk_cracks, vtk_mesh
+from .solid_vtk import solid_arrays, solid_crack_fields, solid_fields, vtk_solid_cracks, vtk_solid_mesh
+from .vtk import crack_fields, is_tetrahedral, mesh_fields, region_names, vertex_arrays, vtk_cracks, vtk_mesh
 
 __all__ = ["TimeSeriesWriter", "COMPRESSIONS"]
 
@@ -169,6 +171,36 @@ class TimeSeriesWriter:
         write_bytes(self.folder / self.PVD, self._collection(self._name), force=True)
         write_bytes(self.folder / self.CRACK_PVD, self._collection(self._crack_name), force=True)
 
+    def _write_plane(self, vtu, vtp, fields, crack_boundary):
+        """The files of a step of a 2D mesh: triangles, crack faces as lines."""
+        mesh, u = fields[:2]
+        a = vertex_arrays(mesh)
+        if self.compression == "lz4":
+            _save_vtk(vtk_mesh(*fields, arrays=a), vtu, self.compression)
+            _save_vtk(vtk_cracks(mesh, u, crack_boundary, arrays=a), vtp, self.compression)
+            return
+        _, points, cells = mesh_fields(*fields, arrays=a)
+        grid = vtkxml.unstructured_grid(a.points, a.triangles, points, cells,
+                                        {"region_names": region_names(a)}, self.compression)
+        write_bytes(vtu, grid, force=True, sync=False)
+        lines = vtkxml.poly_lines(*crack_fields(mesh, u, crack_boundary, a), self.compression)
+        write_bytes(vtp, lines, force=True, sync=False)
+
+    def _write_solid(self, vtu, vtp, fields, crack_boundary):
+        """The files of a step of a 3D mesh: tetrahedra, crack faces as triangles."""
+        mesh, u = fields[:2]
+        a = solid_arrays(mesh)
+        if self.compression == "lz4":
+            _save_vtk(vtk_solid_mesh(*fields, arrays=a), vtu, self.compression)
+            _save_vtk(vtk_solid_cracks(mesh, u, crack_boundary, arrays=a), vtp, self.compression)
+            return
+        _, points, cells = solid_fields(*fields, arrays=a)
+        grid = vtkxml.unstructured_grid(a.points, a.tets, points, cells, {"region_names": region_names(a)},
+                                        self.compression, cell_type=vtkxml.VTK_TETRA)
+        write_bytes(vtu, grid, force=True, sync=False)
+        faces = vtkxml.poly_triangles(*solid_crack_fields(mesh, u, crack_boundary, a), self.compression)
+        write_bytes(vtp, faces, force=True, sync=False)
+
     def write(self, step, time, mesh, u=None, fragment=None, strain="green", point_data=None,
               cell_data=None, crack_boundary="crack"):
         """Write one step and update the collections.
@@ -180,7 +212,9 @@ class TimeSeriesWriter:
         time : float
             The load parameter: the time value in the collections.
         mesh, u, fragment, strain, point_data, cell_data
-            As for :func:`to_pyvista`.
+            As for :func:`to_pyvista`: a 2D mesh, or a 3D one (``ngsolve.Mesh`` of
+            dimension 3 or SolidArrays; ``fragment`` per tetrahedron) as for
+            :func:`ngfracture.output.solid_vtk.solid_to_pyvista`.
         crack_boundary : str
             Boundary name of the crack faces.
 
@@ -206,22 +240,15 @@ class TimeSeriesWriter:
         time = float(time)
         if not math.isfinite(time):
             raise ValueError(f"TimeSeriesWriter.write: time must be finite, got {time!r}")
-        a = vertex_arrays(mesh)
         vtu, vtp = self.folder / self._name(step), self.folder / self._crack_name(step)
         for p in (vtu, vtp):
             if p.exists():   # a file the collection does not list: never overwrite it silently
                 raise FileExistsError(f"TimeSeriesWriter.write: {p} exists but is not in the collection")
-        if self.compression == "lz4":
-            _save_vtk(vtk_mesh(mesh, u, fragment, strain, point_data, cell_data, arrays=a), vtu,
-                      self.compression)
-            _save_vtk(vtk_cracks(mesh, u, crack_boundary, arrays=a), vtp, self.compression)
+        fields = (mesh, u, fragment, strain, point_data, cell_data)
+        if is_tetrahedral(mesh):
+            self._write_solid(vtu, vtp, fields, crack_boundary)
         else:
-            _, points, cells = mesh_fields(mesh, u, fragment, strain, point_data, cell_data, arrays=a)
-            grid = vtkxml.unstructured_grid(a.points, a.triangles, points, cells,
-                                            {"region_names": region_names(a)}, self.compression)
-            write_bytes(vtu, grid, force=True, sync=False)
-            lines = vtkxml.poly_lines(*crack_fields(mesh, u, crack_boundary, a), self.compression)
-            write_bytes(vtp, lines, force=True, sync=False)
+            self._write_plane(vtu, vtp, fields, crack_boundary)
         self.steps.append((step, time))
         self._write_collections()
         return vtu, vtp

@@ -20,14 +20,37 @@ of the vertices and their ``displacement``, so the same *Warp By Vector* applies
 separate data set rather than line cells in the triangles' one, where mixed cells would
 break cell data (every line would need a fragment and a strain) and filters like
 *Threshold*.
+
+Tetrahedral meshes (3D) have their own module, :mod:`ngfracture.output.solid_vtk`;
+``to_pyvista`` and ``cracks_to_pyvista`` pass them on to it (:func:`is_tetrahedral`).
 """
 import numpy as np
+import ngsolve
 
 from ..fracture.strain import element_strain, principal, vertex_displacement, vertex_strain
 from ..geometry.meshio import check_mesh, mesh_to_arrays
+from ..geometry.solid import SolidArrays
 
-__all__ = ["vertex_arrays", "displacement_values", "to_pyvista", "cracks_to_pyvista", "mesh_fields",
+__all__ = ["is_tetrahedral", "vertex_arrays", "displacement_values", "to_pyvista", "cracks_to_pyvista", "mesh_fields",
            "crack_fields", "region_names"]
+
+
+def is_tetrahedral(mesh):
+    """True for a 3D mesh: SolidArrays or an ngsolve.Mesh of dimension 3.
+
+    The outputs take 3D meshes through the same functions as 2D ones and pass them on to
+    :mod:`ngfracture.output.solid_vtk` and :mod:`ngfracture.output.solid_pictures`.
+
+    Parameters
+    ----------
+    mesh : object
+
+    Returns
+    -------
+    bool
+        False for anything else (a 2D mesh, or what is no mesh: the 2D checks name it).
+    """
+    return isinstance(mesh, SolidArrays) or (isinstance(mesh, ngsolve.Mesh) and mesh.dim == 3)
 
 
 def vertex_arrays(mesh):
@@ -91,7 +114,25 @@ def _tensor9(t):
     return out
 
 
-def _add_user_data(data, extra, n, where):
+def add_user_data(data, extra, n, where):
+    """Add the caller's arrays to point or cell data, checked to have one row per point / cell.
+
+    Parameters
+    ----------
+    data : dict of str -> numpy.ndarray
+        Point or cell arrays, extended in place.
+    extra : dict of str -> array_like or None
+        The caller's arrays.
+    n : int
+        The number of points / cells.
+    where : str
+        ``"point_data"`` or ``"cell_data"``, for the message.
+
+    Raises
+    ------
+    ValueError
+        An array without ``n`` rows.
+    """
     for name, values in (extra or {}).items():
         v = np.asarray(values)
         if v.shape[:1] != (n,):
@@ -107,7 +148,8 @@ def to_pyvista(mesh, u=None, fragment=None, strain="green", point_data=None, cel
     Parameters
     ----------
     mesh : ngsolve.Mesh
-        2D triangle mesh, reference configuration.
+        2D triangle mesh, reference configuration. A 3D mesh (or SolidArrays) gives
+        :func:`ngfracture.output.solid_vtk.solid_to_pyvista`.
     u : ngsolve.GridFunction or numpy.ndarray, optional
         Displacement; point data ``displacement`` as 3-vectors (z = 0), float64.
     fragment : array_like of int, optional
@@ -131,6 +173,9 @@ def to_pyvista(mesh, u=None, fragment=None, strain="green", point_data=None, cel
         Arrays whose length does not fit the mesh, non-finite displacement.
     """
     import pyvista as pv
+    if is_tetrahedral(mesh):
+        from .solid_vtk import vtk_solid_mesh
+        return pv.wrap(vtk_solid_mesh(mesh, u, fragment, strain, point_data, cell_data, arrays))
     return pv.wrap(vtk_mesh(mesh, u, fragment, strain, point_data, cell_data, arrays))
 
 
@@ -149,7 +194,7 @@ def vtk_mesh(mesh, u=None, fragment=None, strain="green", point_data=None, cell_
     a, points, cells = mesh_fields(mesh, u, fragment, strain, point_data, cell_data, arrays)
     from vtkmodules.vtkCommonDataModel import vtkUnstructuredGrid
     grid = vtkUnstructuredGrid()
-    _fill_vtk(grid, a.points, a.triangles, points, cells, region_names(a))
+    fill_vtk(grid, a.points, a.triangles, points, cells, region_names(a))
     return grid
 
 
@@ -210,18 +255,39 @@ def mesh_fields(mesh, u=None, fragment=None, strain="green", point_data=None, ce
             points["nodal_strain"] = _tensor9(En)
             points["nodal_principal_strain"] = val
             points["nodal_principal_direction"] = _pad3(d)
-    _add_user_data(points, point_data, nv, "point_data")
-    _add_user_data(cells, cell_data, ne, "cell_data")
+    add_user_data(points, point_data, nv, "point_data")
+    add_user_data(cells, cell_data, ne, "cell_data")
     return a, points, cells
 
 
-def _fill_vtk(data, points, cells, point_data, cell_data, region_names=None):
-    """Points (z = 0), cells of one kind (triangles: 3 columns, lines: 2), arrays and the
-    field data ``region_names`` into a vtkUnstructuredGrid or vtkPolyData. The first point
-    and cell arrays are the active scalars (what ParaView colours by at first)."""
+def fill_vtk(data, points, cells, point_data, cell_data, region_names=None):
+    """Fill a VTK data set with points, cells of one kind, point and cell arrays.
+
+    The first point and cell arrays are the active scalars (what ParaView colours by at
+    first).
+
+    Parameters
+    ----------
+    data : vtkUnstructuredGrid or vtkPolyData
+        Filled in place. A grid takes triangles (3 columns) or tetrahedra (4); poly data
+        lines (2) or triangles (3, as polygons).
+    points : numpy.ndarray, shape (n, 2) or (n, 3)
+        Coordinates (z = 0 if two columns).
+    cells : numpy.ndarray of int, shape (m, corners)
+        0-based point numbers.
+    point_data, cell_data : dict of str -> numpy.ndarray
+        Arrays by name (bool as UInt8).
+    region_names : list of str, optional
+        The field data ``region_names``.
+
+    Raises
+    ------
+    ValueError
+        A number of corners the data set does not take.
+    """
     from vtkmodules.util.numpy_support import numpy_to_vtk
     from vtkmodules.vtkCommonCore import VTK_ID_TYPE, vtkPoints, vtkStringArray
-    from vtkmodules.vtkCommonDataModel import VTK_TRIANGLE, vtkCellArray
+    from vtkmodules.vtkCommonDataModel import VTK_TETRA, VTK_TRIANGLE, vtkCellArray, vtkPolyData
 
     def array(name, values):
         v = np.ascontiguousarray(values)
@@ -229,17 +295,23 @@ def _fill_vtk(data, points, cells, point_data, cell_data, region_names=None):
         arr.SetName(name)
         return arr
 
-    pts = vtkPoints()
-    pts.SetData(numpy_to_vtk(np.ascontiguousarray(_pad3(points), dtype=np.float64), deep=True))
-    data.SetPoints(pts)
     corners = cells.shape[1]
+    poly = isinstance(data, vtkPolyData)
+    if corners not in ((2, 3) if poly else (3, 4)):
+        raise ValueError(f"ngfracture.output.vtk: {type(data).__name__} takes no cells of {corners} corners")
+    pts = vtkPoints()
+    xyz = points if points.shape[1] == 3 else _pad3(points)
+    pts.SetData(numpy_to_vtk(np.ascontiguousarray(xyz, dtype=np.float64), deep=True))
+    data.SetPoints(pts)
     offsets = np.arange(0, corners * len(cells) + 1, corners, dtype=np.int64)
     cell_array = vtkCellArray()
     cell_array.SetData(numpy_to_vtk(offsets, deep=True, array_type=VTK_ID_TYPE),
                        numpy_to_vtk(np.ascontiguousarray(cells, dtype=np.int64).ravel(), deep=True,
                                     array_type=VTK_ID_TYPE))
-    if corners == 3:
-        data.SetCells(VTK_TRIANGLE, cell_array)
+    if not poly:
+        data.SetCells(VTK_TRIANGLE if corners == 3 else VTK_TETRA, cell_array)
+    elif corners == 3:
+        data.SetPolys(cell_array)
     else:
         data.SetLines(cell_array)
     for attributes, arrays in ((data.GetPointData(), point_data), (data.GetCellData(), cell_data)):
@@ -261,7 +333,8 @@ def cracks_to_pyvista(mesh, u=None, boundary="crack", arrays=None):
     Parameters
     ----------
     mesh : ngsolve.Mesh
-        2D triangle mesh, reference configuration.
+        2D triangle mesh, reference configuration. A 3D mesh (or SolidArrays) gives
+        :func:`ngfracture.output.solid_vtk.solid_cracks_to_pyvista`.
     u : ngsolve.GridFunction or numpy.ndarray, optional
         Displacement; point data ``displacement`` (3-vectors, z = 0).
     boundary : str
@@ -282,6 +355,9 @@ def cracks_to_pyvista(mesh, u=None, boundary="crack", arrays=None):
         Not a 2D triangle mesh, or a displacement that does not fit it.
     """
     import pyvista as pv
+    if is_tetrahedral(mesh):
+        from .solid_vtk import vtk_solid_cracks
+        return pv.wrap(vtk_solid_cracks(mesh, u, boundary, arrays))
     return pv.wrap(vtk_cracks(mesh, u, boundary, arrays))
 
 
@@ -301,7 +377,7 @@ def vtk_cracks(mesh, u=None, boundary="crack", arrays=None):
     poly = vtkPolyData()
     points, lines, point_data = crack_fields(mesh, u, boundary, arrays)
     if len(lines):
-        _fill_vtk(poly, points, lines, point_data, {})
+        fill_vtk(poly, points, lines, point_data, {})
     return poly
 
 

@@ -1,5 +1,8 @@
 """VTK XML files (.vtu unstructured grids, .vtp poly data) written from numpy arrays.
 
+Unstructured grids of triangles (2D meshes) or tetrahedra (3D meshes); poly data of line
+segments (2D crack faces) or triangles (3D crack faces).
+
 The format of VTK's own XML writers in appended raw mode: an XML header that describes
 every array and gives its byte offset, then ``<AppendedData encoding="raw">`` with the
 arrays' bytes (little endian, UInt64 headers). A compressed array is split into blocks of
@@ -28,7 +31,10 @@ _TYPES = {np.dtype(np.float64): "Float64", np.dtype(np.float32): "Float32",
           np.dtype(np.int8): "Int8", np.dtype(np.uint64): "UInt64", np.dtype(np.uint32): "UInt32",
           np.dtype(np.uint16): "UInt16", np.dtype(np.uint8): "UInt8"}
 
-VTK_LINE, VTK_TRIANGLE = 3, 5
+VTK_LINE, VTK_TRIANGLE, VTK_TETRA = 3, 5, 10
+
+#: corners of the cell types of :func:`unstructured_grid`
+CORNERS = {VTK_TRIANGLE: 3, VTK_TETRA: 4}
 
 
 def _compress(raw, compression):
@@ -153,21 +159,24 @@ def _cell_arrays(appended, cells, indent):
             appended.data_array("offsets", offsets, indent)]
 
 
-def unstructured_grid(points, triangles, point_data=None, cell_data=None, field_strings=None, compression="zlib"):
-    """The bytes of a .vtu file of triangles.
+def unstructured_grid(points, cells, point_data=None, cell_data=None, field_strings=None, compression="zlib",
+                      cell_type=VTK_TRIANGLE):
+    """The bytes of a .vtu file of cells of one type (triangles or tetrahedra).
 
     Parameters
     ----------
     points : array_like, shape (n, 2) or (n, 3)
         Point coordinates (z = 0 if two columns).
-    triangles : array_like of int, shape (m, 3)
-        0-based point numbers.
+    cells : array_like of int, shape (m, 3) or (m, 4)
+        0-based point numbers, as many columns as ``cell_type`` has corners.
     point_data, cell_data : dict of str -> array_like, optional
-        Arrays with one row per point / triangle (1 or 2 dimensions; bool as UInt8). The
+        Arrays with one row per point / cell (1 or 2 dimensions; bool as UInt8). The
         first of each is the active scalars.
     field_strings : dict of str -> list of str, optional
         String arrays of the field data.
     compression : {'zlib', 'lzma', None}
+    cell_type : {VTK_TRIANGLE, VTK_TETRA}
+        VTK cell type of every cell (5 or 10).
 
     Returns
     -------
@@ -176,16 +185,18 @@ def unstructured_grid(points, triangles, point_data=None, cell_data=None, field_
     Raises
     ------
     ValueError
-        Unknown compression, points / triangles of the wrong shape, an array without one
-        row per point / triangle, a name with control characters.
+        Unknown compression or cell type, points / cells of the wrong shape, an array
+        without one row per point / cell, a name with control characters.
     TypeError
         An array of a dtype VTK has no type for.
     """
-    p, t = _check(compression, points, triangles, 3)
+    if cell_type not in CORNERS:
+        raise ValueError(f"ngfracture.output.vtkxml: cell_type must be one of {list(CORNERS)}, got {cell_type!r}")
+    p, t = _check(compression, points, cells, CORNERS[cell_type])
     appended = _Appended(compression)
     body = (_data_and_points(appended, point_data, cell_data, p, len(t))
             + ["      <Cells>"] + _cell_arrays(appended, t, "        ")
-            + [appended.data_array("types", np.full(len(t), VTK_TRIANGLE, dtype=np.uint8), "        "),
+            + [appended.data_array("types", np.full(len(t), cell_type, dtype=np.uint8), "        "),
                "      </Cells>"])
     return _file("UnstructuredGrid", f'NumberOfPoints="{len(p)}" NumberOfCells="{len(t)}"', body,
                  field_strings, appended)
@@ -212,10 +223,41 @@ def poly_lines(points, lines, point_data=None, compression="zlib"):
     ValueError, TypeError
         As :func:`unstructured_grid`.
     """
-    p, s = _check(compression, points, lines, 2)
+    return _poly(points, lines, point_data, compression, "Lines")
+
+
+def poly_triangles(points, triangles, point_data=None, compression="zlib"):
+    """The bytes of a .vtp file of triangles (polygons of three corners).
+
+    Parameters
+    ----------
+    points : array_like, shape (n, 2) or (n, 3)
+    triangles : array_like of int, shape (m, 3)
+        0-based point numbers.
+    point_data : dict of str -> array_like, optional
+        As for :func:`unstructured_grid`.
+    compression : {'zlib', 'lzma', None}
+
+    Returns
+    -------
+    bytes
+
+    Raises
+    ------
+    ValueError, TypeError
+        As :func:`unstructured_grid`.
+    """
+    return _poly(points, triangles, point_data, compression, "Polys")
+
+
+def _poly(points, cells, point_data, compression, kind):
+    """A .vtp of one kind of cells: ``Lines`` (2 corners) or ``Polys`` (triangles)."""
+    p, s = _check(compression, points, cells, 2 if kind == "Lines" else 3)
     appended = _Appended(compression)
     body = (_data_and_points(appended, point_data, {}, p, len(s))
-            + ["      <Lines>"] + _cell_arrays(appended, s, "        ") + ["      </Lines>"])
-    piece = (f'NumberOfPoints="{len(p)}" NumberOfVerts="0" NumberOfLines="{len(s)}" '
-             f'NumberOfStrips="0" NumberOfPolys="0"')
+            + [f"      <{kind}>"] + _cell_arrays(appended, s, "        ") + [f"      </{kind}>"])
+    counts = {"Lines": 0, "Polys": 0}
+    counts[kind] = len(s)
+    piece = (f'NumberOfPoints="{len(p)}" NumberOfVerts="0" NumberOfLines="{counts["Lines"]}" '
+             f'NumberOfStrips="0" NumberOfPolys="{counts["Polys"]}"')
     return _file("PolyData", piece, body, None, appended)
