@@ -1,0 +1,363 @@
+"""Node splitting on tetrahedral meshes: the crack engine in 3D (``cpp_ext/crack_split3d.cpp``).
+
+One pass reads::
+
+    values, directions = principal_3d(tensors)          # largest principal value + direction
+    result = split_by_tensor_3d(arrays, tensors)         # the most overstressed vertex that splits
+    u_new = transfer_vertex_field_3d(u, result)          # exact copy through the parent map
+    mesh = solid_mesh(result.arrays)                     # netgen / NGSolve rebuild
+
+Conventions (as in 2D, ``split.py``)
+-----------------------------------
+* Splitting happens in the reference configuration: a new vertex is a bitwise copy of its
+  parent. Tetrahedra keep their number, order, orientation and region; only vertex numbers
+  change, so every tetrahedron keeps its volume to the last bit. New vertices are numbered
+  from nv on, in creation order; a split vertex keeps its number on the side holding its
+  smallest tetrahedron.
+* The input faces keep their order (vertex numbers follow their tetrahedron); the new crack
+  faces follow, two lips per face, each oriented out of its tetrahedron, with the boundary
+  name ``crack`` (added to ``bc_names`` if absent).
+* Vertices are processed in the given order and later vertices see the earlier splits.
+  ``split_by_tensor_3d`` orders overstressed vertices by decreasing principal value, ties
+  by increasing vertex number; tensors are rows (xx, yy, zz, yz, xz, xy).
+
+Rules (docs/solid.md, "Node splitting in 3D")
+--------------------------------------------
+Two tetrahedra are joined across a face iff they share its three vertex numbers; crack
+faces are where they no longer do. The star of a vertex v is split in two sides by the
+plane through v normal to the opening direction n (each tetrahedron by the side of its
+centroid; a centroid on the plane counts as the minus side). A part of a side that is
+disconnected from the side's largest part (ties: the part of the smaller tetrahedron)
+changes side, the minus side first, so both sides are connected. The faces between the
+sides become crack faces. On a crack front (front edges through v) the existing crack
+faces are already cuts, and the new faces meet them where the front edges were: the front
+moves to the far edges of the new faces (flag ``closed``). Then:
+
+* pinched: a star already in pieces (crack faces all around) gets one copy per piece,
+  without new faces;
+* refused (``none``): a side is empty (``empty``); v lies on a boundary (free surface or
+  crack) and a side touches none of v's boundary faces, so that the new faces would close a
+  cone around v (``enclosed``); the new faces would end inside the body at an edge through
+  v that was not a front edge (``dangling``);
+* far vertices: every vertex of the new faces whose star fell apart is split per piece
+  (``far``): no two pieces are ever joined by a single vertex or a single edge;
+* fronts meeting a free surface, two fronts meeting, a crack meeting another (junction,
+  T-intersection) need no rule of their own: each is the same side split of the star with
+  the existing crack and free-surface faces as cuts; the flags record which case it was
+  (``surface``, ``crack``, ``front``, ``closed``).
+
+A front edge is an edge held by two crack faces whose third vertices are distinct copies of
+one point (the two lips meet there): :func:`front_edges_3d`.
+"""
+import math
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from .. import _ngfracture as _ext
+from ..geometry.solid import SolidArrays, tet_volumes
+
+__all__ = ["SPLIT3D_FLAGS", "Split3dResult", "split_vertices_3d", "transfer_vertex_field_3d",
+           "principal_3d", "split_by_tensor_3d", "Fragments3d", "fragments_3d", "front_edges_3d",
+           "pinched_vertices_3d", "flag_names_3d"]
+
+#: bit flags of the record's "flags" entries, by name (cpp_ext/crack_split3d.hpp)
+SPLIT3D_FLAGS = dict(_ext.SPLIT3D_FLAGS)
+
+
+def flag_names_3d(flags):
+    """Names of the flags set in one record entry, e.g. ``['cut', 'front', 'closed']``.
+
+    Parameters
+    ----------
+    flags : int
+        An entry of ``record["flags"]``.
+
+    Returns
+    -------
+    list of str
+        In increasing bit order.
+    """
+    return [name for name, bit in sorted(SPLIT3D_FLAGS.items(), key=lambda x: x[1]) if int(flags) & bit]
+
+
+@dataclass
+class Split3dResult:
+    """Outcome of one splitting pass on a tetrahedral mesh.
+
+    Parameters
+    ----------
+    arrays : SolidArrays
+        The new mesh (the same tetrahedra in the same order, more vertices, more faces).
+    parent : numpy.ndarray
+        Shape (nv_new,): the vertex of the old mesh every vertex copies.
+    record : dict
+        Per processed vertex (numpy arrays): ``vertex``, ``flags`` (:func:`flag_names_3d`),
+        ``faces`` (new crack faces, lips counted once), ``fronts_before`` / ``fronts_after``
+        (front edges through the vertex and its copies), ``new_vertices`` with
+        ``new_offsets`` (vertices created at entry i are
+        ``new_vertices[new_offsets[i]:new_offsets[i+1]]``), ``direction``, ``nv_old``.
+    """
+    arrays: SolidArrays
+    parent: np.ndarray
+    record: dict
+
+    @property
+    def nsplit(self):
+        """Number of vertices created."""
+        return len(self.parent) - int(self.record["nv_old"])
+
+
+def _crack_bc(arrays, crack_name):
+    names = list(arrays.bc_names)
+    if crack_name not in names:
+        names.append(crack_name)
+    return names.index(crack_name) + 1, names
+
+
+def split_vertices_3d(arrays, vertices, directions, crack_name="crack", first_only=False):
+    """Split vertices one after the other across their opening directions.
+
+    Parameters
+    ----------
+    arrays : SolidArrays
+        Tetrahedral mesh, reference configuration.
+    vertices : array_like of int
+        Vertices to process, in this order; numbers of the mesh as split so far (a vertex
+        split earlier in the pass is its copy that kept the number).
+    directions : array_like
+        Shape (len(vertices), 3): the opening direction of each (any length > 0).
+    crack_name : str
+        Boundary name of the crack faces (new and existing).
+    first_only : bool
+        Stop after the first vertex that splits anything.
+
+    Returns
+    -------
+    Split3dResult
+        ``result.arrays`` is the input itself when nothing was split.
+
+    Raises
+    ------
+    ValueError
+        Bad shapes, vertex numbers out of range or repeated, zero or non-finite directions,
+        a boundary face that is no face of a tetrahedron.
+    """
+    if not isinstance(arrays, SolidArrays):
+        raise ValueError(f"ngfracture.fracture.split3d: arrays must be SolidArrays, got {type(arrays).__name__}")
+    v = np.ascontiguousarray(vertices, dtype=np.int32).reshape(-1)
+    d = np.ascontiguousarray(directions, dtype=float)
+    if d.shape != (len(v), 3):
+        raise ValueError(f"ngfracture.fracture.split3d: directions must have shape ({len(v)}, 3), got {d.shape}")
+    if len(np.unique(v)) != len(v):
+        raise ValueError("ngfracture.fracture.split3d: a vertex appears twice in the processing order")
+    bc, names = _crack_bc(arrays, crack_name)
+    r = _ext.Split3dVertices(np.asarray(arrays.points, dtype=float), np.asarray(arrays.tets), np.asarray(arrays.faces),
+                             np.asarray(arrays.face_bc), bc, v, d, bool(first_only))
+    rec = {k: np.asarray(x) for k, x in dict(r["record"]).items()}
+    nv = len(arrays.points)
+    rec["direction"] = d[:len(rec["vertex"])].copy()
+    rec["nv_old"] = nv
+    if len(r["parent"]) == nv:
+        return Split3dResult(arrays, np.arange(nv), rec)
+    new = replace(arrays, points=r["points"], tets=r["tets"].astype(np.int64), faces=r["faces"].astype(np.int64),
+                  face_bc=r["face_bc"].astype(np.int64), bc_names=names)
+    return Split3dResult(new, r["parent"].astype(np.int64), rec)
+
+
+def transfer_vertex_field_3d(values, result):
+    """Carry a vertex field to the split mesh: ``values[parent]`` (exact, no interpolation).
+
+    Parameters
+    ----------
+    values : numpy.ndarray
+        Shape (nv_old, ...).
+    result : Split3dResult
+        The pass that made the new mesh.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (nv_new, ...).
+
+    Raises
+    ------
+    ValueError
+        If values does not have one row per vertex of the old mesh.
+    """
+    a = np.asarray(values)
+    if a.ndim == 0 or a.shape[0] != result.record["nv_old"]:
+        raise ValueError(f"ngfracture.fracture.split3d: the field has shape {a.shape}, the old mesh has "
+                         f"{result.record['nv_old']} vertices")
+    return a[result.parent]
+
+
+def principal_3d(tensors):
+    """Largest principal value and its unit direction of symmetric 3x3 tensors (vectorised).
+
+    Parameters
+    ----------
+    tensors : numpy.ndarray
+        Shape (n, 6), rows (xx, yy, zz, yz, xz, xy).
+
+    Returns
+    -------
+    values : numpy.ndarray
+        Shape (n,).
+    directions : numpy.ndarray
+        Shape (n, 3), unit; the sign makes the largest component (by absolute value, the first
+        of equal ones) positive.
+
+    Raises
+    ------
+    ValueError
+        If tensors is not of shape (n, 6) or holds NaN or inf.
+    """
+    t = np.asarray(tensors, dtype=float)
+    if t.ndim != 2 or t.shape[1] != 6:
+        raise ValueError(f"ngfracture.fracture.split3d: tensors must have shape (n, 6), got {t.shape}")
+    if not np.all(np.isfinite(t)):
+        raise ValueError("ngfracture.fracture.split3d: the tensor field has NaN or inf values")
+    m = t[:, [0, 5, 4, 5, 1, 3, 4, 3, 2]].reshape(-1, 3, 3)
+    w, q = np.linalg.eigh(m)
+    d = q[:, :, -1]
+    k = np.argmax(np.abs(d), axis=1)
+    d = d * np.where(d[np.arange(len(d)), k] < 0, -1.0, 1.0)[:, None]
+    return w[:, -1], d
+
+
+def split_by_tensor_3d(arrays, tensors, critical=1.0, one=True, crack_name="crack"):
+    """One splitting pass from a vertex tensor field.
+
+    Parameters
+    ----------
+    arrays : SolidArrays
+        Tetrahedral mesh, reference configuration.
+    tensors : numpy.ndarray
+        Shape (nv, 6), rows (xx, yy, zz, yz, xz, xy), e.g. an overstrain (> 1 cracks).
+    critical : float
+        Finite, > 0: vertices whose largest principal value exceeds it are overstressed.
+    one : bool
+        True: only the most overstressed vertex that splits anything is split (the vertices
+        before it, which split nothing, are in the record), as ``StepControl.split="one"``
+        in 2D. False: every overstressed vertex, by decreasing principal value.
+    crack_name : str
+        Boundary name of the crack faces.
+
+    Returns
+    -------
+    Split3dResult
+        The record also holds ``principal`` (values of the processed vertices).
+
+    Raises
+    ------
+    ValueError
+        Wrong tensor shape, NaN values, critical <= 0 or not finite.
+    """
+    c = float(critical)
+    if not (math.isfinite(c) and c > 0):
+        raise ValueError(f"ngfracture.fracture.split3d: critical must be finite and > 0, got {critical!r}")
+    t = np.asarray(tensors, dtype=float)
+    if t.shape != (len(arrays.points), 6):
+        raise ValueError(f"ngfracture.fracture.split3d: tensors must have shape ({len(arrays.points)}, 6), got {t.shape}")
+    values, dirs = principal_3d(t)
+    over = np.flatnonzero(values > c)
+    order = over[np.lexsort((over, -values[over]))]
+    res = split_vertices_3d(arrays, order, dirs[order], crack_name, first_only=one)
+    res.record["principal"] = values[res.record["vertex"]]
+    return res
+
+
+@dataclass
+class Fragments3d:
+    """The pieces of a cracked tetrahedral mesh.
+
+    Parameters
+    ----------
+    count : int
+    fragment : numpy.ndarray
+        Fragment of every tetrahedron, numbered by its smallest tetrahedron.
+    volumes : numpy.ndarray
+        Shape (count,), each ``math.fsum`` of its tetrahedra's volumes.
+    centroids : numpy.ndarray
+        Shape (count, 3), volume centroids in the reference configuration.
+    """
+    count: int
+    fragment: np.ndarray
+    volumes: np.ndarray
+    centroids: np.ndarray
+
+
+def fragments_3d(arrays):
+    """Fragments: tetrahedra connected through shared faces (C++ ``TetComponents``).
+
+    Parameters
+    ----------
+    arrays : SolidArrays
+
+    Returns
+    -------
+    Fragments3d
+
+    Raises
+    ------
+    ValueError
+        A tetrahedron vertex number out of range.
+    """
+    n, frag = _ext.TetComponents(np.asarray(arrays.tets), len(arrays.points))
+    frag = np.asarray(frag, dtype=np.int64)
+    vol = tet_volumes(arrays.points, arrays.tets)
+    centres = np.asarray(arrays.points)[arrays.tets].mean(axis=1)
+    order = np.argsort(frag, kind="stable")
+    cuts = np.searchsorted(frag[order], np.arange(1, n))
+    volumes = np.array([math.fsum(p) for p in np.split(vol[order], cuts)])
+    centroids = np.column_stack([np.bincount(frag, weights=vol * centres[:, k], minlength=n) for k in range(3)])
+    return Fragments3d(int(n), frag, volumes, centroids / volumes[:, None])
+
+
+def front_edges_3d(arrays, crack_name="crack"):
+    """The crack front: edges held by two crack faces whose third vertices are distinct
+    copies of one point (the lips meet there).
+
+    Parameters
+    ----------
+    arrays : SolidArrays
+    crack_name : str
+        Boundary name of the crack faces.
+
+    Returns
+    -------
+    numpy.ndarray of int, shape (k, 2)
+        Edges (smaller vertex first), sorted, each once.
+    """
+    f = arrays.boundary_faces(crack_name)
+    if not len(f):
+        return np.zeros((0, 2), dtype=np.int64)
+    e = np.concatenate([f[:, [0, 1, 2]], f[:, [1, 2, 0]], f[:, [2, 0, 1]]])
+    p, q, r = np.minimum(e[:, 0], e[:, 1]), np.maximum(e[:, 0], e[:, 1]), e[:, 2]
+    x = np.asarray(arrays.points)[r]
+    o = np.lexsort((r, x[:, 2], x[:, 1], x[:, 0], q, p))
+    same = ((p[o][1:] == p[o][:-1]) & (q[o][1:] == q[o][:-1]) & np.all(x[o][1:] == x[o][:-1], axis=1)
+            & (r[o][1:] != r[o][:-1]))
+    k = o[1:][same]
+    return np.unique(np.column_stack([p[k], q[k]]), axis=0).reshape(-1, 2)
+
+
+def pinched_vertices_3d(arrays):
+    """Vertices whose star is in more than one piece through shared faces.
+
+    Parameters
+    ----------
+    arrays : SolidArrays
+
+    Returns
+    -------
+    numpy.ndarray of int
+        Increasing; empty after every pass of the splitter.
+
+    Raises
+    ------
+    ValueError
+        A tetrahedron vertex number out of range.
+    """
+    return np.asarray(_ext.Split3dPinched(np.asarray(arrays.tets), len(arrays.points)), dtype=np.int64)

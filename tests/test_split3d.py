@@ -1,0 +1,215 @@
+"""Node splitting on tetrahedral meshes (ngfracture.fracture.split3d, docs/solid.md).
+
+Exact invariants: volume to the last bit, positive volumes, twin lips, no pinched star;
+structured bars whose mid-plane is made of faces give the cross-section's area to
+rounding and a planar crack; the rules at fronts, free surfaces, junctions and meeting
+fronts one case each.
+"""
+import math
+
+import numpy as np
+import ngsolve
+import pytest
+from netgen.csg import CSGeometry, OrthoBrick, Pnt
+
+from ngfracture.fracture import split3d as s3
+from ngfracture.geometry.solid import solid_mesh, solid_to_arrays, tet_volumes, total_volume
+from split3d_util import check_twins, crack_area, crack_pieces, cube_bar
+
+Z = np.array([0.0, 0.0, 1.0])
+X = np.array([1.0, 0.0, 0.0])
+
+
+def split_each(arrays, vertices, n):
+    """Split the vertices one call each (numbers of the input mesh; later ones see the splits)."""
+    records = []
+    for v in vertices:
+        r = s3.split_vertices_3d(arrays, [v], [n])
+        assert len(s3.pinched_vertices_3d(r.arrays)) == 0, "a pinched star after a pass"
+        records.append({k: r.record[k][0] for k in ("flags", "faces", "fronts_before", "fronts_after")})
+        arrays = r.arrays
+    return arrays, records
+
+
+def check_invariants(before, after):
+    assert total_volume(after.points, after.tets) == total_volume(before.points, before.tets)
+    assert np.all(tet_volumes(after.points, after.tets) > 0)
+    assert np.array_equal(after.regions, before.regions)
+    check_twins(after)
+    assert len(s3.pinched_vertices_3d(after)) == 0
+
+
+def names(flags):
+    return set(s3.flag_names_3d(flags))
+
+
+def test_structured_bar_splits_in_two_across_its_mid_plane():
+    a = cube_bar(2, 2, 8)
+    plane = np.flatnonzero(a.points[:, 2] == 4.0)
+    b, rec = split_each(a, plane, Z)
+    check_invariants(a, b)
+    fr = s3.fragments_3d(b)
+    assert fr.count == 2
+    assert [math.fsum(fr.volumes)] == [total_volume(a.points, a.tets)]
+    assert crack_area(b) == pytest.approx(4.0, abs=1e-12)
+    assert np.all(b.points[b.boundary_faces("crack")][..., 2] == 4.0)
+    assert len(s3.front_edges_3d(b)) == 0
+    m = solid_mesh(b)
+    assert ngsolve.Integrate(1, m) == pytest.approx(32.0, rel=1e-13)
+    assert ngsolve.Integrate(1, m, definedon=m.Boundaries("crack")) == pytest.approx(8.0, rel=1e-13)
+    # the tensor field's transfer is an exact copy
+    r = s3.split_vertices_3d(a, plane[:1], [Z])
+    u = np.arange(3 * len(a.points), dtype=float).reshape(-1, 3)
+    assert np.array_equal(s3.transfer_vertex_field_3d(u, r), u[r.parent])
+
+
+def grow_from_mid_plane(a, z0):
+    """A crack grown front vertex by front vertex, the one nearest the plane z = z0 first."""
+    dist = np.abs(a.points[:, 2] - z0) + 1e-3 * np.linalg.norm(a.points[:, :2] - 0.5, axis=1)
+    b = s3.split_vertices_3d(a, [int(np.argmin(dist))], [Z]).arrays
+    for _ in range(10 * len(a.points)):
+        fv = np.unique(s3.front_edges_3d(b))
+        if not len(fv):
+            return b
+        fv = fv[np.argsort(np.abs(b.points[fv, 2] - z0), kind="stable")]
+        r = s3.split_vertices_3d(b, fv, np.tile(Z, (len(fv), 1)), first_only=True)
+        assert r.nsplit, "the front is stuck"
+        b = r.arrays
+    raise AssertionError("the crack did not stop growing")
+
+
+def test_netgen_bar_splits_in_two_near_its_mid_plane():
+    geo = CSGeometry()
+    geo.Add(OrthoBrick(Pnt(0, 0, 0), Pnt(1, 1, 4)))
+    maxh = 0.25
+    a = solid_to_arrays(ngsolve.Mesh(geo.GenerateMesh(maxh=maxh)))
+    b = grow_from_mid_plane(a, 2.0)
+    check_invariants(a, b)
+    assert s3.fragments_3d(b).count == 2
+    # a surface that separates the bar's ends covers its cross-section at least once
+    assert crack_area(b) >= 1.0 - 1e-12
+    assert np.abs(b.points[b.boundary_faces("crack")][..., 2] - 2.0).max() <= maxh
+    m = solid_mesh(b)
+    assert ngsolve.Integrate(1, m) == pytest.approx(4.0, rel=1e-12)
+
+
+def test_front_vertex_continues_the_crack():
+    a = cube_bar(4, 4, 4)
+    v0 = int(np.flatnonzero(np.all(a.points == [2, 2, 2], axis=1))[0])
+    v1 = int(np.flatnonzero(np.all(a.points == [3, 2, 2], axis=1))[0])
+    b, rec = split_each(a, [v0, v1], Z)
+    assert names(rec[0]["flags"]) == {"cut"} and rec[0]["faces"] == 6
+    assert {"cut", "crack", "front", "closed"} <= names(rec[1]["flags"])
+    assert rec[1]["fronts_before"] == 2 and rec[1]["fronts_after"] == 0
+    # one crack sheet, planar, its front the rim of both vertices' planar faces
+    assert crack_pieces(b) == 1
+    assert np.all(b.points[b.boundary_faces("crack")][..., 2] == 2.0)
+    fe = s3.front_edges_3d(b)
+    assert len(fe) and not np.any(np.isin(fe, [v0, v1]))
+    check_invariants(a, b)
+
+
+def test_new_crack_at_a_free_surface_vertex():
+    a = cube_bar(4, 4, 4)
+    v = int(np.flatnonzero(np.all(a.points == [0, 2, 2], axis=1))[0])
+    b, rec = split_each(a, [v], Z)
+    assert names(rec[0]["flags"]) == {"cut", "surface"} and rec[0]["faces"] > 0
+    # both copies of the vertex keep free-surface faces: the crack reaches the surface
+    copies = np.flatnonzero(np.all(b.points == [0, 2, 2], axis=1))
+    assert len(copies) == 2
+    free = b.faces[b.face_bc == 1]
+    assert all(np.any(free == c) for c in copies)
+    # the front is inside the body or on the surface, never through the split vertex
+    assert not np.any(np.isin(s3.front_edges_3d(b), copies))
+    check_invariants(a, b)
+    # pulled normal to the surface, a surface vertex splits nothing (rule 2a)
+    r = s3.split_vertices_3d(a, [v], [X])
+    assert r.nsplit == 0 and {"none", "aligned"} <= names(r.record["flags"][0])
+
+
+def test_fronts_meet_the_free_surface():
+    a = cube_bar(4, 4, 2)
+    plane = np.flatnonzero(a.points[:, 2] == 1.0)
+    inner = [v for v in plane if 0 < a.points[v, 0] < 4 and 0 < a.points[v, 1] < 4]
+    outer = [v for v in plane if v not in inner]
+    b, rec = split_each(a, inner, Z)
+    assert s3.fragments_3d(b).count == 1 and len(s3.front_edges_3d(b))
+    b, rec2 = split_each(b, outer, Z)
+    # the front reaches the surface: surface vertices on the front close it, the others had
+    # fallen apart already (split per piece) or lie beside the crack on one side only
+    flags = [names(r["flags"]) for r in rec + rec2]
+    assert any({"surface", "front", "closed"} <= f for f in flags)
+    assert any("far" in f for f in flags)
+    assert s3.fragments_3d(b).count == 2 and len(s3.front_edges_3d(b)) == 0
+    assert crack_area(b) == pytest.approx(16.0, abs=1e-12)
+    check_invariants(a, b)
+
+
+def test_two_fronts_meet():
+    a = cube_bar(6, 2, 2)
+    at = lambda x: int(np.flatnonzero(np.all(a.points == [x, 1, 1], axis=1))[0])
+    b, rec = split_each(a, [at(1), at(5)], Z)
+    assert crack_pieces(b) == 2
+    # grown towards each other, the two fronts pass through the vertex between them
+    b, rec = split_each(b, [at(2), at(4)], Z)
+    b, rec = split_each(b, [at(3)], Z)
+    assert {"cut", "front", "closed"} <= names(rec[0]["flags"])
+    assert rec[0]["fronts_before"] == 4 and rec[0]["fronts_after"] == 0
+    assert crack_pieces(b) == 1
+    check_invariants(a, b)
+
+
+def test_junction_splits_a_crack_vertex_again():
+    a = cube_bar(4, 2, 4)
+    b, _ = split_each(a, np.flatnonzero(a.points[:, 2] == 2.0), Z)
+    assert s3.fragments_3d(b).count == 2
+    # a second crack, x = 2, in the upper half, down to the first one (T-intersection): the
+    # T-line's vertices are split again, their upper copies
+    upper = np.unique(b.tets[b.points[b.tets].mean(axis=1)[:, 2] > 2.0])
+    second = sorted((v for v in upper if b.points[v, 0] == 2.0), key=lambda v: (b.points[v, 2], v))
+    c, rec = split_each(b, second, X)
+    t_line = [r for v, r in zip(second, rec) if b.points[v, 2] == 2.0]
+    # the first is cut by its own star; its neighbours' stars may have fallen apart already
+    assert len(t_line) == 3 and {"cut", "crack"} <= names(t_line[0]["flags"])
+    # three copies of every point of the T-line: below, upper left, upper right
+    on_t = c.points[(c.points[:, 0] == 2.0) & (c.points[:, 2] == 2.0)]
+    assert len(on_t) == 9 and len(np.unique(on_t, axis=0)) == 3
+    fr = s3.fragments_3d(c)
+    assert fr.count == 3
+    assert sorted(fr.volumes) == [8.0, 8.0, 16.0]
+    assert crack_area(c) == pytest.approx(8.0 + 4.0, abs=1e-12)
+    check_invariants(a, c)
+
+
+def test_split_by_tensor_and_determinism():
+    a = cube_bar(2, 2, 4)
+    t = np.zeros((len(a.points), 6))
+    t[:, 2] = 0.5
+    plane = np.flatnonzero(a.points[:, 2] == 2.0)
+    t[plane, 2] = 1.05 + np.arange(len(plane)) / 10      # zz overstressed on the mid-plane
+    values, dirs = s3.principal_3d(t)
+    assert np.array_equal(values, t[:, 2]) and np.array_equal(np.abs(dirs[plane]), np.tile(Z, (len(plane), 1)))
+    one = s3.split_by_tensor_3d(a, t)
+    assert list(one.record["vertex"]) == [plane[-1]] and one.nsplit == 1
+    r1 = s3.split_by_tensor_3d(a, t, one=False)
+    r2 = s3.split_by_tensor_3d(a, t, one=False)
+    assert list(r1.record["vertex"]) == list(plane[::-1])
+    for name in ("points", "tets", "faces", "face_bc"):
+        assert np.array_equal(getattr(r1.arrays, name), getattr(r2.arrays, name))
+    assert np.array_equal(r1.parent, r2.parent)
+    assert s3.fragments_3d(r1.arrays).count == 2
+    check_invariants(a, r1.arrays)
+
+
+def test_bad_input_is_named():
+    a = cube_bar(1, 1, 1)
+    with pytest.raises(ValueError, match="directions"):
+        s3.split_vertices_3d(a, [0], [[0, 0]])
+    with pytest.raises(ValueError, match="direction of vertex 0"):
+        s3.split_vertices_3d(a, [0], [[0, 0, 0]])
+    with pytest.raises(ValueError, match="vertex 99"):
+        s3.split_vertices_3d(a, [99], [Z])
+    with pytest.raises(ValueError, match="twice"):
+        s3.split_vertices_3d(a, [0, 0], [Z, Z])
+    with pytest.raises(ValueError, match="tensors"):
+        s3.split_by_tensor_3d(a, np.zeros((3, 6)))
