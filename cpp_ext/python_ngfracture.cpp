@@ -10,6 +10,7 @@ using namespace ngfracture;
 
 void ExportCrack (py::module & m);   // python_crack.cpp
 void ExportCollision (py::module & m);  // python_collision.cpp
+void ExportCriterion3D (py::module & m);  // python_criterion3d.cpp
 
 using Doubles = py::array_t<double, py::array::c_style | py::array::forcecast>;
 using Ints = py::array_t<int, py::array::c_style | py::array::forcecast>;
@@ -284,4 +285,5 @@ PYBIND11_MODULE(_ngfracture, m)
   ExportSupernodalLDL(m);
   ExportCrack(m);
   ExportCollision(m);
+  ExportCriterion3D(m);
 }
