@@ -370,6 +370,11 @@ namespace ngfracture
       S6 end;            // the tensor at the segment's end point
     };
 
+    // A ray within 1e-9 radians of a face's plane runs along the face: it neither leaves a
+    // tet through it nor counts as pointing out of the body (a ray along a boundary face is
+    // judged as in exact arithmetic, whatever the rounding of a rotated mesh).
+    constexpr double ALONG_FACE = 1e-9;
+
     // Walk from vertex v along the unit direction d up to `reach` (or a boundary face):
     // the tensor at the start, at every face crossing and at the end. False if d points out
     // of the body at v (no tet of v's star holds d in its cone at v) or the walk does not end.
@@ -386,7 +391,7 @@ namespace ngfracture
           Barycentric(m, f, p, grad, lam);
           bool inside = true;
           for (int j = 0; j < 4; j++)
-            if (m.tet[f][j] != v && Dot(grad[j], d) < 0) inside = false;
+            if (m.tet[f][j] != v && Dot(grad[j], d) < -ALONG_FACE * Norm(grad[j])) inside = false;
           if (inside) t = f;
         }
       if (t < 0) return false;
@@ -407,7 +412,7 @@ namespace ngfracture
             {
               g[j] = Dot(grad[j], d);
               if (prev < 0 ? m.tet[t][j] != v : m.nb[t][j] == prev) continue;   // first tet: the face opposite v
-              if (g[j] >= 0) continue;
+              if (g[j] >= -ALONG_FACE * Norm(grad[j])) continue;     // along the face, or into the tet
               double s = -lam[j] / g[j];
               if (s < s_out) { s_out = s; exit = j; }
             }
@@ -503,11 +508,13 @@ namespace ngfracture
       return dirs;
     }
 
-    // The best ray of vertex v over its candidate directions, then refined: the ray in the
-    // plane normal to the principal direction at the best ray's end point (for a sharp
-    // vertex, also normal to its front), taken when it is better. False: no ray counts.
+    // The best ray of vertex v over its candidate directions (spacing `spacing` radians),
+    // then refined: a compass search about it (the neighbouring directions at the spacing,
+    // halved six times; within the front's normal plane for a sharp vertex), and the ray in
+    // the plane normal to the principal direction at the best ray's end point (for a sharp
+    // vertex, also normal to its front), each taken when it is better. False: no ray counts.
     bool BestRay (const TetMesh & m, FlatMatrix<double> T, int v, double r, bool tip, const V3 & tangent,
-                  const std::vector<V3> & dirs, std::vector<Sample> & samples, RayValue & best)
+                  const std::vector<V3> & dirs, double spacing, std::vector<Sample> & samples, RayValue & best)
     {
       bool found = false;
       V3 dbest = { 0, 0, 0 };
@@ -516,18 +523,33 @@ namespace ngfracture
         if (Ray(m, T, v, d, r, tip, samples, rv) && (!found || rv.value > best.value))
           { best = rv; dbest = d; found = true; }
       if (!found) return false;
-      for (int iter = 0; iter < 2; iter++)
+      auto tryRay = [&] (V3 d)
         {
-          V3 np;
-          LargestEigen(best.end, np);
-          V3 d2 = tip ? Cross(tangent, np) : Sub(dbest, Scaled(np, Dot(dbest, np)));
-          double len = Norm(d2);
-          if (!(len > 1e-8)) break;
-          d2 = Scaled(d2, (Dot(d2, dbest) < 0 ? -1.0 : 1.0) / len);
-          if (!(Ray(m, T, v, d2, r, tip, samples, rv) && rv.value > best.value)) break;
-          best = rv;
-          dbest = d2;
-        }
+          d = Scaled(d, 1 / Norm(d));
+          if (Ray(m, T, v, d, r, tip, samples, rv) && rv.value > best.value)
+            { best = rv; dbest = d; return true; }
+          return false;
+        };
+      double delta = spacing;
+      for (int level = 0; level < 6; level++, delta *= 0.5)
+        for (int moves = 0; moves < 4; moves++)
+          {
+            V3 e1, e2;
+            if (tip) { e1 = Cross(tangent, dbest); e2 = { 0, 0, 0 }; }
+            else PlaneBasis(dbest, e1, e2);
+            const V3 d0 = dbest;
+            double step = std::tan(delta);
+            bool moved = false;
+            for (const V3 & e : { e1, Scaled(e1, -1.0), e2, Scaled(e2, -1.0) })
+              if (Norm(e) > 0)
+                moved |= tryRay({ d0[0] + step*e[0], d0[1] + step*e[1], d0[2] + step*e[2] });
+            if (!moved) break;
+          }
+      V3 np;
+      LargestEigen(best.end, np);
+      V3 d2 = tip ? Cross(tangent, np) : Sub(dbest, Scaled(np, Dot(dbest, np)));
+      if (Norm(d2) > 1e-8)
+        tryRay(Scaled(d2, Dot(d2, dbest) < 0 ? -1.0 : 1.0));
       return true;
     }
   }
@@ -579,7 +601,8 @@ namespace ngfracture
               }
           }
         RayValue best;
-        if (!BestRay(m, T, int(v), radius[v], sharp[v], tangent[v], tip ? plane : sphere, samples, best))
+        if (!BestRay(m, T, int(v), radius[v], sharp[v], tangent[v], tip ? plane : sphere,
+                     tip ? 2 * M_PI / nplane : std::sqrt(4 * M_PI / ndir), samples, best))
           continue;
         const V3 & n = best.n;
         double val = best.value;

@@ -27,7 +27,7 @@ __all__ = ["NDIR", "NPLANE", "tet_strain", "stress_over_E", "principal_3d", "sha
            "nonlocal_opening_3d", "overstrain_3d"]
 
 #: ray directions over the sphere (Fibonacci set) of a hot spot that is not sharp (docs/solid.md)
-NDIR = 128
+NDIR = 256
 #: ray directions in the plane normal to the front of a sharp vertex (the 2D criterion's 72)
 NPLANE = 72
 
