@@ -11,6 +11,7 @@ using namespace ngfracture;
 void ExportCrack (py::module & m);   // python_crack.cpp
 void ExportCollision (py::module & m);  // python_collision.cpp
 void ExportSplit3d (py::module & m);   // python_split3d.cpp
+void ExportCriterion3D (py::module & m);  // python_criterion3d.cpp
 
 using Doubles = py::array_t<double, py::array::c_style | py::array::forcecast>;
 using Ints = py::array_t<int, py::array::c_style | py::array::forcecast>;
@@ -286,4 +287,5 @@ PYBIND11_MODULE(_ngfracture, m)
   ExportCrack(m);
   ExportCollision(m);
   ExportSplit3d(m);
+  ExportCriterion3D(m);
 }
