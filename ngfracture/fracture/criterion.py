@@ -25,7 +25,9 @@ import numpy as np
 from .. import _ngfracture as _ext
 from ..geometry.meshio import mesh_to_arrays
 from ..mechanics.materials import Material
-from .strain import check_mesh_2d, check_positive, element_strain, equivalent_strain, vertex_strain
+from ..geometry.solid import solid_to_arrays
+from .solid_criterion import overstrain_3d
+from .strain import check_mesh_2d, check_positive, element_strain, equivalent_strain, vertex_displacement, vertex_strain
 
 __all__ = ["Criterion", "nonlocal_opening", "toughness", "critical_distance", "select"]
 
@@ -232,25 +234,28 @@ class Criterion:
         Parameters
         ----------
         mesh : ngsolve.Mesh
-            2D triangle mesh, reference configuration.
+            2D triangle mesh or 3D tetrahedral mesh, reference configuration.
         u : ngsolve.GridFunction or numpy.ndarray
-            Displacement (``VectorH1``) or its vertex values (nv, 2).
+            Displacement (``VectorH1``) or its vertex values (nv, 2) or (nv, 3).
         strength : numpy.ndarray, optional
             Critical strain per vertex; it replaces the region's at the vertices that can
             crack.
-        arrays : MeshArrays, optional
+        arrays : MeshArrays or SolidArrays, optional
             The mesh as arrays, if the caller has them (else made here).
 
         Returns
         -------
         numpy.ndarray
-            Shape (nv, 3), rows (xx, yy, xy); zero at vertices that cannot crack.
+            Shape (nv, 3), rows (xx, yy, xy); in 3D (nv, 6), rows (xx, yy, zz, yz, xz, xy);
+            zero at vertices that cannot crack.
 
         Raises
         ------
         ValueError
             A critical strain or radius for a region the mesh does not have, bad fields.
         """
+        if mesh.dim == 3:
+            return self._overstrain_3d(mesh, u, strength, arrays)
         check_mesh_2d(mesh)
         arrays = mesh_to_arrays(mesh) if arrays is None else arrays
         names = arrays.region_names
@@ -275,6 +280,17 @@ class Criterion:
             # the vertex's random strength replaces its region's critical strain
             tensors *= np.where(scale > 0, 1.0 / (strength * np.where(scale > 0, scale, 1.0)), 0.0)[:, None]
         return tensors
+
+    def _overstrain_3d(self, mesh, u, strength, arrays):
+        """:meth:`overstrain` on a tetrahedral mesh (:func:`.solid_criterion.overstrain_3d`)."""
+        arrays = solid_to_arrays(mesh) if arrays is None else arrays
+        E = nu = None
+        if self.material is not None:      # the stress over E of the material, as in 2D
+            m = self.material
+            E = {n: v.E for n, v in m.items()} if isinstance(m, dict) else m.E
+            nu = {n: v.nu for n, v in m.items()} if isinstance(m, dict) else m.nu
+        radius = None if self.one_ring else self.radius
+        return overstrain_3d(arrays, vertex_displacement(u), self.critical, radius, E, nu, strength, self.measure)
 
     def describe(self):
         """What the criterion is, for summaries: kind, critical strains, critical distances.

@@ -56,9 +56,10 @@ import numpy as np
 
 from .. import _ngfracture as _ext
 from ..geometry.solid import SolidArrays, tet_volumes
+from .solid_criterion import principal_3d
 
 __all__ = ["SPLIT3D_FLAGS", "Split3dResult", "split_vertices_3d", "transfer_vertex_field_3d",
-           "principal_3d", "split_by_tensor_3d", "Fragments3d", "fragments_3d", "front_edges_3d",
+           "split_by_tensor_3d", "Fragments3d", "fragments_3d", "front_edges_3d",
            "pinched_vertices_3d", "flag_names_3d"]
 
 #: bit flags of the record's "flags" entries, by name (cpp_ext/crack_split3d.hpp)
@@ -190,40 +191,6 @@ def transfer_vertex_field_3d(values, result):
         raise ValueError(f"ngfracture.fracture.split3d: the field has shape {a.shape}, the old mesh has "
                          f"{result.record['nv_old']} vertices")
     return a[result.parent]
-
-
-def principal_3d(tensors):
-    """Largest principal value and its unit direction of symmetric 3x3 tensors (vectorised).
-
-    Parameters
-    ----------
-    tensors : numpy.ndarray
-        Shape (n, 6), rows (xx, yy, zz, yz, xz, xy).
-
-    Returns
-    -------
-    values : numpy.ndarray
-        Shape (n,).
-    directions : numpy.ndarray
-        Shape (n, 3), unit; the sign makes the largest component (by absolute value, the first
-        of equal ones) positive.
-
-    Raises
-    ------
-    ValueError
-        If tensors is not of shape (n, 6) or holds NaN or inf.
-    """
-    t = np.asarray(tensors, dtype=float)
-    if t.ndim != 2 or t.shape[1] != 6:
-        raise ValueError(f"ngfracture.fracture.split3d: tensors must have shape (n, 6), got {t.shape}")
-    if not np.all(np.isfinite(t)):
-        raise ValueError("ngfracture.fracture.split3d: the tensor field has NaN or inf values")
-    m = t[:, [0, 5, 4, 5, 1, 3, 4, 3, 2]].reshape(-1, 3, 3)
-    w, q = np.linalg.eigh(m)
-    d = q[:, :, -1]
-    k = np.argmax(np.abs(d), axis=1)
-    d = d * np.where(d[np.arange(len(d)), k] < 0, -1.0, 1.0)[:, None]
-    return w[:, -1], d
 
 
 def split_by_tensor_3d(arrays, tensors, critical=1.0, one=True, crack_name="crack"):

@@ -251,7 +251,8 @@ def equivalent_strain(mesh, strain, material):
 
 
 def principal(tensors):
-    """Largest principal value and its unit direction of symmetric 2x2 tensors.
+    """Largest principal value and its unit direction of symmetric 2x2 tensors (3x3: shape
+    (n, 6), :func:`.solid_criterion.principal_3d`).
 
     Parameters
     ----------
@@ -271,6 +272,9 @@ def principal(tensors):
         If tensors is not of shape (n, 3) or holds NaN or inf.
     """
     t = np.asarray(tensors, dtype=float)
+    if t.ndim == 2 and t.shape[1] == 6:
+        from .solid_criterion import principal_3d     # it imports this module
+        return principal_3d(t)
     if t.ndim != 2 or t.shape[1] != 3:
         raise ValueError(f"ngfracture.fracture.strain: tensors must have shape (n, 3), got {t.shape}")
     if not np.all(np.isfinite(t)):

@@ -2,7 +2,8 @@
 
 Every accepted step's history record holds the resultants of the loaded boundaries
 (``boundaries``: force and mean displacement per boundary, mechanics/resultants.py); the
-CSV has one row per step, the load parameter and, per boundary, Fx, Fy, ux, uy.
+CSV has one row per step, the load parameter and, per boundary, Fx, Fy, ux, uy (with Fz and
+uz in 3D).
 """
 import csv
 import io
@@ -25,17 +26,21 @@ def curve_columns(history):
     Returns
     -------
     dict of str -> numpy.ndarray
-        ``step``, ``x``, and ``<boundary>_Fx``, ``_Fy``, ``_ux``, ``_uy`` (NaN where a step
-        lacks the boundary), in the order of the boundary names.
+        ``step``, ``x``, and ``<boundary>_Fx``, ``_Fy``, ``_ux``, ``_uy`` (3D: ``_Fx``, ``_Fy``,
+        ``_Fz``, ``_ux``, ``_uy``, ``_uz``; NaN where a step lacks the boundary), in the order of
+        the boundary names.
     """
     names = sorted({name for h in history for name in h.get("boundaries", {})})
+    # 2 components in 2D, 3 in 3D
+    d = max((len(b["force"]) for h in history for b in h.get("boundaries", {}).values()), default=2)
     cols = {"step": np.array([h["step"] for h in history], dtype=float),
             "x": np.array([h["x"] for h in history], dtype=float)}
     for name in names:
-        values = np.array([h.get("boundaries", {}).get(name, {}).get("force", [np.nan] * 2)
-                           + h.get("boundaries", {}).get(name, {}).get("displacement", [np.nan] * 2)
-                           for h in history], dtype=float).reshape(len(history), 4)
-        for k, label in enumerate(("Fx", "Fy", "ux", "uy")):
+        values = np.array([h.get("boundaries", {}).get(name, {}).get("force", [np.nan] * d)
+                           + h.get("boundaries", {}).get(name, {}).get("displacement", [np.nan] * d)
+                           for h in history], dtype=float).reshape(len(history), 2 * d)
+        labels = [f"F{c}" for c in "xyz"[:d]] + [f"u{c}" for c in "xyz"[:d]]
+        for k, label in enumerate(labels):
             cols[f"{name}_{label}"] = values[:, k]
     return cols
 
@@ -90,10 +95,11 @@ def plot_force_displacement(path, history, load_description=""):
     FigureCanvasAgg(fig)
     ax = fig.subplots()
     for name in names:
-        F = np.column_stack([cols[f"{name}_Fx"], cols[f"{name}_Fy"]])
-        u = np.column_stack([cols[f"{name}_ux"], cols[f"{name}_uy"]])
-        peak = np.nanargmax(np.hypot(F[:, 0], F[:, 1]))
-        d = F[peak] / max(np.hypot(*F[peak]), 1e-300)
+        axes = [c for c in "xyz" if f"{name}_F{c}" in cols]
+        F = np.column_stack([cols[f"{name}_F{c}"] for c in axes])
+        u = np.column_stack([cols[f"{name}_u{c}"] for c in axes])
+        peak = np.nanargmax(np.linalg.norm(F, axis=1))
+        d = F[peak] / max(np.linalg.norm(F[peak]), 1e-300)
         ax.plot(np.r_[0.0, u @ d], np.r_[0.0, F @ d], ".-", label=name)
     ax.set_xlabel("mean displacement of the boundary along its force")
     ax.set_ylabel("force on the boundary (reaction or load)")
