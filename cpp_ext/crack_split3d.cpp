@@ -1,4 +1,7 @@
 #include "crack_split3d.hpp"
+#include "star_mincut.hpp"
+#include <cstdlib>
+#include <cstdio>
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -242,14 +245,14 @@ namespace ngfracture
     return true;
   }
 
-  int TetSplitter :: Classify (const double * n, const std::vector<std::array<int,2>> & pairs,
-                               std::vector<int> & side) const
+  double TetSplitter :: Anchor (const double * n, const std::vector<std::array<int,2>> & pairs) const
   {
-    // the side of a plane normal to n that holds the tetrahedron's centroid; the plane passes
-    // through x_v, or on a front through the mean centroid of the lip faces at the front
-    // edges (the crack continues at its own level, not at the level of the front vertex)
-    double x[3] = { points[3*size_t(lv)], points[3*size_t(lv)+1], points[3*size_t(lv)+2] };
-    if (!pairs.empty())
+    // signed offset (along unit n) of the plane of the cut
+    double nn = std::sqrt(n[0]*n[0] + n[1]*n[1] + n[2]*n[2]);
+    auto dot = [&] (const double * y) { return (y[0]*n[0] + y[1]*n[1] + y[2]*n[2]) / nn; };
+    int mode = std::getenv("CUT_ANCHOR") ? std::atoi(std::getenv("CUT_ANCHOR")) : 2;
+    if (pairs.empty()) return dot(&points[3*size_t(lv)]);
+    if (mode == 0)
       {
         double c[3] = { 0, 0, 0 };
         for (auto & pr : pairs)
@@ -259,8 +262,43 @@ namespace ngfracture
               if (j != le[pr[0]].c)
                 for (int d = 0; d < 3; d++) c[d] += points[3*size_t(T[j])+d];
           }
-        for (int d = 0; d < 3; d++) x[d] = c[d] / (3.0 * pairs.size());
+        for (int d = 0; d < 3; d++) c[d] /= (3.0 * pairs.size());
+        return dot(c);
       }
+    // area-weighted mean offset of the crack faces in the star of v (mode 1) or of v and its
+    // link vertices (mode 2), weighted also by their alignment with n
+    std::vector<int> verts = { lv };
+    if (mode == 2)
+      for (auto & e : le) { verts.push_back(e.a); verts.push_back(e.b); }
+    std::sort(verts.begin(), verts.end());
+    verts.erase(std::unique(verts.begin(), verts.end()), verts.end());
+    std::vector<long long> keys;
+    for (int w : verts)
+      for (const int * t = StarBegin(w); t != StarBegin(w) + StarSize(w); t++)
+        for (int c = 0; c < 4; c++)
+          if (tet_bc[4*size_t(*t) + c] == crack_bc) keys.push_back(4LL * *t + c);
+    std::sort(keys.begin(), keys.end());
+    keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+    double sw = 0, sd = 0;
+    for (long long k : keys)
+      {
+        const int * T = &tets[4*size_t(k/4)];
+        int c = int(k % 4);
+        const double * x[3];
+        for (int j = 0; j < 3; j++) x[j] = &points[3*size_t(T[OUT[c][j]])];
+        double u[3], w[3], cr[3], cen[3];
+        for (int d = 0; d < 3; d++) { u[d] = x[1][d] - x[0][d]; w[d] = x[2][d] - x[0][d]; cen[d] = (x[0][d] + x[1][d] + x[2][d]) / 3; }
+        cr[0] = u[1]*w[2] - u[2]*w[1]; cr[1] = u[2]*w[0] - u[0]*w[2]; cr[2] = u[0]*w[1] - u[1]*w[0];
+        double wt = std::abs(cr[0]*n[0] + cr[1]*n[1] + cr[2]*n[2]) / nn;   // projected area
+        sw += wt; sd += wt * dot(cen);
+      }
+    return sw > 0 ? sd / sw : dot(&points[3*size_t(lv)]);
+  }
+
+  int TetSplitter :: Classify (const double * n, double offset, std::vector<int> & side) const
+  {
+    // the side of the plane (x . n = offset) that holds the tetrahedron's centroid
+    double nn = std::sqrt(n[0]*n[0] + n[1]*n[1] + n[2]*n[2]);
     int n1 = 0;
     side.assign(S.size(), 0);
     for (size_t i = 0; i < S.size(); i++)
@@ -269,12 +307,192 @@ namespace ngfracture
         for (int k = 0; k < 4; k++)
           {
             const double * y = &points[3*size_t(tets[4*size_t(S[i])+k])];
-            d += (y[0]-x[0])*n[0] + (y[1]-x[1])*n[1] + (y[2]-x[2])*n[2];
+            d += (y[0]*n[0] + y[1]*n[1] + y[2]*n[2]) / nn - offset;
           }
         side[i] = d > 0;
         n1 += side[i];
       }
     return n1;
+  }
+
+  void TetSplitter :: CutSides (const double * n, double offset, const std::vector<std::array<int,2>> & pairs,
+                                std::vector<int> & side) const
+  {
+    double alpha = std::getenv("CUT_ALPHA") ? std::atof(std::getenv("CUT_ALPHA")) : 5.0;
+    double beta = std::getenv("CUT_BETA") ? std::atof(std::getenv("CUT_BETA")) : 0.0;
+    int dmode = std::getenv("CUT_DIST") ? std::atoi(std::getenv("CUT_DIST")) : 0;
+    double branch = std::getenv("CUT_BRANCH") ? std::atof(std::getenv("CUT_BRANCH")) : 10.0;
+    std::vector<int> lverts;
+    for (auto & e : le) { lverts.push_back(e.a); lverts.push_back(e.b); }
+    std::sort(lverts.begin(), lverts.end());
+    lverts.erase(std::unique(lverts.begin(), lverts.end()), lverts.end());
+    std::vector<char> closed(lverts.size(), 0);
+    if (branch != 1.0)
+      for (size_t k = 0; k < lverts.size(); k++) closed[k] = ClosedCrackVertex(lverts[k]);
+    auto is_closed = [&] (int w) { return closed[std::lower_bound(lverts.begin(), lverts.end(), w) - lverts.begin()] != 0; };
+    double nn = std::sqrt(n[0]*n[0] + n[1]*n[1] + n[2]*n[2]);
+    auto dist = [&] (int w) { const double * y = &points[3*size_t(w)];
+                              return (y[0]*n[0] + y[1]*n[1] + y[2]*n[2]) / nn - offset; };
+    int m = int(S.size());
+    const double * xv = &points[3*size_t(lv)];
+    double h = 0;
+    for (auto & e : le)
+      for (int w : { e.a, e.b })
+        {
+          const double * y = &points[3*size_t(w)];
+          h += std::sqrt((y[0]-xv[0])*(y[0]-xv[0]) + (y[1]-xv[1])*(y[1]-xv[1]) + (y[2]-xv[2])*(y[2]-xv[2]));
+        }
+    h /= 2.0 * le.size();
+    const double tol = 1e-12 * h;
+    MinCut g(m);
+    // terminals: tetrahedra wholly on one side (their vertices other than v)
+    std::vector<double> cen(m, 0.0);
+    int kv_plus = -1, kv_minus = -1;
+    bool plus = false, minus = false;
+    for (int i = 0; i < m; i++)
+      {
+        double lo = 0, hi = 0;
+        for (int k = 0; k < 4; k++)
+          {
+            int w = tets[4*size_t(S[i])+k];
+            double d = dist(w);
+            cen[i] += d;
+            if (w == lv) continue;
+            if (std::abs(d) <= tol) d = 0;
+            lo = std::min(lo, d); hi = std::max(hi, d);
+          }
+        if (lo == 0 && hi > 0) { g.Fix(i, 1); plus = true; }
+        else if (hi == 0 && lo < 0) { g.Fix(i, 0); minus = true; }
+        if (kv_plus < 0 || cen[i] > cen[kv_plus]) kv_plus = i;
+        if (kv_minus < 0 || cen[i] < cen[kv_minus]) kv_minus = i;
+      }
+    if (!plus) g.Fix(kv_plus, 1);
+    if (!minus) g.Fix(kv_minus, 0);
+    // tetrahedra holding a crack face well aligned with the plane: on the side the face
+    // puts them (below the crack if its outward normal points along n)
+    double fixcrack = std::getenv("CUT_FIXCRACK") ? std::atof(std::getenv("CUT_FIXCRACK")) : 0.2;
+    if (fixcrack > 0)
+      for (int i = 0; i < m; i++)
+        for (int c = 0; c < 4; c++)
+          if (tet_bc[4*size_t(S[i]) + c] == crack_bc)
+            {
+              const int * T = &tets[4*size_t(S[i])];
+              const double * x[3];
+              for (int j = 0; j < 3; j++) x[j] = &points[3*size_t(T[OUT[c][j]])];
+              double u[3], w[3], cr[3];
+              for (int d = 0; d < 3; d++) { u[d] = x[1][d] - x[0][d]; w[d] = x[2][d] - x[0][d]; }
+              cr[0] = u[1]*w[2] - u[2]*w[1]; cr[1] = u[2]*w[0] - u[0]*w[2]; cr[2] = u[0]*w[1] - u[1]*w[0];
+              double cs = (cr[0]*n[0] + cr[1]*n[1] + cr[2]*n[2]) / (std::sqrt(cr[0]*cr[0] + cr[1]*cr[1] + cr[2]*cr[2]) * nn);
+              if (std::abs(cs) >= fixcrack) g.Fix(i, cs > 0 ? 0 : 1);
+            }
+    // the lips at front edges: fixed to opposite sides
+    std::vector<int> lips(m, -1);
+    SeedLips(pairs, n, lips);
+    for (int i = 0; i < m; i++) if (lips[i] >= 0) g.Fix(i, lips[i]);
+    // interior faces at v: area, growing with the distance of their far vertices from the plane
+    for (size_t e = 0; e < le.size(); e++)
+      {
+        int p = partner[e];
+        if (p < int(e)) continue;
+        const int * T = &tets[4*size_t(S[le[e].i])];
+        const double * x[3];
+        for (int j = 0; j < 3; j++) x[j] = &points[3*size_t(T[OUT[le[e].c][j]])];
+        double u[3], w[3], cr[3];
+        for (int d = 0; d < 3; d++) { u[d] = x[1][d] - x[0][d]; w[d] = x[2][d] - x[0][d]; }
+        cr[0] = u[1]*w[2] - u[2]*w[1]; cr[1] = u[2]*w[0] - u[0]*w[2]; cr[2] = u[0]*w[1] - u[1]*w[0];
+        double area = 0.5 * std::sqrt(cr[0]*cr[0] + cr[1]*cr[1] + cr[2]*cr[2]);
+        double cosn = std::abs(cr[0]*n[0] + cr[1]*n[1] + cr[2]*n[2]) / (2 * area * nn);
+        double da = std::abs(dist(le[e].a)), db = std::abs(dist(le[e].b));
+        double dd = dmode == 0 ? std::max(da, db) : dmode == 1 ? (da + db + std::abs(dist(lv))) / 3 : 0.5 * (da + db);
+        double cap = area * (1 + alpha * dd / h);
+        if (beta > 0) cap /= std::pow(std::max(cosn, 0.1), beta);
+        if (branch != 1.0 && (is_closed(le[e].a) || is_closed(le[e].b) || CrackEdge(le[e].a, le[e].b) ||
+                              CrackEdge(lv, le[e].a) || CrackEdge(lv, le[e].b)))
+          cap *= branch;
+        g.AddEdge(le[e].i, le[p].i, cap);
+        int debug = std::getenv("CUT_DEBUG") ? 1 : 0;
+        if (debug) fprintf(stderr, "  face %d %d %d cap %g area %g closed %d %d edges %d %d %d\n", lv, le[e].a, le[e].b, cap, area,
+                           int(is_closed(le[e].a)), int(is_closed(le[e].b)), int(CrackEdge(le[e].a, le[e].b)), int(CrackEdge(lv, le[e].a)), int(CrackEdge(lv, le[e].b)));
+      }
+    double value;
+    side = g.Solve(value);
+  }
+
+  bool TetSplitter :: ClosedCrackVertex (int a) const
+  {
+    // crack faces at a as (x, y, face) for both edges (a, x) of every face (a, x, y)
+    std::vector<std::array<int,3>> h;
+    const int * st = StarBegin(a);
+    for (int s = 0; s < StarSize(a); s++)
+      {
+        const int * T = &tets[4*size_t(st[s])];
+        for (int c = 0; c < 4; c++)
+          {
+            if (T[c] == a || tet_bc[4*size_t(st[s]) + c] != crack_bc) continue;
+            int xy[2], k = 0;
+            for (int j = 0; j < 4; j++) if (j != c && T[j] != a) xy[k++] = T[j];
+            h.push_back({ xy[0], xy[1], 0 });
+            h.push_back({ xy[1], xy[0], 0 });
+          }
+      }
+    if (h.empty()) return false;
+    std::sort(h.begin(), h.end());
+    // a front edge (a, x): two crack faces whose third vertices are distinct copies of one point
+    for (size_t s = 0; s < h.size(); )
+      {
+        size_t e = s;
+        while (e < h.size() && h[e][0] == h[s][0]) e++;
+        for (size_t x = s; x < e; x++)
+          for (size_t y = x+1; y < e; y++)
+            if (h[x][1] != h[y][1] &&
+                std::memcmp(&points[3*size_t(h[x][1])], &points[3*size_t(h[y][1])], 3*sizeof(double)) == 0)
+              return false;
+        s = e;
+      }
+    return true;
+  }
+
+  bool TetSplitter :: CrackEdge (int p, int q) const
+  {
+    // crack faces (p, q, x): true if there is one and they are not exactly the two lips of
+    // a front edge (third vertices distinct copies of one point)
+    int third[3], k = 0;
+    const int * st = StarBegin(p);
+    for (int s = 0; s < StarSize(p); s++)
+      {
+        const int * T = &tets[4*size_t(st[s])];
+        int kp = -1, kq = -1;
+        for (int j = 0; j < 4; j++) { if (T[j] == p) kp = j; if (T[j] == q) kq = j; }
+        if (kq < 0) continue;
+        for (int c = 0; c < 4; c++)
+          if (c != kp && c != kq && tet_bc[4*size_t(st[s]) + c] == crack_bc)
+            {
+              if (k == 2) return true;
+              third[k++] = T[6 - kp - kq - c];
+            }
+      }
+    if (k != 2) return k > 0;
+    return third[0] == third[1] ||
+      std::memcmp(&points[3*size_t(third[0])], &points[3*size_t(third[1])], 3*sizeof(double)) != 0;
+  }
+
+  bool TetSplitter :: Connect (std::vector<int> & side) const
+  {
+    // both sides connected: a part cut off from its side's largest part changes side
+    int m = int(S.size());
+    bool moved = false;
+    std::vector<int> comp;
+    for (int s = 0; s < 2; s++)
+      {
+        int k = Components(side, s, comp);
+        if (k <= 1) continue;
+        std::vector<int> count(k, 0);
+        for (int i = 0; i < m; i++) if (comp[i] >= 0) count[comp[i]]++;
+        int main = int(std::max_element(count.begin(), count.end()) - count.begin());   // first of the largest
+        for (int i = 0; i < m; i++) if (comp[i] >= 0 && comp[i] != main) side[i] = 1 - s;
+        moved = true;
+      }
+    return moved;
   }
 
   int TetSplitter :: RefuseReason (const std::vector<int> & side, const std::vector<long long> & before,
@@ -335,22 +553,32 @@ namespace ngfracture
           }
         if (best_bnd > best_in) return flags | SPLIT3_NONE | SPLIT3_ALIGNED;
       }
-    Classify(n, pairs, side);
+    double offset = Anchor(n, pairs);
+    Classify(n, offset, side);
     SeedLips(pairs, n, side);
     int n1 = int(std::count(side.begin(), side.end(), 1));
     if (n1 == 0 || n1 == m) return flags | SPLIT3_NONE | SPLIT3_EMPTY;
-    // both sides connected: a part cut off from its side's largest part changes side
-    for (int s = 0; s < 2; s++)
-      {
-        int k = Components(side, s, comp);
-        if (k <= 1) continue;
-        std::vector<int> count(k, 0);
-        for (int i = 0; i < m; i++) if (comp[i] >= 0) count[comp[i]]++;
-        int main = int(std::max_element(count.begin(), count.end()) - count.begin());   // first of the largest
-        for (int i = 0; i < m; i++) if (comp[i] >= 0 && comp[i] != main) side[i] = 1 - s;
-        flags |= SPLIT3_MOVED;
-      }
+    int fallback = std::getenv("CUT_FALLBACK") ? std::atoi(std::getenv("CUT_FALLBACK")) : 1;
+    int usecut = std::getenv("CUT_MINCUT") ? std::atoi(std::getenv("CUT_MINCUT")) : 1;
+    std::vector<int> centroid = side;
+    std::vector<int> lips_dbg(m, -1);
+    SeedLips(pairs, n, lips_dbg);
+    if (usecut) CutSides(n, offset, pairs, side);
+    bool moved = Connect(side);
     int refuse = RefuseReason(side, slit, after);
+    int debug = std::getenv("CUT_DEBUG") ? 1 : 0;
+    if (debug) fprintf(stderr, "v %d mincut moved %d refuse %d\n", v, int(moved), refuse);
+    if (debug)
+      for (size_t e = 0; e < le.size(); e++)
+        if (partner[e] > int(e) && side[le[e].i] != side[le[partner[e]].i])
+          fprintf(stderr, "   cut %d %d %d lips %d %d\n", v, le[e].a, le[e].b, lips_dbg[le[e].i], lips_dbg[le[partner[e]].i]);
+    if (refuse && usecut && fallback)
+      {
+        side = centroid;
+        moved = Connect(side);
+        refuse = RefuseReason(side, slit, after);
+      }
+    if (moved) flags |= SPLIT3_MOVED;
     if (refuse) { after = before; return flags | SPLIT3_NONE | refuse; }
     // the faces between the sides become crack faces, both lips; the side of the smallest
     // tetrahedron (entry 0) first

@@ -112,7 +112,13 @@ namespace ngfracture
     void SplitGroups (const std::vector<int> & label, int ngroups);
     bool SplitPieces (int w);
     int ProcessVertex (int v, const double * n, int & nfaces, int & before, int & after);
-    int Classify (const double * n, const std::vector<std::array<int,2>> & pairs, std::vector<int> & side) const;
+    double Anchor (const double * n, const std::vector<std::array<int,2>> & pairs) const;
+    int Classify (const double * n, double offset, std::vector<int> & side) const;
+    void CutSides (const double * n, double offset, const std::vector<std::array<int,2>> & pairs,
+                   std::vector<int> & side) const;
+    bool Connect (std::vector<int> & side) const;
+    bool ClosedCrackVertex (int a) const;
+    bool CrackEdge (int p, int q) const;
     int RefuseReason (const std::vector<int> & side, const std::vector<long long> & before,
                       int & after) const;
     void AddFace (int t, int c);
