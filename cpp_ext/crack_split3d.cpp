@@ -1,7 +1,5 @@
 #include "crack_split3d.hpp"
 #include "star_mincut.hpp"
-#include <cstdlib>
-#include <cstdio>
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -17,6 +15,18 @@ namespace ngfracture
     // the face opposite local vertex c, in the order whose normal points out of a
     // positively oriented tetrahedron
     const int OUT[4][3] = { { 1, 2, 3 }, { 0, 3, 2 }, { 0, 1, 3 }, { 0, 2, 1 } };
+
+    // The minimum cut of a star (docs/solid.md, "Node splitting in 3D"). Capacity of an
+    // interior face (v, a, b): area * (1 + CUT_ALPHA * max(|d_a|, |d_b|) / h), d the
+    // distance from the plane, h the mean edge length at v: the new front vertices a, b
+    // (split next) stay near the plane. A face that would make the crack branch (a
+    // vertex of it inside an existing crack, with no front edge, or an edge of it on
+    // crack faces other than a front edge's two lips) costs CUT_BRANCH times more.
+    // Tetrahedra holding a crack face with |cos(normal, n)| >= CUT_FIX_COS are fixed to
+    // the side the face puts them on.
+    const double CUT_ALPHA = 5.0;
+    const double CUT_BRANCH = 10.0;
+    const double CUT_FIX_COS = 0.2;
 
     int Find (std::vector<int> & uf, int i)
     {
@@ -250,26 +260,12 @@ namespace ngfracture
     // signed offset (along unit n) of the plane of the cut
     double nn = std::sqrt(n[0]*n[0] + n[1]*n[1] + n[2]*n[2]);
     auto dot = [&] (const double * y) { return (y[0]*n[0] + y[1]*n[1] + y[2]*n[2]) / nn; };
-    int mode = std::getenv("CUT_ANCHOR") ? std::atoi(std::getenv("CUT_ANCHOR")) : 2;
     if (pairs.empty()) return dot(&points[3*size_t(lv)]);
-    if (mode == 0)
-      {
-        double c[3] = { 0, 0, 0 };
-        for (auto & pr : pairs)
-          {
-            const int * T = &tets[4*size_t(S[le[pr[0]].i])];
-            for (int j = 0; j < 4; j++)
-              if (j != le[pr[0]].c)
-                for (int d = 0; d < 3; d++) c[d] += points[3*size_t(T[j])+d];
-          }
-        for (int d = 0; d < 3; d++) c[d] /= (3.0 * pairs.size());
-        return dot(c);
-      }
-    // area-weighted mean offset of the crack faces in the star of v (mode 1) or of v and its
-    // link vertices (mode 2), weighted also by their alignment with n
+    // on a front: the mean offset of the crack faces in the stars of v and its link
+    // vertices, weighted by their area projected on the plane (the crack continues at the
+    // level of the crack around it, not at the level of the front vertex)
     std::vector<int> verts = { lv };
-    if (mode == 2)
-      for (auto & e : le) { verts.push_back(e.a); verts.push_back(e.b); }
+    for (auto & e : le) { verts.push_back(e.a); verts.push_back(e.b); }
     std::sort(verts.begin(), verts.end());
     verts.erase(std::unique(verts.begin(), verts.end()), verts.end());
     std::vector<long long> keys;
@@ -318,17 +314,12 @@ namespace ngfracture
   void TetSplitter :: CutSides (const double * n, double offset, const std::vector<std::array<int,2>> & pairs,
                                 std::vector<int> & side) const
   {
-    double alpha = std::getenv("CUT_ALPHA") ? std::atof(std::getenv("CUT_ALPHA")) : 5.0;
-    double beta = std::getenv("CUT_BETA") ? std::atof(std::getenv("CUT_BETA")) : 0.0;
-    int dmode = std::getenv("CUT_DIST") ? std::atoi(std::getenv("CUT_DIST")) : 0;
-    double branch = std::getenv("CUT_BRANCH") ? std::atof(std::getenv("CUT_BRANCH")) : 10.0;
     std::vector<int> lverts;
     for (auto & e : le) { lverts.push_back(e.a); lverts.push_back(e.b); }
     std::sort(lverts.begin(), lverts.end());
     lverts.erase(std::unique(lverts.begin(), lverts.end()), lverts.end());
     std::vector<char> closed(lverts.size(), 0);
-    if (branch != 1.0)
-      for (size_t k = 0; k < lverts.size(); k++) closed[k] = ClosedCrackVertex(lverts[k]);
+    for (size_t k = 0; k < lverts.size(); k++) closed[k] = ClosedCrackVertex(lverts[k]);
     auto is_closed = [&] (int w) { return closed[std::lower_bound(lverts.begin(), lverts.end(), w) - lverts.begin()] != 0; };
     double nn = std::sqrt(n[0]*n[0] + n[1]*n[1] + n[2]*n[2]);
     auto dist = [&] (int w) { const double * y = &points[3*size_t(w)];
@@ -370,9 +361,7 @@ namespace ngfracture
     if (!minus) g.Fix(kv_minus, 0);
     // tetrahedra holding a crack face well aligned with the plane: on the side the face
     // puts them (below the crack if its outward normal points along n)
-    double fixcrack = std::getenv("CUT_FIXCRACK") ? std::atof(std::getenv("CUT_FIXCRACK")) : 0.2;
-    if (fixcrack > 0)
-      for (int i = 0; i < m; i++)
+    for (int i = 0; i < m; i++)
         for (int c = 0; c < 4; c++)
           if (tet_bc[4*size_t(S[i]) + c] == crack_bc)
             {
@@ -383,7 +372,7 @@ namespace ngfracture
               for (int d = 0; d < 3; d++) { u[d] = x[1][d] - x[0][d]; w[d] = x[2][d] - x[0][d]; }
               cr[0] = u[1]*w[2] - u[2]*w[1]; cr[1] = u[2]*w[0] - u[0]*w[2]; cr[2] = u[0]*w[1] - u[1]*w[0];
               double cs = (cr[0]*n[0] + cr[1]*n[1] + cr[2]*n[2]) / (std::sqrt(cr[0]*cr[0] + cr[1]*cr[1] + cr[2]*cr[2]) * nn);
-              if (std::abs(cs) >= fixcrack) g.Fix(i, cs > 0 ? 0 : 1);
+              if (std::abs(cs) >= CUT_FIX_COS) g.Fix(i, cs > 0 ? 0 : 1);
             }
     // the lips at front edges: fixed to opposite sides
     std::vector<int> lips(m, -1);
@@ -401,18 +390,12 @@ namespace ngfracture
         for (int d = 0; d < 3; d++) { u[d] = x[1][d] - x[0][d]; w[d] = x[2][d] - x[0][d]; }
         cr[0] = u[1]*w[2] - u[2]*w[1]; cr[1] = u[2]*w[0] - u[0]*w[2]; cr[2] = u[0]*w[1] - u[1]*w[0];
         double area = 0.5 * std::sqrt(cr[0]*cr[0] + cr[1]*cr[1] + cr[2]*cr[2]);
-        double cosn = std::abs(cr[0]*n[0] + cr[1]*n[1] + cr[2]*n[2]) / (2 * area * nn);
         double da = std::abs(dist(le[e].a)), db = std::abs(dist(le[e].b));
-        double dd = dmode == 0 ? std::max(da, db) : dmode == 1 ? (da + db + std::abs(dist(lv))) / 3 : 0.5 * (da + db);
-        double cap = area * (1 + alpha * dd / h);
-        if (beta > 0) cap /= std::pow(std::max(cosn, 0.1), beta);
-        if (branch != 1.0 && (is_closed(le[e].a) || is_closed(le[e].b) || CrackEdge(le[e].a, le[e].b) ||
+        double cap = area * (1 + CUT_ALPHA * std::max(da, db) / h);
+        if ((is_closed(le[e].a) || is_closed(le[e].b) || CrackEdge(le[e].a, le[e].b) ||
                               CrackEdge(lv, le[e].a) || CrackEdge(lv, le[e].b)))
-          cap *= branch;
+          cap *= CUT_BRANCH;
         g.AddEdge(le[e].i, le[p].i, cap);
-        int debug = std::getenv("CUT_DEBUG") ? 1 : 0;
-        if (debug) fprintf(stderr, "  face %d %d %d cap %g area %g closed %d %d edges %d %d %d\n", lv, le[e].a, le[e].b, cap, area,
-                           int(is_closed(le[e].a)), int(is_closed(le[e].b)), int(CrackEdge(le[e].a, le[e].b)), int(CrackEdge(lv, le[e].a)), int(CrackEdge(lv, le[e].b)));
       }
     double value;
     side = g.Solve(value);
@@ -476,6 +459,52 @@ namespace ngfracture
       std::memcmp(&points[3*size_t(third[0])], &points[3*size_t(third[1])], 3*sizeof(double)) != 0;
   }
 
+  bool TetSplitter :: SmallPiece (const std::vector<int> & side) const
+  {
+    // the faces between the sides, blocked; a side whose tetrahedra reach fewer than
+    // |star| tetrahedra of the mesh through unblocked shared faces is a pocket
+    std::vector<long long> blocked;
+    for (size_t e = 0; e < le.size(); e++)
+      {
+        int p = partner[e];
+        if (p >= 0 && side[le[e].i] != side[le[p].i]) blocked.push_back(4LL * S[le[e].i] + le[e].c);
+      }
+    std::sort(blocked.begin(), blocked.end());
+    size_t limit = S.size();
+    for (int s = 0; s < 2; s++)
+      {
+        int start = -1;
+        for (size_t i = 0; i < S.size() && start < 0; i++) if (side[i] == s) start = S[i];
+        if (start < 0) continue;
+        std::vector<int> seen = { start };
+        for (size_t q = 0; q < seen.size() && seen.size() < limit; q++)
+          {
+            int t = seen[q];
+            const int * T = &tets[4*size_t(t)];
+            for (int c = 0; c < 4; c++)
+              {
+                if (std::binary_search(blocked.begin(), blocked.end(), 4LL * t + c)) continue;
+                int x[3];
+                for (int j = 0; j < 3; j++) x[j] = T[OUT[c][j]];
+                const int * st = StarBegin(x[0]);
+                for (int k = 0; k < StarSize(x[0]); k++)
+                  {
+                    int u = st[k];
+                    if (u == t) continue;
+                    const int * U = &tets[4*size_t(u)];
+                    int hit = 0;
+                    for (int j = 0; j < 4; j++) hit += (U[j] == x[1]) + (U[j] == x[2]);
+                    if (hit < 2) continue;
+                    if (std::find(seen.begin(), seen.end(), u) == seen.end()) seen.push_back(u);
+                    break;
+                  }
+              }
+          }
+        if (seen.size() < limit) return true;
+      }
+    return false;
+  }
+
   bool TetSplitter :: Connect (std::vector<int> & side) const
   {
     // both sides connected: a part cut off from its side's largest part changes side
@@ -523,6 +552,26 @@ namespace ngfracture
     tet_bc[4*size_t(t) + c] = crack_bc;
   }
 
+  int TetSplitter :: ChooseSides (const double * n, double offset, const std::vector<std::array<int,2>> & pairs,
+                                  const std::vector<long long> & slit, std::vector<int> & side,
+                                  int & after, bool & moved) const
+  {
+    // the minimum cut first, the centroid sides (given in side) if the cut is refused;
+    // each made connected, then checked against the refusals
+    std::vector<int> centroid = side;
+    CutSides(n, offset, pairs, side);
+    int refuse = 0;
+    for (int attempt = 0; attempt < 2; attempt++)
+      {
+        if (attempt) side = centroid;
+        moved = Connect(side);
+        refuse = RefuseReason(side, slit, after);
+        if (!refuse && SmallPiece(side)) refuse = SPLIT3_POCKET;
+        if (!refuse) break;
+      }
+    return refuse;
+  }
+
   int TetSplitter :: ProcessVertex (int v, const double * n, int & nfaces, int & before, int & after)
   {
     nfaces = before = after = 0;
@@ -558,26 +607,8 @@ namespace ngfracture
     SeedLips(pairs, n, side);
     int n1 = int(std::count(side.begin(), side.end(), 1));
     if (n1 == 0 || n1 == m) return flags | SPLIT3_NONE | SPLIT3_EMPTY;
-    int fallback = std::getenv("CUT_FALLBACK") ? std::atoi(std::getenv("CUT_FALLBACK")) : 1;
-    int usecut = std::getenv("CUT_MINCUT") ? std::atoi(std::getenv("CUT_MINCUT")) : 1;
-    std::vector<int> centroid = side;
-    std::vector<int> lips_dbg(m, -1);
-    SeedLips(pairs, n, lips_dbg);
-    if (usecut) CutSides(n, offset, pairs, side);
-    bool moved = Connect(side);
-    int refuse = RefuseReason(side, slit, after);
-    int debug = std::getenv("CUT_DEBUG") ? 1 : 0;
-    if (debug) fprintf(stderr, "v %d mincut moved %d refuse %d\n", v, int(moved), refuse);
-    if (debug)
-      for (size_t e = 0; e < le.size(); e++)
-        if (partner[e] > int(e) && side[le[e].i] != side[le[partner[e]].i])
-          fprintf(stderr, "   cut %d %d %d lips %d %d\n", v, le[e].a, le[e].b, lips_dbg[le[e].i], lips_dbg[le[partner[e]].i]);
-    if (refuse && usecut && fallback)
-      {
-        side = centroid;
-        moved = Connect(side);
-        refuse = RefuseReason(side, slit, after);
-      }
+    bool moved = false;
+    int refuse = ChooseSides(n, offset, pairs, slit, side, after, moved);
     if (moved) flags |= SPLIT3_MOVED;
     if (refuse) { after = before; return flags | SPLIT3_NONE | refuse; }
     // the faces between the sides become crack faces, both lips; the side of the smallest
