@@ -1,4 +1,5 @@
 #include "crack_split3d.hpp"
+#include "star_mincut.hpp"
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -14,6 +15,18 @@ namespace ngfracture
     // the face opposite local vertex c, in the order whose normal points out of a
     // positively oriented tetrahedron
     const int OUT[4][3] = { { 1, 2, 3 }, { 0, 3, 2 }, { 0, 1, 3 }, { 0, 2, 1 } };
+
+    // The minimum cut of a star (docs/solid.md, "Node splitting in 3D"). Capacity of an
+    // interior face (v, a, b): area * (1 + CUT_ALPHA * max(|d_a|, |d_b|) / h), d the
+    // distance from the plane, h the mean edge length at v: the new front vertices a, b
+    // (split next) stay near the plane. A face that would make the crack branch (a
+    // vertex of it inside an existing crack, with no front edge, or an edge of it on
+    // crack faces other than a front edge's two lips) costs CUT_BRANCH times more.
+    // Tetrahedra holding a crack face with |cos(normal, n)| >= CUT_FIX_COS are fixed to
+    // the side the face puts them on.
+    const double CUT_ALPHA = 5.0;
+    const double CUT_BRANCH = 10.0;
+    const double CUT_FIX_COS = 0.2;
 
     int Find (std::vector<int> & uf, int i)
     {
@@ -242,25 +255,46 @@ namespace ngfracture
     return true;
   }
 
-  int TetSplitter :: Classify (const double * n, const std::vector<std::array<int,2>> & pairs,
-                               std::vector<int> & side) const
+  double TetSplitter :: Anchor (const double * n, const std::vector<std::array<int,2>> & pairs) const
   {
-    // the side of a plane normal to n that holds the tetrahedron's centroid; the plane passes
-    // through x_v, or on a front through the mean centroid of the lip faces at the front
-    // edges (the crack continues at its own level, not at the level of the front vertex)
-    double x[3] = { points[3*size_t(lv)], points[3*size_t(lv)+1], points[3*size_t(lv)+2] };
-    if (!pairs.empty())
+    // signed offset (along unit n) of the plane of the cut
+    double nn = std::sqrt(n[0]*n[0] + n[1]*n[1] + n[2]*n[2]);
+    auto dot = [&] (const double * y) { return (y[0]*n[0] + y[1]*n[1] + y[2]*n[2]) / nn; };
+    if (pairs.empty()) return dot(&points[3*size_t(lv)]);
+    // on a front: the mean offset of the crack faces in the stars of v and its link
+    // vertices, weighted by their area projected on the plane (the crack continues at the
+    // level of the crack around it, not at the level of the front vertex)
+    std::vector<int> verts = { lv };
+    for (auto & e : le) { verts.push_back(e.a); verts.push_back(e.b); }
+    std::sort(verts.begin(), verts.end());
+    verts.erase(std::unique(verts.begin(), verts.end()), verts.end());
+    std::vector<long long> keys;
+    for (int w : verts)
+      for (const int * t = StarBegin(w); t != StarBegin(w) + StarSize(w); t++)
+        for (int c = 0; c < 4; c++)
+          if (tet_bc[4*size_t(*t) + c] == crack_bc) keys.push_back(4LL * *t + c);
+    std::sort(keys.begin(), keys.end());
+    keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+    double sw = 0, sd = 0;
+    for (long long k : keys)
       {
-        double c[3] = { 0, 0, 0 };
-        for (auto & pr : pairs)
-          {
-            const int * T = &tets[4*size_t(S[le[pr[0]].i])];
-            for (int j = 0; j < 4; j++)
-              if (j != le[pr[0]].c)
-                for (int d = 0; d < 3; d++) c[d] += points[3*size_t(T[j])+d];
-          }
-        for (int d = 0; d < 3; d++) x[d] = c[d] / (3.0 * pairs.size());
+        const int * T = &tets[4*size_t(k/4)];
+        int c = int(k % 4);
+        const double * x[3];
+        for (int j = 0; j < 3; j++) x[j] = &points[3*size_t(T[OUT[c][j]])];
+        double u[3], w[3], cr[3], cen[3];
+        for (int d = 0; d < 3; d++) { u[d] = x[1][d] - x[0][d]; w[d] = x[2][d] - x[0][d]; cen[d] = (x[0][d] + x[1][d] + x[2][d]) / 3; }
+        cr[0] = u[1]*w[2] - u[2]*w[1]; cr[1] = u[2]*w[0] - u[0]*w[2]; cr[2] = u[0]*w[1] - u[1]*w[0];
+        double wt = std::abs(cr[0]*n[0] + cr[1]*n[1] + cr[2]*n[2]) / nn;   // projected area
+        sw += wt; sd += wt * dot(cen);
       }
+    return sw > 0 ? sd / sw : dot(&points[3*size_t(lv)]);
+  }
+
+  int TetSplitter :: Classify (const double * n, double offset, std::vector<int> & side) const
+  {
+    // the side of the plane (x . n = offset) that holds the tetrahedron's centroid
+    double nn = std::sqrt(n[0]*n[0] + n[1]*n[1] + n[2]*n[2]);
     int n1 = 0;
     side.assign(S.size(), 0);
     for (size_t i = 0; i < S.size(); i++)
@@ -269,12 +303,225 @@ namespace ngfracture
         for (int k = 0; k < 4; k++)
           {
             const double * y = &points[3*size_t(tets[4*size_t(S[i])+k])];
-            d += (y[0]-x[0])*n[0] + (y[1]-x[1])*n[1] + (y[2]-x[2])*n[2];
+            d += (y[0]*n[0] + y[1]*n[1] + y[2]*n[2]) / nn - offset;
           }
         side[i] = d > 0;
         n1 += side[i];
       }
     return n1;
+  }
+
+  void TetSplitter :: CutSides (const double * n, double offset, const std::vector<std::array<int,2>> & pairs,
+                                std::vector<int> & side) const
+  {
+    std::vector<int> lverts;
+    for (auto & e : le) { lverts.push_back(e.a); lverts.push_back(e.b); }
+    std::sort(lverts.begin(), lverts.end());
+    lverts.erase(std::unique(lverts.begin(), lverts.end()), lverts.end());
+    std::vector<char> closed(lverts.size(), 0);
+    for (size_t k = 0; k < lverts.size(); k++) closed[k] = ClosedCrackVertex(lverts[k]);
+    auto is_closed = [&] (int w) { return closed[std::lower_bound(lverts.begin(), lverts.end(), w) - lverts.begin()] != 0; };
+    double nn = std::sqrt(n[0]*n[0] + n[1]*n[1] + n[2]*n[2]);
+    auto dist = [&] (int w) { const double * y = &points[3*size_t(w)];
+                              return (y[0]*n[0] + y[1]*n[1] + y[2]*n[2]) / nn - offset; };
+    int m = int(S.size());
+    const double * xv = &points[3*size_t(lv)];
+    double h = 0;
+    for (auto & e : le)
+      for (int w : { e.a, e.b })
+        {
+          const double * y = &points[3*size_t(w)];
+          h += std::sqrt((y[0]-xv[0])*(y[0]-xv[0]) + (y[1]-xv[1])*(y[1]-xv[1]) + (y[2]-xv[2])*(y[2]-xv[2]));
+        }
+    h /= 2.0 * le.size();
+    const double tol = 1e-12 * h;
+    MinCut g(m);
+    // terminals: tetrahedra wholly on one side (their vertices other than v)
+    std::vector<double> cen(m, 0.0);
+    int kv_plus = -1, kv_minus = -1;
+    bool plus = false, minus = false;
+    for (int i = 0; i < m; i++)
+      {
+        double lo = 0, hi = 0;
+        for (int k = 0; k < 4; k++)
+          {
+            int w = tets[4*size_t(S[i])+k];
+            double d = dist(w);
+            cen[i] += d;
+            if (w == lv) continue;
+            if (std::abs(d) <= tol) d = 0;
+            lo = std::min(lo, d); hi = std::max(hi, d);
+          }
+        if (lo == 0 && hi > 0) { g.Fix(i, 1); plus = true; }
+        else if (hi == 0 && lo < 0) { g.Fix(i, 0); minus = true; }
+        if (kv_plus < 0 || cen[i] > cen[kv_plus]) kv_plus = i;
+        if (kv_minus < 0 || cen[i] < cen[kv_minus]) kv_minus = i;
+      }
+    if (!plus) g.Fix(kv_plus, 1);
+    if (!minus) g.Fix(kv_minus, 0);
+    // tetrahedra holding a crack face well aligned with the plane: on the side the face
+    // puts them (below the crack if its outward normal points along n)
+    for (int i = 0; i < m; i++)
+        for (int c = 0; c < 4; c++)
+          if (tet_bc[4*size_t(S[i]) + c] == crack_bc)
+            {
+              const int * T = &tets[4*size_t(S[i])];
+              const double * x[3];
+              for (int j = 0; j < 3; j++) x[j] = &points[3*size_t(T[OUT[c][j]])];
+              double u[3], w[3], cr[3];
+              for (int d = 0; d < 3; d++) { u[d] = x[1][d] - x[0][d]; w[d] = x[2][d] - x[0][d]; }
+              cr[0] = u[1]*w[2] - u[2]*w[1]; cr[1] = u[2]*w[0] - u[0]*w[2]; cr[2] = u[0]*w[1] - u[1]*w[0];
+              double cs = (cr[0]*n[0] + cr[1]*n[1] + cr[2]*n[2]) / (std::sqrt(cr[0]*cr[0] + cr[1]*cr[1] + cr[2]*cr[2]) * nn);
+              if (std::abs(cs) >= CUT_FIX_COS) g.Fix(i, cs > 0 ? 0 : 1);
+            }
+    // the lips at front edges: fixed to opposite sides
+    std::vector<int> lips(m, -1);
+    SeedLips(pairs, n, lips);
+    for (int i = 0; i < m; i++) if (lips[i] >= 0) g.Fix(i, lips[i]);
+    // interior faces at v: area, growing with the distance of their far vertices from the plane
+    for (size_t e = 0; e < le.size(); e++)
+      {
+        int p = partner[e];
+        if (p < int(e)) continue;
+        const int * T = &tets[4*size_t(S[le[e].i])];
+        const double * x[3];
+        for (int j = 0; j < 3; j++) x[j] = &points[3*size_t(T[OUT[le[e].c][j]])];
+        double u[3], w[3], cr[3];
+        for (int d = 0; d < 3; d++) { u[d] = x[1][d] - x[0][d]; w[d] = x[2][d] - x[0][d]; }
+        cr[0] = u[1]*w[2] - u[2]*w[1]; cr[1] = u[2]*w[0] - u[0]*w[2]; cr[2] = u[0]*w[1] - u[1]*w[0];
+        double area = 0.5 * std::sqrt(cr[0]*cr[0] + cr[1]*cr[1] + cr[2]*cr[2]);
+        double da = std::abs(dist(le[e].a)), db = std::abs(dist(le[e].b));
+        double cap = area * (1 + CUT_ALPHA * std::max(da, db) / h);
+        if ((is_closed(le[e].a) || is_closed(le[e].b) || CrackEdge(le[e].a, le[e].b) ||
+                              CrackEdge(lv, le[e].a) || CrackEdge(lv, le[e].b)))
+          cap *= CUT_BRANCH;
+        g.AddEdge(le[e].i, le[p].i, cap);
+      }
+    double value;
+    side = g.Solve(value);
+  }
+
+  bool TetSplitter :: ClosedCrackVertex (int a) const
+  {
+    // crack faces at a as (x, y, face) for both edges (a, x) of every face (a, x, y)
+    std::vector<std::array<int,3>> h;
+    const int * st = StarBegin(a);
+    for (int s = 0; s < StarSize(a); s++)
+      {
+        const int * T = &tets[4*size_t(st[s])];
+        for (int c = 0; c < 4; c++)
+          {
+            if (T[c] == a || tet_bc[4*size_t(st[s]) + c] != crack_bc) continue;
+            int xy[2], k = 0;
+            for (int j = 0; j < 4; j++) if (j != c && T[j] != a) xy[k++] = T[j];
+            h.push_back({ xy[0], xy[1], 0 });
+            h.push_back({ xy[1], xy[0], 0 });
+          }
+      }
+    if (h.empty()) return false;
+    std::sort(h.begin(), h.end());
+    // a front edge (a, x): two crack faces whose third vertices are distinct copies of one point
+    for (size_t s = 0; s < h.size(); )
+      {
+        size_t e = s;
+        while (e < h.size() && h[e][0] == h[s][0]) e++;
+        for (size_t x = s; x < e; x++)
+          for (size_t y = x+1; y < e; y++)
+            if (h[x][1] != h[y][1] &&
+                std::memcmp(&points[3*size_t(h[x][1])], &points[3*size_t(h[y][1])], 3*sizeof(double)) == 0)
+              return false;
+        s = e;
+      }
+    return true;
+  }
+
+  bool TetSplitter :: CrackEdge (int p, int q) const
+  {
+    // crack faces (p, q, x): true if there is one and they are not exactly the two lips of
+    // a front edge (third vertices distinct copies of one point)
+    int third[3], k = 0;
+    const int * st = StarBegin(p);
+    for (int s = 0; s < StarSize(p); s++)
+      {
+        const int * T = &tets[4*size_t(st[s])];
+        int kp = -1, kq = -1;
+        for (int j = 0; j < 4; j++) { if (T[j] == p) kp = j; if (T[j] == q) kq = j; }
+        if (kq < 0) continue;
+        for (int c = 0; c < 4; c++)
+          if (c != kp && c != kq && tet_bc[4*size_t(st[s]) + c] == crack_bc)
+            {
+              if (k == 2) return true;
+              third[k++] = T[6 - kp - kq - c];
+            }
+      }
+    if (k != 2) return k > 0;
+    return third[0] == third[1] ||
+      std::memcmp(&points[3*size_t(third[0])], &points[3*size_t(third[1])], 3*sizeof(double)) != 0;
+  }
+
+  bool TetSplitter :: SmallPiece (const std::vector<int> & side) const
+  {
+    // the faces between the sides, blocked; a side whose tetrahedra reach fewer than
+    // |star| tetrahedra of the mesh through unblocked shared faces is a pocket
+    std::vector<long long> blocked;
+    for (size_t e = 0; e < le.size(); e++)
+      {
+        int p = partner[e];
+        if (p >= 0 && side[le[e].i] != side[le[p].i]) blocked.push_back(4LL * S[le[e].i] + le[e].c);
+      }
+    std::sort(blocked.begin(), blocked.end());
+    size_t limit = S.size();
+    for (int s = 0; s < 2; s++)
+      {
+        int start = -1;
+        for (size_t i = 0; i < S.size() && start < 0; i++) if (side[i] == s) start = S[i];
+        if (start < 0) continue;
+        std::vector<int> seen = { start };
+        for (size_t q = 0; q < seen.size() && seen.size() < limit; q++)
+          {
+            int t = seen[q];
+            const int * T = &tets[4*size_t(t)];
+            for (int c = 0; c < 4; c++)
+              {
+                if (std::binary_search(blocked.begin(), blocked.end(), 4LL * t + c)) continue;
+                int x[3];
+                for (int j = 0; j < 3; j++) x[j] = T[OUT[c][j]];
+                const int * st = StarBegin(x[0]);
+                for (int k = 0; k < StarSize(x[0]); k++)
+                  {
+                    int u = st[k];
+                    if (u == t) continue;
+                    const int * U = &tets[4*size_t(u)];
+                    int hit = 0;
+                    for (int j = 0; j < 4; j++) hit += (U[j] == x[1]) + (U[j] == x[2]);
+                    if (hit < 2) continue;
+                    if (std::find(seen.begin(), seen.end(), u) == seen.end()) seen.push_back(u);
+                    break;
+                  }
+              }
+          }
+        if (seen.size() < limit) return true;
+      }
+    return false;
+  }
+
+  bool TetSplitter :: Connect (std::vector<int> & side) const
+  {
+    // both sides connected: a part cut off from its side's largest part changes side
+    int m = int(S.size());
+    bool moved = false;
+    std::vector<int> comp;
+    for (int s = 0; s < 2; s++)
+      {
+        int k = Components(side, s, comp);
+        if (k <= 1) continue;
+        std::vector<int> count(k, 0);
+        for (int i = 0; i < m; i++) if (comp[i] >= 0) count[comp[i]]++;
+        int main = int(std::max_element(count.begin(), count.end()) - count.begin());   // first of the largest
+        for (int i = 0; i < m; i++) if (comp[i] >= 0 && comp[i] != main) side[i] = 1 - s;
+        moved = true;
+      }
+    return moved;
   }
 
   int TetSplitter :: RefuseReason (const std::vector<int> & side, const std::vector<long long> & before,
@@ -303,6 +550,26 @@ namespace ngfracture
     for (int j = 0; j < 3; j++) face_loc.push_back(int8_t(OUT[c][j]));
     face_bc.push_back(crack_bc);
     tet_bc[4*size_t(t) + c] = crack_bc;
+  }
+
+  int TetSplitter :: ChooseSides (const double * n, double offset, const std::vector<std::array<int,2>> & pairs,
+                                  const std::vector<long long> & slit, std::vector<int> & side,
+                                  int & after, bool & moved) const
+  {
+    // the minimum cut first, the centroid sides (given in side) if the cut is refused;
+    // each made connected, then checked against the refusals
+    std::vector<int> centroid = side;
+    CutSides(n, offset, pairs, side);
+    int refuse = 0;
+    for (int attempt = 0; attempt < 2; attempt++)
+      {
+        if (attempt) side = centroid;
+        moved = Connect(side);
+        refuse = RefuseReason(side, slit, after);
+        if (!refuse && SmallPiece(side)) refuse = SPLIT3_POCKET;
+        if (!refuse) break;
+      }
+    return refuse;
   }
 
   int TetSplitter :: ProcessVertex (int v, const double * n, int & nfaces, int & before, int & after)
@@ -335,22 +602,14 @@ namespace ngfracture
           }
         if (best_bnd > best_in) return flags | SPLIT3_NONE | SPLIT3_ALIGNED;
       }
-    Classify(n, pairs, side);
+    double offset = Anchor(n, pairs);
+    Classify(n, offset, side);
     SeedLips(pairs, n, side);
     int n1 = int(std::count(side.begin(), side.end(), 1));
     if (n1 == 0 || n1 == m) return flags | SPLIT3_NONE | SPLIT3_EMPTY;
-    // both sides connected: a part cut off from its side's largest part changes side
-    for (int s = 0; s < 2; s++)
-      {
-        int k = Components(side, s, comp);
-        if (k <= 1) continue;
-        std::vector<int> count(k, 0);
-        for (int i = 0; i < m; i++) if (comp[i] >= 0) count[comp[i]]++;
-        int main = int(std::max_element(count.begin(), count.end()) - count.begin());   // first of the largest
-        for (int i = 0; i < m; i++) if (comp[i] >= 0 && comp[i] != main) side[i] = 1 - s;
-        flags |= SPLIT3_MOVED;
-      }
-    int refuse = RefuseReason(side, slit, after);
+    bool moved = false;
+    int refuse = ChooseSides(n, offset, pairs, slit, side, after, moved);
+    if (moved) flags |= SPLIT3_MOVED;
     if (refuse) { after = before; return flags | SPLIT3_NONE | refuse; }
     // the faces between the sides become crack faces, both lips; the side of the smallest
     // tetrahedron (entry 0) first

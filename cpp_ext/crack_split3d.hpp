@@ -40,6 +40,8 @@ namespace ngfracture
       SPLIT3_ENCLOSED = 1024,  // refused: a side touches none of v's boundary faces
                                // (the new faces would close a cone around v)
       SPLIT3_DANGLING = 2048,  // refused: the new faces would end at a new front edge through v
+      SPLIT3_POCKET   = 8192,  // refused: a side of the cut would be a piece of the mesh
+                               // smaller than the star (a pocket closed by earlier cracks)
       SPLIT3_ALIGNED  = 4096   // refused (rule 2a): v on a surface, not on a front, and one of
                                // its boundary faces is better aligned with the crack plane
                                // than every interior face at v
@@ -112,7 +114,16 @@ namespace ngfracture
     void SplitGroups (const std::vector<int> & label, int ngroups);
     bool SplitPieces (int w);
     int ProcessVertex (int v, const double * n, int & nfaces, int & before, int & after);
-    int Classify (const double * n, const std::vector<std::array<int,2>> & pairs, std::vector<int> & side) const;
+    double Anchor (const double * n, const std::vector<std::array<int,2>> & pairs) const;
+    int Classify (const double * n, double offset, std::vector<int> & side) const;
+    void CutSides (const double * n, double offset, const std::vector<std::array<int,2>> & pairs,
+                   std::vector<int> & side) const;
+    bool Connect (std::vector<int> & side) const;
+    bool ClosedCrackVertex (int a) const;
+    bool CrackEdge (int p, int q) const;
+    bool SmallPiece (const std::vector<int> & side) const;
+    int ChooseSides (const double * n, double offset, const std::vector<std::array<int,2>> & pairs,
+                     const std::vector<long long> & slit, std::vector<int> & side, int & after, bool & moved) const;
     int RefuseReason (const std::vector<int> & side, const std::vector<long long> & before,
                       int & after) const;
     void AddFace (int t, int c);

@@ -46,6 +46,7 @@ void ExportSplit3d (py::module & m)
   flags["moved"] = int(SPLIT3_MOVED); flags["far"] = int(SPLIT3_FAR); flags["none"] = int(SPLIT3_NONE);
   flags["empty"] = int(SPLIT3_EMPTY); flags["enclosed"] = int(SPLIT3_ENCLOSED);
   flags["dangling"] = int(SPLIT3_DANGLING); flags["aligned"] = int(SPLIT3_ALIGNED);
+  flags["pocket"] = int(SPLIT3_POCKET);
   m.attr("SPLIT3D_FLAGS") = flags;   // bit flags of Split3dVertices' record "flags"
 
   m.def("Split3dVertices",

@@ -14,7 +14,7 @@ from netgen.csg import CSGeometry, OrthoBrick, Pnt
 
 from ngfracture.fracture import split3d as s3
 from ngfracture.geometry.solid import solid_mesh, solid_to_arrays, tet_volumes, total_volume
-from split3d_util import check_twins, crack_area, crack_pieces, cube_bar
+from split3d_util import check_twins, crack_area, crack_pieces, cube_bar, min_face_surface
 
 Z = np.array([0.0, 0.0, 1.0])
 X = np.array([1.0, 0.0, 0.0])
@@ -63,34 +63,66 @@ def test_structured_bar_splits_in_two_across_its_mid_plane():
     assert np.array_equal(s3.transfer_vertex_field_3d(u, r), u[r.parent])
 
 
-def grow_from_mid_plane(a, z0):
-    """A crack grown front vertex by front vertex, the one nearest the plane z = z0 first."""
-    dist = np.abs(a.points[:, 2] - z0) + 1e-3 * np.linalg.norm(a.points[:, :2] - 0.5, axis=1)
-    b = s3.split_vertices_3d(a, [int(np.argmin(dist))], [Z]).arrays
+def grow_across_plane(a, normal, centre):
+    """A crack grown front vertex by front vertex across the plane (normal, through centre),
+    the front vertex nearest the plane first (as a criterion picks the most stressed)."""
+    n = np.asarray(normal, dtype=float)
+    dist = np.abs((a.points - centre) @ n) + 1e-3 * np.linalg.norm(a.points - centre, axis=1)
+    b = s3.split_vertices_3d(a, [int(np.argmin(dist))], [n]).arrays
     for _ in range(10 * len(a.points)):
         fv = np.unique(s3.front_edges_3d(b))
         if not len(fv):
             return b
-        fv = fv[np.argsort(np.abs(b.points[fv, 2] - z0), kind="stable")]
-        r = s3.split_vertices_3d(b, fv, np.tile(Z, (len(fv), 1)), first_only=True)
+        fv = fv[np.argsort(np.abs((b.points[fv] - centre) @ n), kind="stable")]
+        r = s3.split_vertices_3d(b, fv, np.tile(n, (len(fv), 1)), first_only=True)
         assert r.nsplit, "the front is stuck"
         b = r.arrays
     raise AssertionError("the crack did not stop growing")
 
 
-def test_netgen_bar_splits_in_two_near_its_mid_plane():
+def netgen_bar(maxh):
     geo = CSGeometry()
     geo.Add(OrthoBrick(Pnt(0, 0, 0), Pnt(1, 1, 4)))
-    maxh = 0.25
-    a = solid_to_arrays(ngsolve.Mesh(geo.GenerateMesh(maxh=maxh)))
-    b = grow_from_mid_plane(a, 2.0)
+    return solid_to_arrays(ngsolve.Mesh(geo.GenerateMesh(maxh=maxh)))
+
+
+def check_grown_crack(a, b, normal, centre, maxh):
+    """Two fragments, volume kept, every crack vertex within maxh of the plane; returns the
+    crack area."""
     check_invariants(a, b)
     assert s3.fragments_3d(b).count == 2
-    # a surface that separates the bar's ends covers its cross-section at least once
-    assert crack_area(b) >= 1.0 - 1e-12
-    assert np.abs(b.points[b.boundary_faces("crack")][..., 2] - 2.0).max() <= maxh
+    assert len(s3.front_edges_3d(b)) == 0
+    x = b.points[b.boundary_faces("crack")]
+    assert np.abs((x - centre) @ normal).max() <= maxh
     m = solid_mesh(b)
     assert ngsolve.Integrate(1, m) == pytest.approx(4.0, rel=1e-12)
+    return crack_area(b)
+
+
+@pytest.mark.parametrize("maxh", [0.25, pytest.param(0.15, marks=pytest.mark.slow)])
+def test_netgen_bar_splits_in_two_at_its_mid_plane(maxh):
+    # mode I: the crack of mesh faces is planar to one element size and its area within
+    # 10 % of the smallest surface of mesh faces within one element size of the plane
+    # (the best any crack of faces can do: 1.12-1.17 times the cross-section on these
+    # unstructured meshes), at least the cross-section
+    a = netgen_bar(maxh)
+    c = np.array([0.5, 0.5, 2.0])
+    area = check_grown_crack(a, grow_across_plane(a, Z, c), Z, c, maxh)
+    best = min_face_surface(a, Z, c, maxh)
+    assert 1.0 - 1e-12 <= best <= area <= 1.10 * best
+
+
+def test_netgen_bar_splits_in_two_across_an_inclined_plane():
+    # opening direction 30 degrees from the bar's axis: planar to one element size; the
+    # area is at least the smallest face surface near the plane and below the 1.5 times the
+    # inclined section of a crack made of centroid-side faces (the zigzag)
+    maxh, t = 0.25, math.radians(30)
+    n = np.array([math.sin(t), 0.0, math.cos(t)])
+    c = np.array([0.5, 0.5, 2.0])
+    a = netgen_bar(maxh)
+    area = check_grown_crack(a, grow_across_plane(a, n, c), n, c, maxh)
+    section = 1.0 / math.cos(t)
+    assert min_face_surface(a, n, c, maxh) <= area <= 1.5 * section
 
 
 def test_front_vertex_continues_the_crack():

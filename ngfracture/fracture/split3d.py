@@ -24,21 +24,28 @@ Conventions (as in 2D, ``split.py``)
 Rules (docs/solid.md, "Node splitting in 3D")
 --------------------------------------------
 Two tetrahedra are joined across a face iff they share its three vertex numbers; crack
-faces are where they no longer do. The star of a vertex v is split in two sides by the
-plane through v normal to the opening direction n (each tetrahedron by the side of its
-centroid; a centroid on the plane counts as the minus side). A part of a side that is
-disconnected from the side's largest part (ties: the part of the smaller tetrahedron)
-changes side, the minus side first, so both sides are connected. The faces between the
-sides become crack faces. On a crack front (front edges through v) the existing crack
-faces are already cuts, and the new faces meet them where the front edges were: the front
-moves to the far edges of the new faces (flag ``closed``). Then:
+faces are where they no longer do. The star of a vertex v is split in two sides by a
+minimum cut (C++ ``MinCut``) of its tetrahedra through its interior faces, each face
+costing its area times ``1 + 5 max(|d_a|, |d_b|) / h`` (d_a, d_b: distances of its far
+vertices, the next front vertices, from the plane normal to the opening direction n; h:
+the mean edge length at v), ten times more if it would make a crack branch; tetrahedra
+wholly on one side of the plane, tetrahedra holding a crack face aligned with the plane
+and the lips at front edges are fixed to their sides. The plane passes through v, or on a
+front at the mean level of the crack faces around v, so the crack continues at its own
+level. A part of a side that is disconnected from the side's largest part (ties: the part
+of the smaller tetrahedron) changes side, the minus side first, so both sides are
+connected; a refused cut falls back to the sides by centroid. The faces between the sides
+become crack faces. On a crack front (front edges through v) the existing crack faces are
+already cuts, and the new faces meet them where the front edges were: the front moves to
+the far edges of the new faces (flag ``closed``). Then:
 
 * pinched: a star already in pieces (crack faces all around) gets one copy per piece,
   without new faces;
 * refused (``none``): a side is empty (``empty``); v lies on a boundary (free surface or
   crack) and a side touches none of v's boundary faces, so that the new faces would close a
   cone around v (``enclosed``); the new faces would end inside the body at an edge through
-  v that was not a front edge (``dangling``);
+  v that was not a front edge (``dangling``); a side would be a piece of the mesh smaller
+  than the star, a pocket closed by earlier cracks (``pocket``);
 * far vertices: every vertex of the new faces whose star fell apart is split per piece
   (``far``): no two pieces are ever joined by a single vertex or a single edge;
 * fronts meeting a free surface, two fronts meeting, a crack meeting another (junction,
