@@ -12,6 +12,8 @@ __all__ = ["notched_bar_mesh", "bar3d", "FRONT_SPLITS"]
 
 #: the first pass of a load step may split this many front vertices before the step is cut
 FRONT_SPLITS = 1000
+import os
+SPLIT = os.environ.get("NGF_SPLIT", "all")
 
 
 def notched_bar_mesh(maxh, fine, length=2.0, width=1.0, thickness=0.5, notch=0.2, notch_width=0.02):
@@ -121,7 +123,7 @@ def bar3d(maxh=0.15, fine=None, strain_max=2e-3, dx=None, material=None, critica
                  radius=radius, load_description=BAR_LOAD,
                  # a front is many vertices that a load step overstresses together: each pass
                  # advances all of them (docs/solid.md)
-                 control={"split": "all", "max_new_cracks": FRONT_SPLITS},
+                 control={"split": SPLIT, "max_new_cracks": FRONT_SPLITS},
                  parameters={"maxh": maxh, "fine": fine, "strain_max": strain_max, "dx": dx, "critical": critical,
                              "radius": radius, "E": material.E, "nu": material.nu, "model": type(material).__name__,
                              "notch_depth": notch, "thickness": thickness})
