@@ -19,6 +19,8 @@ import pytest
 import pyvista as pv
 
 ARGS = ["run", "plate", "--maxh", "0.06", "--quiet", "--pictures", "none"]
+#: the notched bar on tetrahedra, coarse
+BAR3D_ARGS = ["run", "bar3d", "--maxh", "0.3", "--set", "radius=0.16", "--quiet", "--pictures", "none"]
 #: the plate from a coarse start, refined ahead of its crack tips (Scene.refine) in every step
 REFINED_ARGS = ["run", "plate", "--maxh", "0.1", "--set", "refine=true", "--quiet", "--pictures", "none"]
 
@@ -138,4 +140,19 @@ def test_kill_at_a_random_moment_resumes_to_the_same_result(reference, tmp_path,
                                  text=True))
     else:
         _finish(_start(out, tmp_path, resume=True))
+    _compare(out, reference)
+
+
+@pytest.mark.slow
+def test_a_3d_run_killed_during_a_checkpoint_write_resumes_to_the_same_result(tmp_path):
+    reference = tmp_path / "reference"
+    _finish(_start(reference, tmp_path, args=BAR3D_ARGS))
+    summary = json.loads((reference / "summary.json").read_text())
+    assert summary["n_split_vertices"] > 0 and summary["n_tetrahedra"] > 0
+    out = tmp_path / "run"
+    proc = _start(out, tmp_path, slow=2, args=BAR3D_ARGS)
+    assert proc.stdout.readline().strip() == "WRITING", proc.stderr.read()
+    proc.send_signal(signal.SIGKILL)
+    proc.wait()
+    _finish(_start(out, tmp_path, resume=True, args=BAR3D_ARGS))
     _compare(out, reference)

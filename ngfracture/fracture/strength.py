@@ -37,6 +37,8 @@ import math
 
 import numpy as np
 
+from ..geometry.solid import tet_volumes
+
 __all__ = ["weibull_mean", "weibull_variance", "tributary_areas", "weibull_strength", "field_digest",
            "check_weibull"]
 
@@ -108,27 +110,34 @@ def weibull_variance(m, scale):
 
 
 def tributary_areas(arrays, regions=None):
-    """A third of the area of the triangles around each vertex.
+    """A third of the area of the triangles around each vertex (3D: a quarter of the volume
+    of the tetrahedra; the size effect's areas are then volumes).
 
     Parameters
     ----------
-    arrays : ngfracture.geometry.meshio.MeshArrays
+    arrays : ngfracture.geometry.meshio.MeshArrays or SolidArrays
     regions : iterable of str, optional
-        Count only the triangles of these material regions (default all).
+        Count only the triangles (tetrahedra) of these material regions (default all).
 
     Returns
     -------
     numpy.ndarray, shape (nv,)
         0 for a vertex without a counted triangle.
     """
-    p, t = arrays.points, arrays.triangles
-    d1, d2 = p[t[:, 1]] - p[t[:, 0]], p[t[:, 2]] - p[t[:, 0]]
-    area = 0.5 * np.abs(d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0])
+    p = arrays.points
+    if arrays.dim == 3:
+        t = arrays.tets
+        area = np.abs(tet_volumes(p, t))
+    else:
+        t = arrays.triangles
+        d1, d2 = p[t[:, 1]] - p[t[:, 0]], p[t[:, 2]] - p[t[:, 0]]
+        area = 0.5 * np.abs(d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0])
     if regions is not None:
         wanted = [i for i, n in enumerate(arrays.region_names, start=1) if n in set(regions)]
         area = np.where(np.isin(arrays.regions, wanted), area, 0.0)
     out = np.zeros(len(p))
-    np.add.at(out, t.ravel(), np.repeat(area / 3, 3))    # unbuffered, in index order: deterministic
+    k = t.shape[1]
+    np.add.at(out, t.ravel(), np.repeat(area / k, k))    # unbuffered, in index order: deterministic
     return out
 
 

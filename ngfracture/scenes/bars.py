@@ -4,6 +4,7 @@ from netgen.csg import CSGeometry, OrthoBrick, Plane, Pnt, Vec
 import netgen.meshing as nm
 import ngsolve as ng
 
+from ..fracture.strength import scene_strength
 from ..mechanics.materials import StVenantKirchhoff
 from ..run.scene import Scene
 from .common import BAR_LOAD, BAR_RADIUS, GLASS, positive
@@ -64,7 +65,8 @@ def notched_bar_mesh(maxh, fine, length=2.0, width=1.0, thickness=0.5, notch=0.2
 
 
 def bar3d(maxh=0.15, fine=None, strain_max=2e-3, dx=None, material=None, critical=GLASS["critical"],
-          E=GLASS["E"], nu=GLASS["nu"], radius=BAR_RADIUS, notch=0.2, thickness=0.5):
+          E=GLASS["E"], nu=GLASS["nu"], radius=BAR_RADIUS, notch=0.2, thickness=0.5,
+          weibull_m=None, weibull_scale=None, weibull_area=None, seed=None):
     """A notched glass bar pulled along its axis: one crack across the ligament (3D).
 
     A 2 x 1 x ``thickness`` bar of glass (St Venant-Kirchhoff, E = 5 GPa, nu = 0.18) with a
@@ -93,6 +95,10 @@ def bar3d(maxh=0.15, fine=None, strain_max=2e-3, dx=None, material=None, critica
         Critical distance of the crack criterion.
     notch, thickness : float
         Notch depth and bar thickness (the width is 1).
+    weibull_m, weibull_scale, weibull_area, seed
+        Random strength, see :func:`ngfracture.fracture.strength.scene_strength` (in 3D the
+        size effect's reference is a volume): a Weibull modulus (None: uniform strength),
+        the scale (default: mean = ``critical``), the reference volume, the seed (default 0).
 
     Returns
     -------
@@ -110,6 +116,8 @@ def bar3d(maxh=0.15, fine=None, strain_max=2e-3, dx=None, material=None, critica
     material = material if material is not None else StVenantKirchhoff(E, nu)
     dx = positive("dx", dx) if dx is not None else 2 * critical / 5
     corners = _left_corners(mesh)
+    strength, strength_parameters = scene_strength(mesh, ["glass"], critical, weibull_m, weibull_scale,
+                                                   weibull_area, seed)
 
     def apply_load(prob, x):
         prob.add_dirichlet("left", 0.0, component="x")
@@ -126,7 +134,8 @@ def bar3d(maxh=0.15, fine=None, strain_max=2e-3, dx=None, material=None, critica
                  control={"split": SPLIT, "max_new_cracks": FRONT_SPLITS},
                  parameters={"maxh": maxh, "fine": fine, "strain_max": strain_max, "dx": dx, "critical": critical,
                              "radius": radius, "E": material.E, "nu": material.nu, "model": type(material).__name__,
-                             "notch_depth": notch, "thickness": thickness})
+                             "notch_depth": notch, "thickness": thickness, **strength_parameters},
+                 strength=strength)
 
 
 def _left_corners(mesh):

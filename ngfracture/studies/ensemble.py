@@ -111,10 +111,11 @@ def sample_record(summary, index, seed):
     return {"index": index, "seed": seed, "reason": summary["reason"],
             "ok": summary["reason"] in ("load_max", "max_steps", "broken"),
             "steps": summary["n_steps"], "split_vertices": summary["n_split_vertices"],
-            "fragments": summary["n_fragments"], "crack_length": summary["crack_length"],
+            "fragments": summary["n_fragments"],
+            **{k: summary[k] for k in ("crack_length", "crack_area") if k in summary},
             "peak_load": load, "load_at_peak": at,
             "peak_energy": max((h["elastic_energy"] for h in summary["history"]), default=0.0),
-            "fragment_areas": summary["fragment_areas"],
+            **{k: summary[k] for k in ("fragment_areas", "fragment_volumes") if k in summary},
             "timings": {"run": summary["timings"]["wall"]}}
 
 
@@ -407,7 +408,7 @@ class Ensemble:
     def _report(self, samples):
         from .statistics import fit_fragment_sizes, fragment_size_statistics, summary_with_interval
         done = [s for s in samples if s["ok"]]
-        areas = [s["fragment_areas"] for s in done]
+        areas = [s["fragment_volumes"] if "fragment_volumes" in s else s["fragment_areas"] for s in done]   # 3D: volumes
         pooled = np.concatenate([np.asarray(a, dtype=float) for a in areas]) if areas else np.zeros(0)
         return {"format": FORMAT, "scene": self.request["scene"], "parameters": self.request["parameters"],
                 "seeds": self.seeds, "options": self.request["options"],
