@@ -42,7 +42,7 @@ def solid_crack_pass(stepper, prob, x, strength, tensors, largest, timings):
     CrackPass
     """
     t0 = time.perf_counter()
-    res = split_by_tensor_3d(prob.arrays, tensors, 1.0, one=stepper.control.split == "one")
+    res = split_by_tensor_3d(prob.arrays, tensors, 1.0, mode=stepper.control.split)
     timings.add("split", time.perf_counter() - t0)
     if res.nsplit == 0:
         return CrackPass(None, 0, strength, None, np.zeros((0, 3)), largest)
