@@ -3,7 +3,7 @@
 One pass reads::
 
     values, directions = principal_3d(tensors)          # largest principal value + direction
-    result = split_by_tensor_3d(arrays, tensors)         # the most overstressed vertex that splits
+    result = split_by_tensor_3d(arrays, tensors, mode="spread")   # overstressed, no two neighbours
     u_new = transfer_vertex_field_3d(u, result)          # exact copy through the parent map
     mesh = solid_mesh(result.arrays)                     # netgen / NGSolve rebuild
 
@@ -19,7 +19,11 @@ Conventions (as in 2D, ``split.py``)
   name ``crack`` (added to ``bc_names`` if absent).
 * Vertices are processed in the given order and later vertices see the earlier splits.
   ``split_by_tensor_3d`` orders overstressed vertices by decreasing principal value, ties
-  by increasing vertex number; tensors are rows (xx, yy, zz, yz, xz, xy).
+  by increasing vertex number; tensors are rows (xx, yy, zz, yz, xz, xy). Its ``mode`` is
+  ``StepControl.split``'s: "one" stops after the first vertex that splits anything;
+  "spread" skips a vertex that shares an edge of the mesh as split so far with a vertex
+  split earlier in the pass or a copy of one (C++ ``skip_neighbours``; judged again after
+  the next equilibrium); "all" processes every overstressed vertex.
 
 Rules (docs/solid.md, "Node splitting in 3D")
 --------------------------------------------
