@@ -637,8 +637,23 @@ namespace ngfracture
     return flags;
   }
 
-  void TetSplitter :: Run (const int * order, const double * dirs, int n, bool first_only)
+  bool TetSplitter :: NextToSplit (int v, const std::vector<char> & split_input) const
   {
+    // the vertices of v's tetrahedra are the vertices sharing an edge with v; a copy of a
+    // split vertex has the same input vertex (parent)
+    const int * st = StarBegin(v);
+    for (int s = 0; s < StarSize(v); s++)
+      for (int k = 0; k < 4; k++)
+        {
+          int w = tets[4*size_t(st[s]) + k];
+          if (w != v && split_input[parent[w]]) return true;
+        }
+    return false;
+  }
+
+  void TetSplitter :: Run (const int * order, const double * dirs, int n, bool first_only, bool skip_neighbours)
+  {
+    std::vector<char> split_input(skip_neighbours ? nv0 : 0, 0);   // input vertices split in this run
     for (int k = 0; k < n; k++)
       {
         int v = order[k];
@@ -649,6 +664,7 @@ namespace ngfracture
         if (!(std::isfinite(d[0]) && std::isfinite(d[1]) && std::isfinite(d[2])) || (d[0] == 0 && d[1] == 0 && d[2] == 0))
           throw std::invalid_argument("ngfracture: the direction of vertex " + std::to_string(v) +
                                       " (entry " + std::to_string(k) + ") is zero or not finite");
+        if (skip_neighbours && NextToSplit(v, split_input)) { skipped.push_back(v); continue; }
         rec_vertex.push_back(v);
         rec_new_begin.push_back(int(rec_new.size()));
         int nf, before, after;
@@ -657,7 +673,9 @@ namespace ngfracture
         rec_faces.push_back(nf);
         rec_fronts_before.push_back(before);
         rec_fronts_after.push_back(after);
-        if (first_only && (flags & (SPLIT3_CUT | SPLIT3_PINCHED))) break;
+        bool split = (flags & (SPLIT3_CUT | SPLIT3_PINCHED)) != 0;
+        if (skip_neighbours && split) split_input[parent[v]] = 1;
+        if (first_only && split) break;
       }
     rec_new_begin.push_back(int(rec_new.size()));
   }

@@ -57,8 +57,11 @@ namespace ngfracture
 
     // Process vertices in the given order; dirs[3*i..3*i+2] is the opening direction of
     // order[i]. Vertex numbers refer to the mesh as split so far. first_only: stop after the
-    // first vertex that splits anything.
-    void Run (const int * order, const double * dirs, int n, bool first_only = false);
+    // first vertex that splits anything. skip_neighbours: a vertex that shares an edge (of
+    // the mesh as split so far) with a vertex split earlier in this run, or with a copy of
+    // one, is skipped (not processed, listed in skipped).
+    void Run (const int * order, const double * dirs, int n, bool first_only = false,
+              bool skip_neighbours = false);
 
     // Output faces (nf_out x 3) in the current vertex numbers: the input faces in their
     // order, then the new crack faces in creation order (two lips each, outward).
@@ -75,6 +78,7 @@ namespace ngfracture
     // record, one entry per processed vertex
     std::vector<int> rec_vertex, rec_flags, rec_faces, rec_fronts_before, rec_fronts_after;
     std::vector<int> rec_new_begin, rec_new;   // vertices created while processing entry i
+    std::vector<int> skipped;                  // vertices skipped by skip_neighbours, in order
 
     int NV () const { return int(parent.size()); }
 
@@ -113,6 +117,8 @@ namespace ngfracture
     // holding the smallest tetrahedron keeping lv
     void SplitGroups (const std::vector<int> & label, int ngroups);
     bool SplitPieces (int w);
+    // v shares an edge with a vertex whose input vertex is marked in split_input
+    bool NextToSplit (int v, const std::vector<char> & split_input) const;
     int ProcessVertex (int v, const double * n, int & nfaces, int & before, int & after);
     double Anchor (const double * n, const std::vector<std::array<int,2>> & pairs) const;
     int Classify (const double * n, double offset, std::vector<int> & side) const;

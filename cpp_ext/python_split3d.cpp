@@ -51,7 +51,7 @@ void ExportSplit3d (py::module & m)
 
   m.def("Split3dVertices",
         [] (darray points, iarray tets, iarray faces, iarray face_bc, int crack_bc, iarray vertices,
-            darray directions, bool first_only)
+            darray directions, bool first_only, bool skip_neighbours)
         {
           CheckShape("Split3dVertices", "points", points, 2, 3);
           CheckShape("Split3dVertices", "tets", tets, 2, 4);
@@ -66,7 +66,7 @@ void ExportSplit3d (py::module & m)
             py::gil_scoped_release release;
             sp = std::make_unique<TetSplitter>(points.data(), int(points.shape(0)), tets.data(), int(tets.shape(0)),
                                                faces.data(), face_bc.data(), int(faces.shape(0)), crack_bc);
-            sp->Run(vertices.data(), directions.data(), int(vertices.shape(0)), first_only);
+            sp->Run(vertices.data(), directions.data(), int(vertices.shape(0)), first_only, skip_neighbours);
           }
           py::dict rec;
           rec["vertex"] = ToNumpy(sp->rec_vertex);
@@ -83,10 +83,11 @@ void ExportSplit3d (py::module & m)
           r["face_bc"] = ToNumpy(sp->face_bc);
           r["parent"] = ToNumpy(sp->parent);
           r["record"] = rec;
+          r["skipped"] = ToNumpy(sp->skipped);
           return r;
         },
         py::arg("points"), py::arg("tets"), py::arg("faces"), py::arg("face_bc"), py::arg("crack_bc"),
-        py::arg("vertices"), py::arg("directions"), py::arg("first_only") = false,
+        py::arg("vertices"), py::arg("directions"), py::arg("first_only") = false, py::arg("skip_neighbours") = false,
         R"doc(Split vertices of a tetrahedral mesh one after the other (docs/solid.md).
 
 Parameters
@@ -107,13 +108,17 @@ directions : numpy.ndarray
     Shape (len(vertices), 3), the opening direction of each.
 first_only : bool
     Stop after the first vertex that splits anything.
+skip_neighbours : bool
+    Skip a vertex that shares an edge of the mesh as split so far with a vertex split
+    earlier in the call or with a copy of one (the 2D "spread" pass).
 
 Returns
 -------
 dict
     points, tets, faces, face_bc of the new mesh (input faces first, then the new crack
     faces, two lips each), parent (vertex of the input mesh of every vertex), record
-    (vertex, flags, faces, fronts_before, fronts_after, new_offsets, new_vertices).
+    (vertex, flags, faces, fronts_before, fronts_after, new_offsets, new_vertices) of the
+    processed vertices, skipped (the vertices skipped by skip_neighbours, in order).
 
 Raises
 ------

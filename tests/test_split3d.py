@@ -223,8 +223,8 @@ def test_split_by_tensor_and_determinism():
     assert np.array_equal(values, t[:, 2]) and np.array_equal(np.abs(dirs[plane]), np.tile(Z, (len(plane), 1)))
     one = s3.split_by_tensor_3d(a, t)
     assert list(one.record["vertex"]) == [plane[-1]] and one.nsplit == 1
-    r1 = s3.split_by_tensor_3d(a, t, one=False)
-    r2 = s3.split_by_tensor_3d(a, t, one=False)
+    r1 = s3.split_by_tensor_3d(a, t, mode="all")
+    r2 = s3.split_by_tensor_3d(a, t, mode="all")
     assert list(r1.record["vertex"]) == list(plane[::-1])
     for name in ("points", "tets", "faces", "face_bc"):
         assert np.array_equal(getattr(r1.arrays, name), getattr(r2.arrays, name))
@@ -245,3 +245,74 @@ def test_bad_input_is_named():
         s3.split_vertices_3d(a, [0, 0], [Z, Z])
     with pytest.raises(ValueError, match="tensors"):
         s3.split_by_tensor_3d(a, np.zeros((3, 6)))
+
+
+def input_neighbours(a):
+    """Vertex pairs sharing an edge (a tetrahedron) in the input mesh, as a set of (p, q), p < q."""
+    pairs = set()
+    for t in np.asarray(a.tets):
+        for i in range(4):
+            for j in range(i + 1, 4):
+                pairs.add((min(t[i], t[j]), max(t[i], t[j])))
+    return pairs
+
+
+def test_spread_pass_splits_no_two_neighbours_and_ends_planar():
+    a = cube_bar(4, 4, 4)
+    near = input_neighbours(a)
+    t = np.zeros((len(a.points), 6))
+    t[:, 2] = 0.5
+    plane = np.flatnonzero(a.points[:, 2] == 2.0)
+    t[plane, 2] = 1.05 + ((7 * np.arange(len(plane))) % len(plane)) / 100    # distinct, scattered order
+    order = plane[np.argsort(-t[plane, 2], kind="stable")]
+    r = s3.split_by_tensor_3d(a, t, mode="spread")
+    # the greedy rule on the input adjacency (on an uncracked mesh the split one's is the same)
+    done = []
+    for v in order:
+        if not any((min(v, w), max(v, w)) in near for w in done):
+            done.append(v)
+    assert list(r.record["vertex"]) == done
+    assert list(r.record["skipped"]) == [v for v in order if v not in done]
+    assert all("cut" in names(f) for f in r.record["flags"])
+    split = set(int(r.parent[v]) for v in r.record["new_vertices"]) & set(done)
+    assert split == set(done)
+    assert not any((p, q) in near for p in split for q in split if p < q)
+    check_invariants(a, r.arrays)
+    # the skipped ones, judged again pass after pass, finish the crack: planar, exactly the section
+    b, passes = r.arrays, 1
+    tb = s3.transfer_vertex_field_3d(t, r)
+    while True:
+        q = s3.split_by_tensor_3d(b, tb, mode="spread")
+        if not q.nsplit:
+            break
+        b, tb, passes = q.arrays, s3.transfer_vertex_field_3d(tb, q), passes + 1
+        assert passes <= len(plane)
+    check_invariants(a, b)
+    assert s3.fragments_3d(b).count == 2
+    assert crack_area(b) == pytest.approx(16.0, abs=1e-12)
+    assert np.all(b.points[b.boundary_faces("crack")][..., 2] == 2.0)
+    assert len(s3.front_edges_3d(b)) == 0
+    assert passes < len(done) + 1      # fewer passes than vertices split one at a time
+
+
+def test_spread_skips_a_neighbour_of_a_copy():
+    # cube_bar(2, 2, 2): the centre keeps its number below z = 1 (its smallest tetrahedron is
+    # in the first cube); the top centre then shares edges with its copy only
+    a = cube_bar(2, 2, 2)
+    centre = int(np.flatnonzero(np.all(a.points == 1.0, axis=1))[0])
+    top = int(np.flatnonzero(np.all(a.points == [1.0, 1.0, 2.0], axis=1))[0])
+    r = s3.split_vertices_3d(a, [centre], [Z])
+    copy = int(r.record["new_vertices"][0])
+    star = np.asarray(r.arrays.tets)[np.any(np.asarray(r.arrays.tets) == top, axis=1)]
+    assert copy in star and centre not in star
+    r = s3.split_vertices_3d(a, [centre, top], [Z, X], skip_neighbours=True)
+    assert list(r.record["vertex"]) == [centre] and list(r.record["skipped"]) == [top]
+    assert np.array_equal(r.record["direction"], [Z])
+    r = s3.split_vertices_3d(a, [centre, top], [Z, X])
+    assert list(r.record["vertex"]) == [centre, top] and len(r.record["skipped"]) == 0
+
+
+def test_split_mode_is_checked():
+    a = cube_bar(1, 1, 1)
+    with pytest.raises(ValueError, match="mode"):
+        s3.split_by_tensor_3d(a, np.zeros((len(a.points), 6)), mode="every")

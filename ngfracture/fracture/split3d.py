@@ -3,7 +3,7 @@
 One pass reads::
 
     values, directions = principal_3d(tensors)          # largest principal value + direction
-    result = split_by_tensor_3d(arrays, tensors)         # the most overstressed vertex that splits
+    result = split_by_tensor_3d(arrays, tensors, mode="spread")   # overstressed, no two neighbours
     u_new = transfer_vertex_field_3d(u, result)          # exact copy through the parent map
     mesh = solid_mesh(result.arrays)                     # netgen / NGSolve rebuild
 
@@ -19,7 +19,11 @@ Conventions (as in 2D, ``split.py``)
   name ``crack`` (added to ``bc_names`` if absent).
 * Vertices are processed in the given order and later vertices see the earlier splits.
   ``split_by_tensor_3d`` orders overstressed vertices by decreasing principal value, ties
-  by increasing vertex number; tensors are rows (xx, yy, zz, yz, xz, xy).
+  by increasing vertex number; tensors are rows (xx, yy, zz, yz, xz, xy). Its ``mode`` is
+  ``StepControl.split``'s: "one" stops after the first vertex that splits anything;
+  "spread" skips a vertex that shares an edge of the mesh as split so far with a vertex
+  split earlier in the pass or a copy of one (C++ ``skip_neighbours``; judged again after
+  the next equilibrium); "all" processes every overstressed vertex.
 
 Rules (docs/solid.md, "Node splitting in 3D")
 --------------------------------------------
@@ -65,7 +69,7 @@ from .. import _ngfracture as _ext
 from ..geometry.solid import SolidArrays, tet_volumes
 from .solid_criterion import principal_3d
 
-__all__ = ["SPLIT3D_FLAGS", "Split3dResult", "split_vertices_3d", "transfer_vertex_field_3d",
+__all__ = ["SPLIT3D_FLAGS", "SPLIT_MODES", "Split3dResult", "split_vertices_3d", "transfer_vertex_field_3d",
            "split_by_tensor_3d", "Fragments3d", "fragments_3d", "front_edges_3d",
            "pinched_vertices_3d", "flag_names_3d"]
 
@@ -123,7 +127,7 @@ def _crack_bc(arrays, crack_name):
     return names.index(crack_name) + 1, names
 
 
-def split_vertices_3d(arrays, vertices, directions, crack_name="crack", first_only=False):
+def split_vertices_3d(arrays, vertices, directions, crack_name="crack", first_only=False, skip_neighbours=False):
     """Split vertices one after the other across their opening directions.
 
     Parameters
@@ -139,11 +143,16 @@ def split_vertices_3d(arrays, vertices, directions, crack_name="crack", first_on
         Boundary name of the crack faces (new and existing).
     first_only : bool
         Stop after the first vertex that splits anything.
+    skip_neighbours : bool
+        Skip a vertex that shares an edge of the mesh as split so far with a vertex split
+        earlier in the pass, or with a copy of one (the "spread" pass): its strain predates
+        that split; it is judged again after the next equilibrium.
 
     Returns
     -------
     Split3dResult
-        ``result.arrays`` is the input itself when nothing was split.
+        ``result.arrays`` is the input itself when nothing was split; ``record["skipped"]``
+        lists the vertices skipped (not processed) by ``skip_neighbours``.
 
     Raises
     ------
@@ -161,10 +170,12 @@ def split_vertices_3d(arrays, vertices, directions, crack_name="crack", first_on
         raise ValueError("ngfracture.fracture.split3d: a vertex appears twice in the processing order")
     bc, names = _crack_bc(arrays, crack_name)
     r = _ext.Split3dVertices(np.asarray(arrays.points, dtype=float), np.asarray(arrays.tets), np.asarray(arrays.faces),
-                             np.asarray(arrays.face_bc), bc, v, d, bool(first_only))
+                             np.asarray(arrays.face_bc), bc, v, d, bool(first_only), bool(skip_neighbours))
     rec = {k: np.asarray(x) for k, x in dict(r["record"]).items()}
     nv = len(arrays.points)
-    rec["direction"] = d[:len(rec["vertex"])].copy()
+    processed = np.isin(v, rec["vertex"])
+    rec["direction"] = d[processed].copy()
+    rec["skipped"] = np.asarray(r["skipped"], dtype=np.int64)
     rec["nv_old"] = nv
     if len(r["parent"]) == nv:
         return Split3dResult(arrays, np.arange(nv), rec)
@@ -200,7 +211,11 @@ def transfer_vertex_field_3d(values, result):
     return a[result.parent]
 
 
-def split_by_tensor_3d(arrays, tensors, critical=1.0, one=True, crack_name="crack"):
+#: the split modes of a pass, as ``StepControl.split``
+SPLIT_MODES = ("one", "spread", "all")
+
+
+def split_by_tensor_3d(arrays, tensors, critical=1.0, mode="one", crack_name="crack"):
     """One splitting pass from a vertex tensor field.
 
     Parameters
@@ -211,10 +226,12 @@ def split_by_tensor_3d(arrays, tensors, critical=1.0, one=True, crack_name="crac
         Shape (nv, 6), rows (xx, yy, zz, yz, xz, xy), e.g. an overstrain (> 1 cracks).
     critical : float
         Finite, > 0: vertices whose largest principal value exceeds it are overstressed.
-    one : bool
-        True: only the most overstressed vertex that splits anything is split (the vertices
-        before it, which split nothing, are in the record), as ``StepControl.split="one"``
-        in 2D. False: every overstressed vertex, by decreasing principal value.
+    mode : {"one", "spread", "all"}
+        Which overstressed vertices the pass splits, in decreasing order of principal value
+        (``StepControl.split``): "one" only the first that splits anything (the vertices
+        before it, which split nothing, are in the record); "spread" every one that shares
+        no edge with a vertex split earlier in the pass (``record["skipped"]`` lists the
+        others); "all" every one.
     crack_name : str
         Boundary name of the crack faces.
 
@@ -226,18 +243,21 @@ def split_by_tensor_3d(arrays, tensors, critical=1.0, one=True, crack_name="crac
     Raises
     ------
     ValueError
-        Wrong tensor shape, NaN values, critical <= 0 or not finite.
+        Wrong tensor shape, NaN values, critical <= 0 or not finite, an unknown mode.
     """
     c = float(critical)
     if not (math.isfinite(c) and c > 0):
         raise ValueError(f"ngfracture.fracture.split3d: critical must be finite and > 0, got {critical!r}")
+    if mode not in SPLIT_MODES:
+        raise ValueError(f"ngfracture.fracture.split3d: mode must be one of {SPLIT_MODES}, got {mode!r}")
     t = np.asarray(tensors, dtype=float)
     if t.shape != (len(arrays.points), 6):
         raise ValueError(f"ngfracture.fracture.split3d: tensors must have shape ({len(arrays.points)}, 6), got {t.shape}")
     values, dirs = principal_3d(t)
     over = np.flatnonzero(values > c)
     order = over[np.lexsort((over, -values[over]))]
-    res = split_vertices_3d(arrays, order, dirs[order], crack_name, first_only=one)
+    res = split_vertices_3d(arrays, order, dirs[order], crack_name, first_only=mode == "one",
+                            skip_neighbours=mode == "spread")
     res.record["principal"] = values[res.record["vertex"]]
     return res
 

@@ -1,9 +1,11 @@
 """A crack pass on a tetrahedral mesh: the 3D counterpart of ``LoadStep.crack_pass``.
 
 The overstrain tensors come from the scene's criterion (``Criterion.overstrain``, which
-judges tetrahedra in 3D); the 3D engine (:mod:`ngfracture.fracture.split3d`) splits the
-most overstressed vertex that splits anything (``StepControl.split="one"``) or every
-overstressed vertex; the displacement and the strength are copied to the new vertices
+judges tetrahedra in 3D); the 3D engine (:mod:`ngfracture.fracture.split3d`) splits them
+as ``StepControl.split`` says: "one" (the most overstressed vertex that splits anything),
+"spread" (in decreasing order, skipping those that share an edge with a vertex split
+earlier in the pass; the 3D scenes' default, docs/solid.md "Crack passes in 3D") or "all";
+the displacement and the strength are copied to the new vertices
 through the parent map, exactly. The bordered factorisation of 2D crack passes is not
 used: every split mesh is factorised afresh.
 """
@@ -42,7 +44,7 @@ def solid_crack_pass(stepper, prob, x, strength, tensors, largest, timings):
     CrackPass
     """
     t0 = time.perf_counter()
-    res = split_by_tensor_3d(prob.arrays, tensors, 1.0, one=stepper.control.split == "one")
+    res = split_by_tensor_3d(prob.arrays, tensors, 1.0, mode=stepper.control.split)
     timings.add("split", time.perf_counter() - t0)
     if res.nsplit == 0:
         return CrackPass(None, 0, strength, None, np.zeros((0, 3)), largest)

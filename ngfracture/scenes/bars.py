@@ -9,12 +9,12 @@ from ..mechanics.materials import StVenantKirchhoff
 from ..run.scene import Scene
 from .common import BAR_LOAD, BAR_RADIUS, GLASS, positive
 
-__all__ = ["notched_bar_mesh", "bar3d", "FRONT_SPLITS"]
+__all__ = ["notched_bar_mesh", "bar3d", "FRONT_SPLITS", "SPLIT_3D"]
 
 #: the first pass of a load step may split this many front vertices before the step is cut
 FRONT_SPLITS = 1000
-import os
-SPLIT = os.environ.get("NGF_SPLIT", "all")
+#: the split mode of the 3D scenes' crack passes (docs/solid.md, "Crack passes in 3D")
+SPLIT_3D = "spread"
 
 
 def notched_bar_mesh(maxh, fine, length=2.0, width=1.0, thickness=0.5, notch=0.2, notch_width=0.02):
@@ -65,13 +65,13 @@ def notched_bar_mesh(maxh, fine, length=2.0, width=1.0, thickness=0.5, notch=0.2
 
 
 def bar3d(maxh=0.15, fine=None, strain_max=2e-3, dx=None, material=None, critical=GLASS["critical"],
-          E=GLASS["E"], nu=GLASS["nu"], radius=BAR_RADIUS, notch=0.2, thickness=0.5,
+          E=GLASS["E"], nu=GLASS["nu"], radius=BAR_RADIUS, notch=0.2, thickness=0.5, length=2.0,
           weibull_m=None, weibull_scale=None, weibull_area=None, seed=None):
     """A notched glass bar pulled along its axis: one crack across the ligament (3D).
 
-    A 2 x 1 x ``thickness`` bar of glass (St Venant-Kirchhoff, E = 5 GPa, nu = 0.18) with a
-    through-thickness edge notch of depth ``notch`` at mid-length. Both ends glide: u_x = 0
-    at x = 0 and u_x = x at x = 2, the other components free; the three rigid modes this
+    A ``length`` x 1 x ``thickness`` bar of glass (St Venant-Kirchhoff, E = 5 GPa, nu = 0.18)
+    with a through-thickness edge notch of depth ``notch`` at mid-length. Both ends glide:
+    u_x = 0 at x = 0 and u_x = x at x = ``length``, the other components free; the three rigid modes this
     leaves (translations in y and z, rotation about the axis) are held at two corners of
     the left end. x is the extension of the bar.
 
@@ -82,7 +82,7 @@ def bar3d(maxh=0.15, fine=None, strain_max=2e-3, dx=None, material=None, critica
     fine : float, optional
         Mesh size within two of it of the mid-plane; default radius / 2.
     strain_max : float
-        Final mean strain x / 2 (the run stops once the bar is broken through).
+        Final mean strain x / length (the run stops once the bar is broken through).
     dx : float, optional
         First increment of x; default a fifth of the critical extension of the unnotched bar.
     material : Material, optional
@@ -93,8 +93,8 @@ def bar3d(maxh=0.15, fine=None, strain_max=2e-3, dx=None, material=None, critica
         Young's modulus (Pa) and Poisson's ratio.
     radius : float
         Critical distance of the crack criterion.
-    notch, thickness : float
-        Notch depth and bar thickness (the width is 1).
+    notch, thickness, length : float
+        Notch depth, bar thickness and length (the width is 1).
     weibull_m, weibull_scale, weibull_area, seed
         Random strength, see :func:`ngfracture.fracture.strength.scene_strength` (in 3D the
         size effect's reference is a volume): a Weibull modulus (None: uniform strength),
@@ -112,9 +112,10 @@ def bar3d(maxh=0.15, fine=None, strain_max=2e-3, dx=None, material=None, critica
     maxh, strain_max = positive("maxh", maxh), positive("strain_max", strain_max)
     radius = positive("radius", radius)
     fine = radius / 2 if fine is None else positive("fine", fine)
-    mesh = notched_bar_mesh(maxh, fine, thickness=thickness, notch=notch)
+    mesh = notched_bar_mesh(maxh, fine, thickness=thickness, notch=notch, length=length)
     material = material if material is not None else StVenantKirchhoff(E, nu)
-    dx = positive("dx", dx) if dx is not None else 2 * critical / 5
+    length = positive("length", length)
+    dx = positive("dx", dx) if dx is not None else length * critical / 5
     corners = _left_corners(mesh)
     strength, strength_parameters = scene_strength(mesh, ["glass"], critical, weibull_m, weibull_scale,
                                                    weibull_area, seed)
@@ -127,14 +128,15 @@ def bar3d(maxh=0.15, fine=None, strain_max=2e-3, dx=None, material=None, critica
         prob.add_point_constraint(corners[1], 0.0, component="z")
 
     return Scene(name="bar3d", mesh=mesh, material=material, critical=critical, apply_load=apply_load,
-                 load_max=2 * strain_max, dx=dx, contact_tol=1e-3 * fine, stop_when_unloaded=True,
+                 load_max=length * strain_max, dx=dx, contact_tol=1e-3 * fine, stop_when_unloaded=True,
                  radius=radius, load_description=BAR_LOAD,
                  # a front is many vertices that a load step overstresses together: each pass
-                 # advances all of them (docs/solid.md)
-                 control={"split": SPLIT, "max_new_cracks": FRONT_SPLITS},
+                 # advances those that share no edge (docs/solid.md, "Crack passes in 3D")
+                 control={"split": SPLIT_3D, "max_new_cracks": FRONT_SPLITS},
                  parameters={"maxh": maxh, "fine": fine, "strain_max": strain_max, "dx": dx, "critical": critical,
                              "radius": radius, "E": material.E, "nu": material.nu, "model": type(material).__name__,
-                             "notch_depth": notch, "thickness": thickness, **strength_parameters},
+                             "notch_depth": notch, "thickness": thickness, "length": length,
+                             **strength_parameters},
                  strength=strength)
 
 
