@@ -20,7 +20,8 @@ import pyvista as pv
 
 ARGS = ["run", "plate", "--maxh", "0.06", "--quiet", "--pictures", "none"]
 #: the notched bar on tetrahedra, coarse
-BAR3D_ARGS = ["run", "bar3d", "--maxh", "0.3", "--set", "radius=0.16", "--quiet", "--pictures", "none"]
+BAR3D_ARGS = ["run", "bar3d", "--maxh", "0.4", "--set", "radius=0.2", "--set", "thickness=0.25", "--quiet",
+              "--pictures", "none"]
 #: the plate from a coarse start, refined ahead of its crack tips (Scene.refine) in every step
 REFINED_ARGS = ["run", "plate", "--maxh", "0.1", "--set", "refine=true", "--quiet", "--pictures", "none"]
 

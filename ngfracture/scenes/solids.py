@@ -1,20 +1,25 @@
-"""A notched bar in tension: the 3D scene whose crack is one plane across the ligament."""
+"""The 3D scenes: a notched bar in tension (one crack plane across its ligament) and the
+paper's notched plate extruded to a thickness."""
 import numpy as np
 from netgen.csg import CSGeometry, OrthoBrick, Plane, Pnt, Vec
 import netgen.meshing as nm
+from netgen.occ import X, OCCGeometry, WorkPlane
 import ngsolve as ng
 
 from ..fracture.strength import scene_strength
 from ..mechanics.materials import StVenantKirchhoff
 from ..run.scene import Scene
-from .common import BAR_LOAD, BAR_RADIUS, GLASS, positive
+from .common import BAR_LOAD, BAR_RADIUS, GLASS, PLATE_LOAD, PLATE_RADIUS, positive
 
-__all__ = ["notched_bar_mesh", "bar3d", "FRONT_SPLITS", "SPLIT_3D"]
+__all__ = ["notched_bar_mesh", "bar3d", "extruded_plate_mesh", "plate3d", "FRONT_SPLITS", "SPLIT_3D"]
 
 #: the first pass of a load step may split this many front vertices before the step is cut
 FRONT_SPLITS = 1000
 #: the split mode of the 3D scenes' crack passes (docs/solid.md, "Crack passes in 3D")
 SPLIT_3D = "spread"
+#: the step control of the 3D scenes: a front is many vertices that a load step overstresses
+#: together; each pass advances those that share no edge (docs/solid.md, "Crack passes in 3D")
+FRONT_CONTROL = {"split": SPLIT_3D, "max_new_cracks": FRONT_SPLITS}
 
 
 def notched_bar_mesh(maxh, fine, length=2.0, width=1.0, thickness=0.5, notch=0.2, notch_width=0.02):
@@ -116,7 +121,7 @@ def bar3d(maxh=0.15, fine=None, strain_max=2e-3, dx=None, material=None, critica
     material = material if material is not None else StVenantKirchhoff(E, nu)
     length = positive("length", length)
     dx = positive("dx", dx) if dx is not None else length * critical / 5
-    corners = _left_corners(mesh)
+    corners = _corners(mesh, [[0.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
     strength, strength_parameters = scene_strength(mesh, ["glass"], critical, weibull_m, weibull_scale,
                                                    weibull_area, seed)
 
@@ -130,9 +135,7 @@ def bar3d(maxh=0.15, fine=None, strain_max=2e-3, dx=None, material=None, critica
     return Scene(name="bar3d", mesh=mesh, material=material, critical=critical, apply_load=apply_load,
                  load_max=length * strain_max, dx=dx, contact_tol=1e-3 * fine, stop_when_unloaded=True,
                  radius=radius, load_description=BAR_LOAD,
-                 # a front is many vertices that a load step overstresses together: each pass
-                 # advances those that share no edge (docs/solid.md, "Crack passes in 3D")
-                 control={"split": SPLIT_3D, "max_new_cracks": FRONT_SPLITS},
+                 control=FRONT_CONTROL,
                  parameters={"maxh": maxh, "fine": fine, "strain_max": strain_max, "dx": dx, "critical": critical,
                              "radius": radius, "E": material.E, "nu": material.nu, "model": type(material).__name__,
                              "notch_depth": notch, "thickness": thickness, "length": length,
@@ -140,7 +143,118 @@ def bar3d(maxh=0.15, fine=None, strain_max=2e-3, dx=None, material=None, critica
                  strength=strength)
 
 
-def _left_corners(mesh):
-    """The vertices at the left end's corners (0, 0, 0) and (0, 1, 0)."""
+def _corners(mesh, points):
+    """The vertices nearest the given points (corners of the mesh)."""
     P = mesh.ngmesh.Coordinates()
-    return [int(np.argmin(np.linalg.norm(P - q, axis=1))) for q in ([0.0, 0.0, 0.0], [0.0, 1.0, 0.0])]
+    return [int(np.argmin(np.linalg.norm(P - q, axis=1))) for q in points]
+
+
+def extruded_plate_mesh(maxh, fine, thickness, width=1.0, height=1.0, notch_depth=0.04, notch_width=0.02):
+    """The paper's V-notched plate (``plates.notched_plate_mesh``) extruded along z, by netgen's OCC.
+
+    Boundaries ``left`` (x = 0), ``right`` (x = width) and ``side`` (the rest: top and bottom
+    with their notches, the faces z = 0 and z = thickness); region ``plate``. The mesh is
+    ``fine`` on the plane x = width / 2 between the notch tips (where the crack runs),
+    ``maxh`` elsewhere.
+
+    Parameters
+    ----------
+    maxh, fine, thickness : float
+        Mesh sizes away from and on the crack's plane, the plate's thickness (> 0).
+    width, height, notch_depth, notch_width : float
+        As for the 2D plate.
+
+    Returns
+    -------
+    ngsolve.Mesh
+
+    Raises
+    ------
+    ValueError
+        A size that is not a finite number > 0, or notches that do not fit.
+    """
+    maxh, fine, T = positive("maxh", maxh), positive("fine", fine), positive("thickness", thickness)
+    W, H, d, w = (positive(n, v) for n, v in (("width", width), ("height", height), ("notch_depth", notch_depth),
+                                              ("notch_width", notch_width)))
+    if d >= H / 2 or w >= W:
+        raise ValueError(f"the notches (depth {d}, width {w}) do not fit the {W} x {H} plate")
+    c = W / 2
+    corners = [(0, 0), (c - w / 2, 0), (c, d), (c + w / 2, 0), (W, 0), (W, H), (c + w / 2, H), (c, H - d),
+               (c - w / 2, H), (0, H)]
+    wp = WorkPlane()
+    wp.MoveTo(*corners[0])
+    for p in corners[1:]:
+        wp.LineTo(*p)
+    solid = wp.Close().Face().Extrude(T)
+    for f in solid.faces:
+        f.name = "side"
+    solid.faces.Min(X).name = "left"
+    solid.faces.Max(X).name = "right"
+    solid.mat("plate")
+    mp = nm.MeshingParameters(maxh=maxh)
+    for y in np.arange(d, H - d + fine / 2, fine):
+        for z in np.arange(0.0, T + fine / 2, fine):
+            mp.RestrictH(x=c, y=y, z=z, h=fine)
+    return ng.Mesh(OCCGeometry(solid).GenerateMesh(mp=mp))
+
+
+def plate3d(maxh=0.1, fine=None, thickness=0.2, strain_max=1e-3, dx=None, material=None, critical=GLASS["critical"],
+            E=GLASS["E"], nu=GLASS["nu"], radius=PLATE_RADIUS):
+    """The paper's notched plate (Fig. 8) extruded to a thickness, on tetrahedra.
+
+    The plate of :func:`ngfracture.scenes.plate` (1 x 1, V-notches 0.04 deep in the middle
+    of the top and bottom edges, glass, St Venant-Kirchhoff) as a 3D body of ``thickness``:
+    the left and right faces glide apart, u_x = -x/2 and +x/2; the three rigid modes this
+    leaves (translations in y and z, rotation about x) are held at two corners of the left
+    face. A thin plate is near plane stress, a thick one near plane strain in its middle.
+
+    Parameters
+    ----------
+    maxh : float
+        Mesh size away from the crack's plane.
+    fine : float, optional
+        Mesh size on the plane between the notch tips; default radius / 2.
+    thickness : float
+        Along z.
+    strain_max : float
+        Final mean strain x (the run stops once the plate is broken through).
+    dx : float, optional
+        First increment; default a tenth of the critical strain.
+    material : Material, optional
+        Replaces the St Venant-Kirchhoff material of ``E`` and ``nu``.
+    critical : float
+        Critical principal strain.
+    E, nu : float
+        Young's modulus (Pa) and Poisson's ratio.
+    radius : float
+        Critical distance of the crack criterion (the 2D plate's by default).
+
+    Returns
+    -------
+    Scene
+
+    Raises
+    ------
+    ValueError
+        A parameter that is not a finite number > 0.
+    """
+    maxh, strain_max, radius = positive("maxh", maxh), positive("strain_max", strain_max), positive("radius", radius)
+    fine = radius / 2 if fine is None else positive("fine", fine)
+    mesh = extruded_plate_mesh(maxh, fine, thickness)
+    material = material if material is not None else StVenantKirchhoff(E, nu)
+    dx = positive("dx", dx) if dx is not None else critical / 10
+    corners = _corners(mesh, [[0.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+
+    def apply_load(prob, x):
+        prob.add_dirichlet("left", -x / 2, component="x")
+        prob.add_dirichlet("right", x / 2, component="x")
+        prob.add_point_constraint(corners[0], 0.0, component="y")
+        prob.add_point_constraint(corners[0], 0.0, component="z")
+        prob.add_point_constraint(corners[1], 0.0, component="z")
+
+    return Scene(name="plate3d", mesh=mesh, material=material, critical=critical, apply_load=apply_load,
+                 load_max=strain_max, dx=dx, contact_tol=1e-3 * fine, stop_when_unloaded=True, radius=radius,
+                 load_description=PLATE_LOAD, control=FRONT_CONTROL,
+                 parameters={"maxh": maxh, "fine": fine, "thickness": thickness, "strain_max": strain_max, "dx": dx,
+                             "critical": critical, "radius": radius, "E": material.E, "nu": material.nu,
+                             "model": type(material).__name__, "notch_depth": 0.04, "notch_width": 0.02})
