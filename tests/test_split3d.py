@@ -12,6 +12,7 @@ import ngsolve
 import pytest
 from netgen.csg import CSGeometry, OrthoBrick, Pnt
 
+from ngfracture.fracture.split import transfer_vertex_field
 from ngfracture.fracture import split3d as s3
 from ngfracture.geometry.solid import solid_mesh, solid_to_arrays, tet_volumes, total_volume
 from split3d_util import check_twins, crack_area, crack_pieces, cube_bar, min_face_surface
@@ -60,7 +61,7 @@ def test_structured_bar_splits_in_two_across_its_mid_plane():
     # the tensor field's transfer is an exact copy
     r = s3.split_vertices_3d(a, plane[:1], [Z])
     u = np.arange(3 * len(a.points), dtype=float).reshape(-1, 3)
-    assert np.array_equal(s3.transfer_vertex_field_3d(u, r), u[r.parent])
+    assert np.array_equal(transfer_vertex_field(u, r), u[r.parent])
 
 
 def grow_across_plane(a, normal, centre):
@@ -280,12 +281,12 @@ def test_spread_pass_splits_no_two_neighbours_and_ends_planar():
     check_invariants(a, r.arrays)
     # the skipped ones, judged again pass after pass, finish the crack: planar, exactly the section
     b, passes = r.arrays, 1
-    tb = s3.transfer_vertex_field_3d(t, r)
+    tb = transfer_vertex_field(t, r)
     while True:
         q = s3.split_by_tensor_3d(b, tb, mode="spread")
         if not q.nsplit:
             break
-        b, tb, passes = q.arrays, s3.transfer_vertex_field_3d(tb, q), passes + 1
+        b, tb, passes = q.arrays, transfer_vertex_field(tb, q), passes + 1
         assert passes <= len(plane)
     check_invariants(a, b)
     assert s3.fragments_3d(b).count == 2

@@ -4,7 +4,7 @@ One pass reads::
 
     values, directions = principal_3d(tensors)          # largest principal value + direction
     result = split_by_tensor_3d(arrays, tensors, mode="spread")   # overstressed, no two neighbours
-    u_new = transfer_vertex_field_3d(u, result)          # exact copy through the parent map
+    u_new = split.transfer_vertex_field(u, result)       # exact copy through the parent map
     mesh = solid_mesh(result.arrays)                     # netgen / NGSolve rebuild
 
 Conventions (as in 2D, ``split.py``)
@@ -69,7 +69,7 @@ from .. import _ngfracture as _ext
 from ..geometry.solid import SolidArrays, tet_volumes
 from .solid_criterion import principal_3d
 
-__all__ = ["SPLIT3D_FLAGS", "SPLIT_MODES", "Split3dResult", "split_vertices_3d", "transfer_vertex_field_3d",
+__all__ = ["SPLIT3D_FLAGS", "SPLIT_MODES", "Split3dResult", "split_vertices_3d",
            "split_by_tensor_3d", "Fragments3d", "fragments_3d", "front_edges_3d",
            "pinched_vertices_3d", "flag_names_3d"]
 
@@ -182,33 +182,6 @@ def split_vertices_3d(arrays, vertices, directions, crack_name="crack", first_on
     new = replace(arrays, points=r["points"], tets=r["tets"].astype(np.int64), faces=r["faces"].astype(np.int64),
                   face_bc=r["face_bc"].astype(np.int64), bc_names=names)
     return Split3dResult(new, r["parent"].astype(np.int64), rec)
-
-
-def transfer_vertex_field_3d(values, result):
-    """Carry a vertex field to the split mesh: ``values[parent]`` (exact, no interpolation).
-
-    Parameters
-    ----------
-    values : numpy.ndarray
-        Shape (nv_old, ...).
-    result : Split3dResult
-        The pass that made the new mesh.
-
-    Returns
-    -------
-    numpy.ndarray
-        Shape (nv_new, ...).
-
-    Raises
-    ------
-    ValueError
-        If values does not have one row per vertex of the old mesh.
-    """
-    a = np.asarray(values)
-    if a.ndim == 0 or a.shape[0] != result.record["nv_old"]:
-        raise ValueError(f"ngfracture.fracture.split3d: the field has shape {a.shape}, the old mesh has "
-                         f"{result.record['nv_old']} vertices")
-    return a[result.parent]
 
 
 #: the split modes of a pass, as ``StepControl.split``

@@ -13,7 +13,8 @@ import time
 
 import numpy as np
 
-from ..fracture.split3d import split_by_tensor_3d, transfer_vertex_field_3d
+from ..fracture.split import transfer_vertex_field
+from ..fracture.split3d import split_by_tensor_3d
 from ..geometry.solid import solid_mesh
 from .records import CrackPass
 
@@ -51,9 +52,9 @@ def solid_crack_pass(stepper, prob, x, strength, tensors, largest, timings):
     made = np.diff(res.record["new_offsets"]) > 0
     positions = prob.arrays.points[res.record["vertex"][made]]
     # P1: the displacement is a vertex field (component-major), copied through the split
-    u = transfer_vertex_field_3d(prob.u.vec.FV().NumPy().reshape(3, -1).T, res).T.reshape(-1)
+    u = transfer_vertex_field(prob.u.vec.FV().NumPy().reshape(3, -1).T, res).T.reshape(-1)
     if strength is not None:
-        strength = transfer_vertex_field_3d(strength, res)    # copies inherit the vertex's strength
+        strength = transfer_vertex_field(strength, res)    # copies inherit the vertex's strength
     with timings.timed("rebuild"):
         mesh = solid_mesh(res.arrays)
     split = stepper.problem(mesh, x, timings, u, check_mesh=False)
