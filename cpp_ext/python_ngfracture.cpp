@@ -32,7 +32,7 @@ struct KernelInput
       lam(l.shape(0), const_cast<double*>(l.data())), kind(k.shape(0), const_cast<int*>(k.data()))
   {
     if (p.ndim() != 2 || t.ndim() != 2 || uu.ndim() != 1 || k.ndim() != 1 || m.ndim() != 1 || l.ndim() != 1)
-      throw Exception(std::string("ngfracture.") + name + ": points and triangles must be 2D arrays, "
+      throw Exception(std::string("ngfracture.") + name + ": points and elements must be 2D arrays, "
                       "u, kind, mu and lam 1D");
   }
 };
@@ -40,9 +40,9 @@ struct KernelInput
 static void ExportInternalForces (py::module & m)
 {
   m.def("InternalForces",
-        [] (Doubles points, Ints triangles, Doubles u, Ints kind, Doubles mu, Doubles lam)
+        [] (Doubles points, Ints elements, Doubles u, Ints kind, Doubles mu, Doubles lam)
         {
-          KernelInput in("InternalForces", points, triangles, u, kind, mu, lam);
+          KernelInput in("InternalForces", points, elements, u, kind, mu, lam);
           py::array_t<double> out(u.shape(0));
           FlatVector<double> F(out.shape(0), out.mutable_data());
           {
@@ -51,36 +51,43 @@ static void ExportInternalForces (py::module & m)
           }
           return out;
         },
-        py::arg("points"), py::arg("triangles"), py::arg("u"), py::arg("kind"), py::arg("mu"), py::arg("lam"),
-        R"doc(Internal nodal forces of P1 triangles: f_a = sum_T |T| P(grad u) grad N_a.
+        py::arg("points"), py::arg("elements"), py::arg("u"), py::arg("kind"), py::arg("mu"), py::arg("lam"),
+        R"doc(Internal nodal forces of P1 triangles or tetrahedra: f_a = sum_T |T| P(grad u) grad N_a.
 
 Parameters
 ----------
 points : numpy.ndarray
-    Shape (nv, 2), reference coordinates.
-triangles : numpy.ndarray of int
-    Shape (ne, 3), vertex numbers.
+    Shape (nv, d), reference coordinates; d = 2 (triangles) or 3 (tetrahedra).
+elements : numpy.ndarray of int
+    Shape (ne, d + 1), vertex numbers (the width must match the points').
 u : numpy.ndarray
-    Shape (2 nv,): x components of every vertex, then y (VectorH1 order 1 layout).
+    Shape (d nv,): x components of every vertex, then y, then z (VectorH1 order 1 layout).
 kind : numpy.ndarray of int
-    Per triangle: 0 linear, 1 St Venant-Kirchhoff, 2 neo-Hooke.
+    Per element: 0 linear, 1 St Venant-Kirchhoff, 2 neo-Hooke.
 mu, lam : numpy.ndarray
-    Per triangle, the Lame parameters of its 2D reduction.
+    Per element, the Lame parameters (of the 2D reduction on triangles, the 3D ones on
+    tetrahedra).
 
 Returns
 -------
 numpy.ndarray
-    Shape (2 nv,), the gradient of the strain energy (NaN where a neo-Hooke element has
+    Shape (d nv,), the gradient of the strain energy (NaN where a neo-Hooke element has
     det F <= 0).
+
+Raises
+------
+Exception
+    On widths that are not (2, 3) or (3, 4), a u of the wrong size, per-element arrays of
+    the wrong length, or a vertex number out of range.
 )doc");
 }
 
 static void ExportTangentStiffness (py::module & m)
 {
   m.def("TangentStiffness",
-        [] (Doubles points, Ints triangles, Doubles u, Ints kind, Doubles mu, Doubles lam)
+        [] (Doubles points, Ints elements, Doubles u, Ints kind, Doubles mu, Doubles lam)
         {
-          KernelInput in("TangentStiffness", points, triangles, u, kind, mu, lam);
+          KernelInput in("TangentStiffness", points, elements, u, kind, mu, lam);
           Array<int> indptr, indices;
           Array<double> data;
           {
@@ -96,23 +103,28 @@ static void ExportTangentStiffness (py::module & m)
             };
           return py::make_tuple(copy(data), copy(indices), copy(indptr));
         },
-        py::arg("points"), py::arg("triangles"), py::arg("u"), py::arg("kind"), py::arg("mu"), py::arg("lam"),
-        R"doc(Tangent stiffness of P1 triangles, df/du of InternalForces, as CSR arrays.
+        py::arg("points"), py::arg("elements"), py::arg("u"), py::arg("kind"), py::arg("mu"), py::arg("lam"),
+        R"doc(Tangent stiffness of P1 triangles or tetrahedra, df/du of InternalForces, as CSR arrays.
 
 K_(a i),(b k) = sum_T |T| dP_ij/dH_kl grad_j N_a grad_l N_b, H = grad u. Every pair of
-vertices of a triangle couples in both components (the sparsity of NGSolve's VectorH1
+vertices of an element couples in all components (the sparsity of NGSolve's VectorH1
 order 1 matrix); columns are sorted in every row and structural zeros kept.
 
 Parameters
 ----------
-points, triangles, u, kind, mu, lam
+points, elements, u, kind, mu, lam
     As for InternalForces.
 
 Returns
 -------
 (data, indices, indptr) : tuple of numpy.ndarray
-    The CSR arrays of the 2 nv x 2 nv matrix (component-major dofs), for
+    The CSR arrays of the d nv x d nv matrix (component-major dofs), for
     ``scipy.sparse.csr_matrix((data, indices, indptr))``.
+
+Raises
+------
+Exception
+    As InternalForces.
 )doc");
 }
 

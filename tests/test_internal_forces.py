@@ -137,9 +137,9 @@ def test_kernel_refuses_bad_shapes():
         _C.InternalForces(pts, tris, np.zeros(5), np.array([1], dtype=np.int32), one, one)
     with pytest.raises(Exception, match="out of range"):
         _C.InternalForces(pts, np.array([[0, 1, 3]], dtype=np.int32), np.zeros(6), np.array([1], dtype=np.int32), one, one)
-    with pytest.raises(Exception, match="one entry per triangle"):
+    with pytest.raises(Exception, match="one entry per element"):
         _C.InternalForces(pts, tris, np.zeros(6), np.array([1, 1], dtype=np.int32), one, one)
-    with pytest.raises(Exception, match="one entry per triangle"):
+    with pytest.raises(Exception, match="one entry per element"):
         _C.TangentStiffness(pts, tris, np.zeros(6), np.array([1, 1], dtype=np.int32), one, one)
     with pytest.raises(Exception, match="2 nv"):
         _C.TangentStiffness(pts, tris, np.zeros(5), np.array([1], dtype=np.int32), one, one)

@@ -371,19 +371,19 @@ class ElasticProblem:
         return r.copy()
 
     def _kernel_data(self):
-        """(kind, mu, lam per triangle, external load vector or None) for the C++ residual.
+        """(kind, mu, lam per element, external load vector or None) for the C++ residual.
 
         The same gradient of the same energy as NGSolve's Apply of the form (equal to
-        rounding, tests/test_internal_forces.py) at a twentieth of its cost: P1 gradients
-        are constant per triangle, so one evaluation per triangle is exact. None (Apply
-        is used) for order > 1 and for a material without a kernel law. The external loads
+        rounding, tests/test_internal_forces*.py) at a twentieth of its cost: P1 gradients
+        are constant per triangle or tetrahedron, so one evaluation per element is exact.
+        None (Apply is used) for order > 1 and for a material without a kernel law. The external loads
         are linear in u: their vector is assembled once and scaled by the load factor.
         """
         if self._internal is None:
             regions, names = self._regions
             laws = [self.materials[n] for n in names]
-            # the kernels are those of P1 triangles: tetrahedra take NGSolve's Apply
-            if self.order != 1 or self.dim != 2 or any(m.kernel is None for m in laws):
+            # the kernels are those of P1 triangles and tetrahedra (3D: the 3D Lame parameters)
+            if self.order != 1 or any(m.kernel is None for m in laws):
                 self._internal = False
             else:
                 r = regions - 1                   # 1-based region numbers
