@@ -1,5 +1,6 @@
 """Every benchmark takes ``--json FILE``, refuses an existing FILE before any work, and writes JSON."""
 import json
+import math
 import subprocess
 import sys
 from pathlib import Path
@@ -8,7 +9,8 @@ import pytest
 from conftest import child_env
 
 ROOT = Path(__file__).resolve().parent.parent
-BENCHMARKS = ["contact", "crack", "ensemble", "lshape", "meshcheck", "objectivity", "scenes", "schur"]
+BENCHMARKS = ["contact", "crack", "ensemble", "lshape", "meshcheck", "objectivity", "scenes", "schur",
+              "solid"]
 
 
 def run_benchmark(name, *args):
@@ -67,3 +69,35 @@ def test_scenes_benchmark_puts_the_adaptive_run_beside_the_uniform_one(tmp_path)
     pair = result["adaptive"]["plate"]
     assert pair["uniform_factor"] == 1 and pair["wall_ratio"] == adaptive["phases"]["wall"] / uniform["phases"]["wall"]
     assert pair["initiation_ratio"] is None          # two steps below the first crack
+
+
+def test_solid_benchmark_breaks_the_small_bar_and_reports_positive_ratios(tmp_path):
+    target = tmp_path / "solid.json"
+    r = run_benchmark("solid", "--quick", "--json", str(target))
+    assert r.returncode == 0, r.stderr
+    result = json.loads(target.read_text())
+    (case,) = result["cases"]
+    assert case["reason"] == "broken" and case["fragments"] == 2
+    assert case["dofs"] == 3 * case["vertices"] and case["tets"] > case["vertices"]
+    assert case["solver"] == "superlu"            # 1.1k dofs, below SUPERLU_MAX_DOFS
+    assert case["crack_passes"] >= case["steps"] >= 1
+    for key in ("wall", "t_unit", "solve_equivalents", "crack_work_ratio", "crack_work_per_pass_ratio",
+                "crack_area_ratio", "projected_area_ratio", "rss_peak_gib"):
+        assert math.isfinite(case[key]) and case[key] > 0, key
+    # the crack work is part of the run, and one pass's share of it part of the whole
+    assert case["crack_work"] < case["wall"]
+    assert case["crack_work_per_pass_ratio"] * case["crack_passes"] == \
+        pytest.approx(case["crack_work_ratio"], rel=1e-12)
+    # the two fragments hold the two ends: every line along x through the ligament meets the
+    # crack, so its projection covers the ligament; |n_x| <= 1: the area is at least that
+    assert case["crack_area_ratio"] >= case["projected_area_ratio"] * (1 - 1e-12)
+    assert case["projected_area_ratio"] >= 1 - 1e-12
+    assert case["rss_peak_gib"] >= case["rss_import_gib"]
+    assert result["growth"] is None               # one size: nothing to fit
+    assert set(result["targets"]) == {"crack_work_per_pass_ratio_at_200k", "crack_work_per_pass_exponent",
+                                      "solve_equivalents_at_100k", "rss_peak_gib_at_500k"}
+
+
+def test_solid_benchmark_refuses_a_bad_size_before_any_run(tmp_path):
+    r = run_benchmark("solid", "--sizes", "0.25/-1", "--json", str(tmp_path / "solid.json"))
+    assert r.returncode == 2 and "a size is MAXH/FINE or FINE with numbers > 0" in r.stderr
