@@ -221,19 +221,20 @@ def growth(cases):
 
 
 def targets(cases, fits):
-    """The issue's targets beside the nearest measured values (None where not measured)."""
-    near = lambda n: min(cases, key=lambda c: abs(math.log(c["tets"] / n)))
-    at100k = near(1e5)
-    large = [c for c in cases if c["tets"] >= 4e5]
+    """The issue's targets beside the measured values: a size's own within a factor 1.5 of
+    its tet count (None where no case is that near), the 200k ones from the fits."""
+    def near(n, key):
+        c = min(cases, key=lambda c: abs(math.log(c["tets"] / n)))
+        if abs(math.log(c["tets"] / n)) > math.log(1.5):
+            return {"tets": None, "measured": None, "reason": None}
+        return {"tets": c["tets"], "measured": c[key], "reason": c["reason"]}
     return {"crack_work_per_pass_ratio_at_200k": {"target": TARGETS["crack_work_per_pass_ratio_at_200k"],
                                                   "extrapolated": fits and fits["crack_work_per_pass_ratio_at_200k"]},
             "crack_work_per_pass_exponent": {"target": TARGETS["crack_work_per_pass_exponent"],
                                              "measured_seconds": fits and fits["crack_work_per_pass_exponent"]},
-            "solve_equivalents_at_100k": {"target": TARGETS["solve_equivalents_at_100k"], "tets": at100k["tets"],
-                                          "measured": at100k["solve_equivalents"], "reason": at100k["reason"]},
-            "rss_peak_gib_at_500k": {"target": TARGETS["rss_peak_gib_at_500k"],
-                                     "tets": large[-1]["tets"] if large else None,
-                                     "measured": large[-1]["rss_peak_gib"] if large else None}}
+            "solve_equivalents_at_100k": {"target": TARGETS["solve_equivalents_at_100k"],
+                                          **near(1e5, "solve_equivalents")},
+            "rss_peak_gib_at_500k": {"target": TARGETS["rss_peak_gib_at_500k"], **near(5e5, "rss_peak_gib")}}
 
 
 def main(argv=None):
