@@ -1,5 +1,6 @@
 // Python bindings of the crack engine: nodal strain, selection, node splitting + rebuild.
 #include <python_comp.hpp>
+#include "numpy_arrays.hpp"
 #include <chrono>
 #include "vertex_average.hpp"
 #include "crack_strain.hpp"
@@ -16,14 +17,6 @@ namespace
   using darray = py::array_t<double, py::array::c_style | py::array::forcecast>;
   using iarray = py::array_t<int, py::array::c_style | py::array::forcecast>;
 
-  template <typename T>
-  py::array_t<T> ToNumpy (const std::vector<T> & v, size_t width = 1)
-  {
-    size_t h = width ? v.size() / width : 0;
-    py::array_t<T> out = width == 1 ? py::array_t<T>(h) : py::array_t<T>({ h, width });
-    std::copy(v.begin(), v.end(), out.mutable_data());
-    return out;
-  }
 
   StrainMeasure ParseMeasure (const std::string & s)
   {

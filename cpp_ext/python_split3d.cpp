@@ -1,5 +1,6 @@
 // Python bindings of node splitting on tetrahedral meshes (crack_split3d).
 #include <python_comp.hpp>
+#include "numpy_arrays.hpp"
 #include "crack_split3d.hpp"
 
 namespace py = pybind11;
@@ -10,14 +11,6 @@ namespace
   using darray = py::array_t<double, py::array::c_style | py::array::forcecast>;
   using iarray = py::array_t<int, py::array::c_style | py::array::forcecast>;
 
-  template <typename T>
-  py::array_t<T> ToNumpy (const std::vector<T> & v, size_t width = 1)
-  {
-    size_t h = width ? v.size() / width : 0;
-    py::array_t<T> out = width == 1 ? py::array_t<T>(h) : py::array_t<T>({ h, width });
-    std::copy(v.begin(), v.end(), out.mutable_data());
-    return out;
-  }
 
   void CheckShape (const char * fn, const char * name, py::array & a, int ndim, py::ssize_t width, py::ssize_t rows = -1)
   {
