@@ -62,6 +62,9 @@ setup(
         "matplotlib",
         "pillow",          # final.png: a raster of the triangles (already a dependency of matplotlib)
         "threadpoolctl",   # one BLAS thread for the small dense solves (see README)
+        # 3D problems too large to factorise: smoothed-aggregation AMG with the rigid-body
+        # modes as near-null space, what elasticity needs (docs/solvers.md)
+        "pyamg",
         # ensembles of runs (ngfracture.ensemble): a maintained distributed engine with a
         # LocalCluster, rescheduling of the tasks of a dead worker, and cluster deployments
         # (dask-jobqueue, SSH, Kubernetes) instead of a home-made one

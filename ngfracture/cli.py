@@ -54,6 +54,9 @@ CONTROL_OPTIONS = [
                                      "or full"),
     ("tol", "float", "Newton tolerance (relative increment, paper eq. 7; default 1e-10)"),
     ("maxit", "int1", "Newton iterations per solve (default 60)"),
+    ("inverse", ("auto", "amg", "sparsecholesky", "superlu"),
+     "solver of the stiffness: auto (default; in 3D sparse Cholesky while its predicted memory fits the "
+     "budget, else amg), amg (CG with algebraic multigrid), or a direct factorisation"),
     ("cut", "float", "dx is multiplied by this after too many cracks or a failure (default 0.5)"),
     ("grow", "float", "dx is multiplied by this after --grow-after quiet steps (default 1.5)"),
     ("grow_after", "int1", "crack-free steps in a row before dx grows (default 2)"),

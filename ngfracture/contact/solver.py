@@ -60,9 +60,9 @@ class ContactResult:
         every Newton solve in turn.
     converged, reason, rounds, constraints, multipliers, released, max_penetration
         Initial values of the attributes of the same names (below).
-    timings, history, updates, lcp, notes, active_keys, tangent
+    timings, history, updates, lcp, notes, active_keys, tangent, factorisations
         Likewise; by default zero timings for the four phases, an empty history, 0, 0, no
-        notes, no keys, no tangent.
+        notes, no keys, no tangent, no factorisations.
 
     Attributes
     ----------
@@ -109,6 +109,8 @@ class ContactResult:
     tangent : ngfracture.mechanics.tangent.SavedTangent or None
         The factorisation the solve ended with (the lineage of a mesh split from this
         one, ``linalg.bordered.lineage``).
+    factorisations : list of dict
+        The solver choice of every K^+ its Newton solves made (SolveStatus.factorisations).
     """
     status: SolveStatus
     converged: bool = False
@@ -125,6 +127,7 @@ class ContactResult:
     notes: list = field(default_factory=list)
     active_keys: list = field(default_factory=list)
     tangent: object = None
+    factorisations: list = field(default_factory=list)
 
     def __bool__(self):
         return self.converged
@@ -303,6 +306,7 @@ class ContactSolver:
         t0 = time.perf_counter()
         status = self.problem.solve(tangent=tangent, increment_scale=increment_scale, **self.options)
         result.status = status
+        result.factorisations.extend(status.factorisations)
         result.notes.extend(n for n in status.notes if n not in result.notes)
         result.timings["solve"] += time.perf_counter() - t0
         for part, seconds in status.phase_seconds().items():
@@ -360,6 +364,7 @@ class ContactSolver:
                            "solved from the prediction without rows")
         for phase, seconds in result.timings.items():
             plain.timings[phase] = plain.timings.get(phase, 0.0) + seconds
+        plain.factorisations[:0] = result.factorisations
         return plain
 
     def _solve(self, warm, uncracked, lineage, start):

@@ -21,15 +21,17 @@ import scipy.sparse as sp
 from . import rigid
 from .constraints import ConstraintRows
 from ..linalg.bordered import BorderedFactor
-from ..linalg.factor import LINEAR_SOLVERS, EliminatedFactor, SingularSystem
+from ..linalg.factor import LINEAR_SOLVERS, SingularSystem
+from ..linalg.iterative import ITERATIVE_INVERSES, make_factor
 from ..linalg.kkt import ConstrainedSolver
 from ..linalg.sparse import single_threaded_blas
 
 METHODS = ("modified", "full")
-#: direct solvers: "auto" and scipy's "superlu", or an NGSolve inverse (one not compiled
-#: into the installed NGSolve still fails at the first factorisation, naming itself)
+#: solvers of K^+: "auto", scipy's "superlu", an NGSolve inverse (one not compiled into the
+#: installed NGSolve still fails at the first factorisation, naming itself), or "amg" (CG
+#: with algebraic multigrid, linalg.iterative; "auto" takes it in 3D above the memory budget)
 INVERSES = ("auto", "superlu", "sparsecholesky", "umfpack", "pardiso", "pardisospd", "mumps",
-            "masterinverse")
+            "masterinverse") + ITERATIVE_INVERSES
 
 
 def check_solve_options(options):
@@ -72,9 +74,9 @@ class SolveStatus:
     ----------
     converged, reason, message, iterations, steps, increment_history, residual_history
         Initial values of the attributes of the same names (below).
-    timings, multipliers, first_increment, notes
-        Likewise; by default a dict of zeros for the five phases, an empty array, 0 and an
-        empty list.
+    timings, multipliers, first_increment, notes, factorisations
+        Likewise; by default a dict of zeros for the five phases, an empty array, 0 and
+        empty lists.
 
     Attributes
     ----------
@@ -102,6 +104,9 @@ class SolveStatus:
         Euclidean norm of the first increment du^(0) (0 before any iteration).
     notes : list of str
         Fallbacks the solve took (a carried factorisation given up for a fresh one).
+    factorisations : list of dict
+        The solver choice (linalg.iterative.choose_inverse's record) of every K^+ the solve
+        made, in order.
     """
     converged: bool = False
     reason: str = "max_iterations"
@@ -115,6 +120,7 @@ class SolveStatus:
     multipliers: np.ndarray = field(default_factory=lambda: np.zeros(0))
     first_increment: float = 0.0
     notes: list = field(default_factory=list)
+    factorisations: list = field(default_factory=list)
 
     def __bool__(self):
         return self.converged
@@ -189,7 +195,10 @@ class NewtonSolver:
         Maximum iterations per load step.
     linear_solver : {"direct", "gmres"}
     inverse : str
-        Direct solver: "auto", "superlu" or an NGSolve name (see linalg.kkt.ConstrainedSolver).
+        Solver of K^+ (INVERSES): "auto", "superlu", an NGSolve name (see
+        linalg.kkt.ConstrainedSolver) or "amg"; chosen per factorisation by
+        linalg.iterative.make_factor (3D "auto": sparse Cholesky within the memory budget,
+        "amg" above).
     divergence_factor : float
         An increment this many times larger than the first one means divergence.
     fix_free_modes : bool or "all"
@@ -353,9 +362,7 @@ class NewtonSolver:
         support = saved.support if reuse else prob.support(rows)
         if self.fix_free_modes:
             rows = self._hold_free_modes(rows, support)
-        factor = saved.factor if reuse else EliminatedFactor(prob.tangent(), rows.fixed_dofs, support.pins,
-                                                             self.linear_solver, self.inverse,
-                                                             pattern=prob.tangent_pattern())
+        factor = saved.factor if reuse else self._factor(prob.tangent(), rows, support)
         kkt = ConstrainedSolver(None, rows.fixed_dofs, rows.C, modes=support.modes, pins=support.pins,
                                 factor=factor, dependent_rows=True)
         u = prob.u.vec.FV().NumPy()
@@ -409,6 +416,8 @@ class NewtonSolver:
             try:
                 if kkt is None or (self.method == "full" and given is None):
                     kkt, factor = self._linear_system(rows, support, given, (r, du_fixed), status.timings)
+                    if given is None:
+                        status.factorisations.append(factor.choice)
                 with _Timer(status.timings, "solve"), prob.threads():
                     du, status.multipliers = kkt.solve(r, du_fixed, h)
             except SingularSystem as err:
@@ -463,13 +472,18 @@ class NewtonSolver:
                 K = self.problem.tangent()
             # not inside prob.threads(): the factorisation runs on one thread (linalg.factor)
             with _Timer(timings, "factorize"):
-                factor = EliminatedFactor(K, rows.fixed_dofs, support.pins, self.linear_solver, self.inverse,
-                                          pattern=self.problem.tangent_pattern())
+                factor = self._factor(K, rows, support)
         path = "auto" if self.method == "full" and given is None else "schur"
         with _Timer(timings, "factorize"):
             kkt = ConstrainedSolver(None, rows.fixed_dofs, rows.C, modes=support.modes, pins=support.pins,
                                     factor=factor, path=path, first=first)
         return kkt, factor
+
+    def _factor(self, K, rows, support):
+        """A fresh K^+ of the tangent K (linalg.iterative.make_factor)."""
+        prob = self.problem
+        return make_factor(K, rows.fixed_dofs, support.pins, self.linear_solver, self.inverse, dim=prob.dim,
+                           points=prob.arrays.points, pattern=prob.tangent_pattern())
 
     def _converged(self, status, k, norm, prev, force_scale, r):
         """Whether iterate k (increment ``norm``, the one before ``prev``) ends the load step:

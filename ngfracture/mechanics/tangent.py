@@ -8,6 +8,7 @@ import numpy as np
 from . import rigid
 from ..linalg.bordered import BorderedFactor
 from ..linalg.factor import EliminatedFactor
+from ..linalg.iterative import make_factor
 
 
 class SavedTangent:
@@ -99,8 +100,8 @@ class SavedTangent:
         support = problem.support(rows, state)
         saved = cls()
         saved.fixed_dofs, saved.support, saved.state = rows.fixed_dofs, support, np.array(state, dtype=float)
-        saved.factor = EliminatedFactor(problem.tangent(state), rows.fixed_dofs, support.pins,
-                                        pattern=problem.tangent_pattern())
+        saved.factor = make_factor(problem.tangent(state), rows.fixed_dofs, support.pins, dim=problem.dim,
+                                   points=problem.arrays.points, pattern=problem.tangent_pattern())
         saved.factor.factorise()
         return saved
 

@@ -35,6 +35,11 @@ class StepControl:
         Newton tolerance of eq. 7.
     maxit : int
         Newton iterations per solve.
+    inverse : str
+        The solver of K^+ (mechanics.newton.INVERSES): "auto" (2D: SuperLU or sparse
+        Cholesky by size; 3D: sparse Cholesky while its predicted memory fits the budget,
+        CG with AMG above, linalg.iterative), "amg" to force the iterative solve, or a
+        direct solver by name.
     unloaded_fraction : float
         See Scene.stop_when_unloaded.
     split : {"spread", "all", "one"}
@@ -80,6 +85,7 @@ class StepControl:
     method: str = "modified"
     tol: float = 1e-10
     maxit: int = 60
+    inverse: str = "auto"
     unloaded_fraction: float = 1e-3
     split: str = "spread"
     growth: str = "fixed"
@@ -151,6 +157,7 @@ class StepControl:
         ValueError
             Naming the first field out of range.
         """
+        from ..mechanics.newton import INVERSES     # here: the control is read before any solver
         dx_min, dx_max = self._dx_bounds(dx)
 
         def number(v):
@@ -171,6 +178,7 @@ class StepControl:
                   ("method", self.method in ("modified", "full")),
                   ("tol", number(self.tol) and 0 < self.tol < 1),
                   ("maxit", integer(self.maxit) and self.maxit >= 1),
+                  ("inverse", self.inverse in INVERSES),
                   ("unloaded_fraction", number(self.unloaded_fraction) and 0 < self.unloaded_fraction < 1),
                   ("split", self.split in ("spread", "all", "one")),
                   ("growth", self.growth in ("fixed", "critical"))]

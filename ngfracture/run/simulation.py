@@ -338,6 +338,8 @@ class Simulation:
             "notes": [{"step": h["step"], "note": n} for h in hist for n in h.get("notes", [])],
             "history": hist,
             "timings": {**{k: round(v, 6) for k, v in self.timings.items()}, "wall": round(wall, 6)},
+            # which solver made K^+ and why (linalg.iterative.choose_inverse), this process's part
+            "linear_solver": self.timings.factorisation_record(),
         }
 
 

@@ -152,7 +152,7 @@ class LoadStep:
             The solve did not converge.
         """
         c = self.control
-        options = dict(method=method, tol=c.tol, maxit=c.maxit, load_steps=substeps)
+        options = dict(method=method, tol=c.tol, maxit=c.maxit, inverse=c.inverse, load_steps=substeps)
         if self.needs_contact(prob.mesh):
             return self._contact_equilibrium(prob, phase, options, timings, warm, lineage, start)
         t0 = time.perf_counter()
@@ -161,6 +161,7 @@ class LoadStep:
         timings.add("solve", time.perf_counter() - t0)
         for part, seconds in status.phase_seconds().items():
             timings.add(part, seconds)
+        timings.count_factorisations(status.factorisations)
         if not status.converged:
             raise StepFailed(status.reason, phase, status.message)
         return Equilibrium([], tangent, status.iterations, merged_notes([], status.notes))
@@ -177,6 +178,7 @@ class LoadStep:
         timings.add("collision", collision)
         timings.add("linear", result.timings.get("linear", 0.0))
         timings.add("assembly", result.timings.get("assembly", 0.0))
+        timings.count_factorisations(result.factorisations)
         if not result.converged:
             if result.reason == "penetration":
                 message = (f"contact rows still penetrate by {result.max_penetration:.3g} after "

@@ -23,6 +23,33 @@ class Timings(dict):
     def __init__(self, seconds=None):
         super().__init__(dict.fromkeys(PHASES, 0.0))
         self.update(seconds or {})
+        self._solvers = {}        # solver -> [factorisations, the last choice record]
+
+    def count_factorisations(self, records):
+        """Count the factorisations of K^+ a solve made, by solver.
+
+        Parameters
+        ----------
+        records : list of dict
+            SolveStatus.factorisations (linalg.iterative.choose_inverse's records).
+        """
+        for record in records:
+            entry = self._solvers.setdefault(record["solver"], [0, None])
+            entry[0] += 1
+            entry[1] = record
+
+    def factorisation_record(self):
+        """Which solvers made K^+ in this process and why: summary.json's "linear_solver".
+
+        Returns
+        -------
+        dict
+            solver -> {"factorisations": count, "last": the choice record of its last one:
+            ``reason`` "auto" or "asked", ``dofs``, and for "auto" in 3D
+            ``predicted_bytes`` (sparse Cholesky) and ``budget_bytes``}.
+        """
+        return {solver: {"factorisations": count, "last": dict(record)}
+                for solver, (count, record) in sorted(self._solvers.items())}
 
     def add(self, phase, seconds):
         """Add seconds to a phase.
