@@ -107,10 +107,10 @@ def test_a_3d_run_on_the_iterative_solver_cracks_as_the_direct_one(monkeypatch):
     direct = _bar_run()
     monkeypatch.setattr(iterative, "MEMORY_BUDGET", 1e-12)     # below any prediction: "auto" takes amg
     amg = _bar_run()
-    record = amg.summary["linear_solver"]
+    record = amg.summary["timings"]["linear_solver"]
     assert set(record) == {"amg"} and record["amg"]["last"]["reason"] == "auto"
     assert record["amg"]["last"]["predicted_bytes"] > record["amg"]["last"]["budget_bytes"]
-    assert set(direct.summary["linear_solver"]) == {"sparsecholesky"}
+    assert set(direct.summary["timings"]["linear_solver"]) == {"sparsecholesky"}
     assert amg.reason == direct.reason == "broken"
     for key in ("n_steps", "n_split_vertices", "n_fragments"):
         assert amg.summary[key] == direct.summary[key], key

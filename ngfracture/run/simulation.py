@@ -189,6 +189,7 @@ class Simulation:
             state, run = read_resumable(self.out, self._identity())
             timings = dict(run.get("timings", {}))
             wall_before = float(timings.pop("wall", 0.0))
+            self.timings.restore_factorisations(timings.pop("linear_solver", {}))
             self.timings.update(timings)
             if run["area_initial"] != area_initial:
                 raise checkpoint.CheckpointError(f"{self.out}: the checkpoint's initial area {run['area_initial']!r} "
@@ -208,7 +209,8 @@ class Simulation:
     def _checkpoint_meta(self, area_initial, wall):
         identity = self._identity()
         return {"scene": identity["scene"], "parameters": identity["parameters"], "area_initial": area_initial,
-                "control": identity["control"], "timings": {**self.timings, "wall": wall}}
+                "control": identity["control"],
+                "timings": {**self.timings, "wall": wall, "linear_solver": self.timings.factorisation_record()}}
 
     @single_threaded_blas()
     def run(self, on_step=None):
@@ -337,9 +339,9 @@ class Simulation:
             # departures from the plain path of the solvers (see ContactResult.notes)
             "notes": [{"step": h["step"], "note": n} for h in hist for n in h.get("notes", [])],
             "history": hist,
-            "timings": {**{k: round(v, 6) for k, v in self.timings.items()}, "wall": round(wall, 6)},
-            # which solver made K^+ and why (linalg.iterative.choose_inverse), this process's part
-            "linear_solver": self.timings.factorisation_record(),
+            # and which solver made K^+ how often and why (linalg.iterative.choose_inverse)
+            "timings": {**{k: round(v, 6) for k, v in self.timings.items()}, "wall": round(wall, 6),
+                        "linear_solver": self.timings.factorisation_record()},
         }
 
 

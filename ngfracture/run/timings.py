@@ -38,8 +38,20 @@ class Timings(dict):
             entry[0] += 1
             entry[1] = record
 
+    def restore_factorisations(self, record):
+        """Continue the counts of :meth:`factorisation_record` from a checkpoint's.
+
+        Parameters
+        ----------
+        record : dict
+            What :meth:`factorisation_record` returned (empty for none).
+        """
+        self._solvers = {solver: [int(entry["factorisations"]), dict(entry["last"])]
+                         for solver, entry in record.items()}
+
     def factorisation_record(self):
-        """Which solvers made K^+ in this process and why: summary.json's "linear_solver".
+        """Which solvers made K^+ and why: summary.json's ``timings["linear_solver"]`` (a resumed
+        run continues the counts of its checkpoint, :meth:`restore_factorisations`).
 
         Returns
         -------
