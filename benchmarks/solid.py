@@ -10,9 +10,8 @@ Reported per case:
   tets_end, reason, steps, split_vertices, fragments
   mesh_seconds  netgen's meshing of the scene (not part of the run's wall time)
   phases        the run's seconds per phase (summary.json "timings") and wall
-  solver        the factorisation the run uses at this size (linalg.factor's
-                inverse="auto": "superlu" up to SUPERLU_MAX_DOFS factorised dofs,
-                "sparsecholesky" above)
+  solver        the factorisation the run uses (linalg.iterative.problem_inverse: NGSolve's
+                "sparsecholesky" at every size in 3D), and so plain NGSolve's
   t_unit        one factorisation plus one solve of the bar's linear elasticity (its
                 tangent at u = 0 with the first increment's constraints, without the fixed
                 dofs and pins, as the run leaves them out) by ``EliminatedFactor`` with that
@@ -104,6 +103,7 @@ def unit_solve(scene, repeat=3):
     elasticity, with the solver the run picks at this size, and that solver's name."""
     import ngsolve
     from ngfracture.linalg.factor import EliminatedFactor
+    from ngfracture.linalg.iterative import problem_inverse
     from ngfracture.mechanics.problem import ElasticProblem
     prob = ElasticProblem(scene.mesh, scene.material, order=1)
     scene.apply_load(prob, scene.dx)
@@ -118,7 +118,7 @@ def unit_solve(scene, repeat=3):
     try:
         for _ in range(repeat):
             t0 = time.perf_counter()
-            factor = EliminatedFactor(K, rows.fixed_dofs, support.pins, inverse="auto")
+            factor = EliminatedFactor(K, rows.fixed_dofs, support.pins, inverse=problem_inverse("auto", prob.dim))
             factor.factorise()
             x = factor.solve(rhs)
             best = min(best, time.perf_counter() - t0)
