@@ -227,7 +227,7 @@ namespace ngfracture
       return std::atan2(Norm(Cross(u, w)), Dot(u, w));
     }
 
-    constexpr double SHARP_ANGLE = 300.0 * M_PI / 180.0;
+    constexpr double SHARP_ANGLE = 260.0 * M_PI / 180.0;
     constexpr int TET_EDGES[6][2] = { { 0, 1 }, { 0, 2 }, { 0, 3 }, { 1, 2 }, { 1, 3 }, { 2, 3 } };
 
     // Sharp vertices and their front tangents: the boundary edges whose tets' dihedral
