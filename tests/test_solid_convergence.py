@@ -7,14 +7,15 @@ the continuum that the mesh approaches as h / r -> 0 (docs/criterion.md's 2D tab
 and 0.5 % over the last two halvings); the bound is the issue's 3 %.
 
 * The plane-strain bar of tests/test_solid_lefm.py (structured graded box, through edge
-  crack opened on mesh faces, front on mesh edges, linear material): h = r/2, r/3, r/4, r/6.
+  crack opened on mesh faces, front on mesh edges, linear material): h = r/2, r/3, r/4, r/6
+  (slow: 12 s).
 * The scene ``bar3d`` on netgen meshes (a notch slot 0.02 wide, r = 0.08, its root corners
   re-entrant edges of 270 degrees), thinned to 0.1 to stay small: ``fine`` = r/2 ... r/5 (and
   r/6, r/8 in the slow case), the scene's own material and criterion
   (``studies.initiation.initiation_load``). Also checked: the small-strain scaling of the St
-  Venant-Kirchhoff estimate against LinearElastic (2e-5 measured; bound 1e-3, the order of
-  the strain at the solved load, 1e-5 / 2 x 10 the stress concentration), and that the load
-  is reached at the notch root, across the notch plane.
+  Venant-Kirchhoff estimate against LinearElastic at the coarsest level (6e-6 measured; bound 1e-3,
+  above the Green-Lagrange terms, of the order of the strain, below 1e-4 at x = 1e-5), and
+  that the load is reached at the notch root, across the notch plane.
 """
 import numpy as np
 import pytest
@@ -73,6 +74,7 @@ def test_bar3d_initiation_converges_to_r_over_8():
     check_bar(bar_levels([2, 3, 4, 5, 6, 8]))
 
 
+@pytest.mark.slow
 def test_plane_strain_bar_initiation_converges():
     loads = []
     for k in (2, 3, 4, 6):

@@ -7,7 +7,7 @@ mesh, material and ``apply_load``), judges it with the scene's own criterion
 the load, so ``x / m`` is the load at which it reaches 1 exactly. With St Venant-Kirchhoff
 (the scenes' material) the Green-Lagrange strain adds terms of the order of the strain
 itself: at a strain of 1e-4 they move the estimate by about 1e-4 of itself (measured on
-``bar3d``: 2e-5 against ``LinearElastic`` of the same E and nu), which is why ``x``
+``bar3d`` at x = 1e-5: 6e-6 against ``LinearElastic`` of the same E and nu), which is why ``x``
 defaults to a small load. It is the load at which a run's first crack pass would split,
 without the run: the quantity whose convergence under refinement docs/solid.md
 ("Convergence of initiation in 3D") measures.
