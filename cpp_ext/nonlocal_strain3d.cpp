@@ -227,11 +227,16 @@ namespace ngfracture
       return std::atan2(Norm(Cross(u, w)), Dot(u, w));
     }
 
-    constexpr double SHARP_ANGLE = 300.0 * M_PI / 180.0;
+    // 260 degrees: every re-entrant edge of 270 degrees or more (the root corners of a slot,
+    // a step, an L-section) is a front, whose rays lie in its normal plane; a ray along a
+    // singular edge sees its stress at the mesh's distance from it, and the initiation load
+    // of bar3d's slot did not converge (docs/solid.md, "Convergence of initiation in 3D").
+    // The meshed edges of a concave curved surface stay near 180 degrees.
+    constexpr double SHARP_ANGLE = 260.0 * M_PI / 180.0;
     constexpr int TET_EDGES[6][2] = { { 0, 1 }, { 0, 2 }, { 0, 3 }, { 1, 2 }, { 1, 3 }, { 2, 3 } };
 
     // Sharp vertices and their front tangents: the boundary edges whose tets' dihedral
-    // angles sum to at least 300 degrees, and at each of their vertices the front's
+    // angles sum to at least 260 degrees, and at each of their vertices the front's
     // direction: along its one sharp edge, the chord between the far ends of two, the
     // principal axis of the sharp edges' directions for more.
     void Sharp (const TetMesh & m, std::vector<char> & sharp, std::vector<V3> & tangent)
