@@ -15,6 +15,8 @@ pass it to :class:`ngfracture.run.simulation.Simulation`.
   beside the crack's path: a mixed-mode crack that curves past the hole.
 * :func:`bar3d`: a notched bar in tension, on tetrahedra: one crack across the ligament.
 * :func:`plate3d`: the notched plate extruded to a thickness, on tetrahedra.
+* :func:`shaft3d`: a glass shaft twisted about its axis, on tetrahedra: one crack along a
+  helicoid, a curved crack surface.
 
 Every scene judges cracks at a critical distance ``radius`` (docs/criterion.md);
 ``radius=None`` selects the paper's one-ring criterion.
@@ -25,17 +27,20 @@ from .common import (BAR_LOAD, BAR_RADIUS, BEAM_LOAD, CORE_INNER, DISINTEGRATION
                      PLATE_LOAD, PLATE_RADIUS)
 from .disks import cored_disk_mesh, disintegration, disk
 from .plates import notched_plate_mesh, plate
+from .torsion import SHAFT_LOAD, SHAFT_RADIUS, shaft3d, shaft_mesh
 
 __all__ = ["plate", "disk", "disintegration", "beam", "holed_beam", "notched_plate_mesh", "cored_disk_mesh",
            "notched_beam_mesh", "holed_beam_mesh", "senb_factor", "GLASS", "PLATE_RADIUS", "DISK_RADIUS",
            "DISINTEGRATION_RADIUS", "HOLE", "CORE_INNER", "FIRST_CRACK", "PLATE_LOAD", "DISK_LOAD", "BEAM_LOAD",
            "SCENES", "LOAD_DESCRIPTIONS", "bar3d", "notched_bar_mesh", "plate3d", "extruded_plate_mesh", "BAR_RADIUS",
-           "BAR_LOAD"]
+           "BAR_LOAD", "shaft3d", "shaft_mesh", "SHAFT_RADIUS", "SHAFT_LOAD"]
 
 #: the scenes of ``python -m ngfracture run``
 SCENES = {"plate": plate, "disk": disk, "disintegration": disintegration, "beam": beam, "holed_beam": holed_beam,
-          "bar3d": bar3d, "plate3d": plate3d}
+          "bar3d": bar3d, "plate3d": plate3d,
+          "shaft3d": shaft3d}
 #: what the load parameter x of each scene is (Scene.load_description)
 LOAD_DESCRIPTIONS = {"plate": PLATE_LOAD, "disk": DISK_LOAD, "disintegration": DISK_LOAD, "beam": BEAM_LOAD,
-                     "holed_beam": BEAM_LOAD, "bar3d": BAR_LOAD, "plate3d": PLATE_LOAD}
+                     "holed_beam": BEAM_LOAD, "bar3d": BAR_LOAD, "plate3d": PLATE_LOAD,
+                     "shaft3d": SHAFT_LOAD}
 
