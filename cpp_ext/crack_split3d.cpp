@@ -212,6 +212,32 @@ namespace ngfracture
     return len > 0 ? (c[0]*n[0] + c[1]*n[1] + c[2]*n[2]) / len : 0.0;
   }
 
+  double TetSplitter :: StarSolidAngle () const
+  {
+    const double * o = &points[3*size_t(lv)];
+    double sum = 0;
+    for (int t : S)
+      {
+        double a[3][3], len[3];
+        int j = 0;
+        for (int k = 0; k < 4; k++)
+          {
+            int w = tets[4*size_t(t)+k];
+            if (w == lv) continue;
+            for (int d = 0; d < 3; d++) a[j][d] = points[3*size_t(w)+d] - o[d];
+            len[j] = std::sqrt(a[j][0]*a[j][0] + a[j][1]*a[j][1] + a[j][2]*a[j][2]);
+            j++;
+          }
+        double det = a[0][0] * (a[1][1]*a[2][2] - a[1][2]*a[2][1]) - a[0][1] * (a[1][0]*a[2][2] - a[1][2]*a[2][0])
+                     + a[0][2] * (a[1][0]*a[2][1] - a[1][1]*a[2][0]);
+        auto dot = [&] (int p, int q) { return a[p][0]*a[q][0] + a[p][1]*a[q][1] + a[p][2]*a[q][2]; };
+        // Van Oosterom and Strackee: tan(Omega / 2) = |det| / (l0 l1 l2 + (a0.a1) l2 + (a0.a2) l1 + (a1.a2) l0)
+        double den = len[0]*len[1]*len[2] + dot(0, 1) * len[2] + dot(0, 2) * len[1] + dot(1, 2) * len[0];
+        sum += 2 * std::atan2(std::abs(det), den);
+      }
+    return sum;
+  }
+
   void TetSplitter :: SeedLips (const std::vector<std::array<int,2>> & pairs, const double * n,
                                 std::vector<int> & side) const
   {
@@ -592,7 +618,11 @@ namespace ngfracture
     else if (flags)
       {
         // on a surface (free or crack) away from fronts: if a boundary face at v is better
-        // aligned with the crack plane than every interior face, nothing is split (rule 2a)
+        // aligned with the crack plane than every interior face, nothing is split (rule 2a):
+        // the crack would peel the surface. Not at a re-entrant edge or corner (the star's
+        // solid angle above 2 pi by more than a curved surface's): there the plane along one
+        // of its faces runs on into the body, as a crack from a slot's root corner does
+        bool reentrant = StarSolidAngle() > 2.25 * M_PI;
         double best_in = -1, best_bnd = -1;
         for (size_t e = 0; e < le.size(); e++)
           {
@@ -600,7 +630,7 @@ namespace ngfracture
             double al = std::abs(FaceAlignment(int(e), n));
             (partner[e] < 0 ? best_bnd : best_in) = std::max(partner[e] < 0 ? best_bnd : best_in, al);
           }
-        if (best_bnd > best_in) return flags | SPLIT3_NONE | SPLIT3_ALIGNED;
+        if (best_bnd > best_in && !reentrant) return flags | SPLIT3_NONE | SPLIT3_ALIGNED;
       }
     double offset = Anchor(n, pairs);
     Classify(n, offset, side);

@@ -112,6 +112,9 @@ namespace ngfracture
     // |cos| of the angle between n and the normal of link edge e's face, signed by the
     // face's outward normal (of its star tetrahedron)
     double FaceAlignment (int e, const double * n) const;
+    // the solid angle of the star at lv (2 pi on a flat surface, 3 pi on a right-angle
+    // re-entrant edge, 4 pi inside)
+    double StarSolidAngle () const;
     void SeedLips (const std::vector<std::array<int,2>> & pairs, const double * n, std::vector<int> & side) const;
     // give each label (0 .. ngroups-1) of the current link its own copy of lv, the group
     // holding the smallest tetrahedron keeping lv

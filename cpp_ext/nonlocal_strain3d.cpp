@@ -227,11 +227,21 @@ namespace ngfracture
       return std::atan2(Norm(Cross(u, w)), Dot(u, w));
     }
 
-    constexpr double SHARP_ANGLE = 300.0 * M_PI / 180.0;
+    // 260 degrees: every re-entrant edge of 270 degrees or more (the root corners of a slot,
+    // a step, an L-section) is a front, whose rays lie in its normal plane; a ray along a
+    // singular edge sees its stress at the mesh's distance from it, and the initiation load
+    // of bar3d's slot did not converge (docs/solid.md, "Convergence of initiation in 3D").
+    // The meshed edges of a concave curved surface stay near 180 degrees.
+    constexpr double SHARP_ANGLE = 260.0 * M_PI / 180.0;
+    // A crack front: the two lips meet at the edge, its tets' dihedral angles sum to 360
+    // degrees (up to rounding; no geometric edge of a body comes within 10 degrees of it).
+    constexpr double FRONT_ANGLE = 350.0 * M_PI / 180.0;
+    // Sharp's marks: a re-entrant edge of the body's geometry, a crack front
+    constexpr char REENTRANT = 1, FRONT = 2;
     constexpr int TET_EDGES[6][2] = { { 0, 1 }, { 0, 2 }, { 0, 3 }, { 1, 2 }, { 1, 3 }, { 2, 3 } };
 
     // Sharp vertices and their front tangents: the boundary edges whose tets' dihedral
-    // angles sum to at least 300 degrees, and at each of their vertices the front's
+    // angles sum to at least 260 degrees, and at each of their vertices the front's
     // direction: along its one sharp edge, the chord between the far ends of two, the
     // principal axis of the sharp edges' directions for more.
     void Sharp (const TetMesh & m, std::vector<char> & sharp, std::vector<V3> & tangent)
@@ -256,12 +266,14 @@ namespace ngfracture
                   if (i != f && j != f) boundary[EdgeIndex(m, t[i], t[j])] = 1;
         }
       std::vector<std::vector<int>> ends(nv);
+      std::vector<char> front(nv, 0);
       for (size_t a = 0; a < nv; a++)
         for (int k = m.vv_begin[a]; k < m.vv_begin[a+1]; k++)
           if (m.vv[k] > int(a) && boundary[k] && angle[k] >= SHARP_ANGLE)
             {
               ends[a].push_back(m.vv[k]);
               ends[m.vv[k]].push_back(int(a));
+              if (angle[k] >= FRONT_ANGLE) front[a] = front[m.vv[k]] = 1;
             }
       sharp.assign(nv, 0);
       tangent.assign(nv, { 0, 0, 0 });
@@ -269,7 +281,7 @@ namespace ngfracture
         {
           auto & E = ends[v];
           if (E.empty()) continue;
-          sharp[v] = 1;
+          sharp[v] = front[v] ? FRONT : REENTRANT;
           V3 t;
           if (E.size() == 1) t = Sub(m.x[E[0]], m.x[v]);
           else if (E.size() == 2) t = Sub(m.x[E[1]], m.x[E[0]]);
@@ -466,13 +478,20 @@ namespace ngfracture
     // 60 degrees, 3 sqrt(3)/4 times the value straight ahead), not a concentration of its own.
     constexpr double TIP_ZONE = 27.0 / 16.0;
 
-    // v is judged when it is sharp, or when no sharp vertex lies within TIP_ZONE r and v
-    // leads every vertex within r (largest nodal principal value; ties: smaller number),
-    // both among the vertices the mesh's edges connect to v inside those balls.
-    bool HotSpot (const TetMesh & m, const std::vector<double> & local, const std::vector<char> & sharp,
+    // v is judged when it is on a crack front; on a re-entrant edge, when no crack front lies
+    // within TIP_ZONE r (a crack grown from a notch's root takes over from the notch: the
+    // slot's other root corner, a slot's width from the crack, would otherwise start a
+    // parallel crack beside it) and no other re-entrant edge within r lies behind it along
+    // its opening direction (the two root corners of a slot narrower than r are one front at
+    // the scale r: the corner on the minus side of the opening direction, the same one all
+    // along the slot, starts the crack); elsewhere, when no sharp vertex lies within
+    // TIP_ZONE r and v leads every vertex within r (largest nodal principal value; ties:
+    // smaller number), all among the vertices the mesh's edges connect to v inside those balls.
+    bool HotSpot (const TetMesh & m, const std::vector<double> & local, const std::vector<V3> & dir,
+                  const std::vector<char> & sharp, const std::vector<V3> & tangent,
                   int v, double r, std::vector<int> & mark, std::vector<int> & queue)
     {
-      if (sharp[v]) return true;
+      if (sharp[v] == FRONT) return true;
       const double lv = local[v], r2 = r * r, zone2 = TIP_ZONE * TIP_ZONE * r2;
       queue.clear();
       queue.push_back(v);
@@ -488,8 +507,14 @@ namespace ngfracture
               V3 dx = Sub(m.x[u], m.x[v]);
               double d2 = Dot(dx, dx);
               if (d2 > zone2) continue;
-              if (sharp[u]) return false;
-              if (d2 <= r2 && (local[u] > lv || (local[u] == lv && u < v))) return false;
+              if (sharp[u] == FRONT || (sharp[u] && !sharp[v])) return false;
+              if (sharp[v] == REENTRANT && sharp[u] == REENTRANT && d2 <= r2)
+                {
+                  // off v's edge line by more than a tenth of r, and behind v along n
+                  V3 off = Sub(dx, Scaled(tangent[v], Dot(dx, tangent[v])));
+                  if (Dot(off, off) > 0.01 * r2 && Dot(dx, dir[v]) < -0.1 * r) return false;
+                }
+              if (!sharp[v] && d2 <= r2 && (local[u] > lv || (local[u] == lv && u < v))) return false;
               queue.push_back(u);
             }
         }
@@ -571,12 +596,14 @@ namespace ngfracture
     std::vector<V3> tangent;
     Sharp(m, sharp, tangent);
     std::vector<double> local(nv);
+    std::vector<V3> dir(nv);
     V3 tmp;
     for (size_t v = 0; v < nv; v++)
       {
         S6 S;
         for (int c = 0; c < 6; c++) S[c] = T(v, c);
         local[v] = LargestEigen(S, tmp);
+        dir[v] = tmp;
       }
     const std::vector<V3> sphere = Fibonacci(ndir);
     std::vector<V3> plane(nplane);
@@ -587,7 +614,7 @@ namespace ngfracture
       {
         for (int c = 0; c < 6; c++) result(v, c) = 0.0;
         if (!(radius[v] > 0) || m.vt_begin[v] == m.vt_begin[v+1]) continue;
-        if (!HotSpot(m, local, sharp, int(v), radius[v], mark, queue)) continue;
+        if (!HotSpot(m, local, dir, sharp, tangent, int(v), radius[v], mark, queue)) continue;
         bool tip = sharp[v] && Norm(tangent[v]) > 0;
         if (tip)
           {

@@ -9,8 +9,8 @@
 // * VertexAverage3D: the volume-weighted mean of element values at every vertex (the
 //   paper's one-ring nodal value).
 // * SharpVertices3D: the vertices of the boundary edges whose inside dihedral angle (the
-//   sum of the dihedral angles of the tets around the edge) is at least 300 degrees: notch
-//   fronts, and crack fronts (360 degrees: the two lips are separate boundary faces), with
+//   sum of the dihedral angles of the tets around the edge) is at least 260 degrees: notch
+//   fronts and re-entrant edges of 270 degrees or more, and crack fronts (360 degrees: the two lips are separate boundary faces), with
 //   the unit tangent of the front at each of them.
 // * NonlocalOpening3D: the critical-distance measure. From every hot spot, rays of length r
 //   are walked through the tets (a boundary face, e.g. a crack lip, ends a ray; a direction

@@ -177,11 +177,12 @@ def principal_3d(tensors):
 
 
 def sharp_vertices_3d(arrays):
-    """The sharp vertices: on a boundary edge whose inside dihedral angle is at least 300 degrees.
+    """The sharp vertices: on a boundary edge whose inside dihedral angle is at least 260 degrees.
 
     A crack front edge (the two lips meet there; its tets' dihedral angles sum to 360
-    degrees) and a sharp notch front; the stress concentrations from which the critical
-    distance is measured (docs/solid.md).
+    degrees), a sharp notch front and a re-entrant edge of 270 degrees or more (a slot's
+    root corners); the stress concentrations from which the critical distance is measured
+    (docs/solid.md, "Convergence of initiation in 3D").
 
     Parameters
     ----------

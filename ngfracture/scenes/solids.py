@@ -70,7 +70,7 @@ def notched_bar_mesh(maxh, fine, length=2.0, width=1.0, thickness=0.5, notch=0.2
 
 
 def bar3d(maxh=0.15, fine=None, strain_max=2e-3, dx=None, material=None, critical=GLASS["critical"],
-          E=GLASS["E"], nu=GLASS["nu"], radius=BAR_RADIUS, notch=0.2, thickness=0.5, length=2.0,
+          E=GLASS["E"], nu=GLASS["nu"], radius=BAR_RADIUS, notch=0.4, thickness=0.5, length=2.0,
           weibull_m=None, weibull_scale=None, weibull_area=None, seed=None):
     """A notched glass bar pulled along its axis: one crack across the ligament (3D).
 
@@ -99,7 +99,10 @@ def bar3d(maxh=0.15, fine=None, strain_max=2e-3, dx=None, material=None, critica
     radius : float
         Critical distance of the crack criterion.
     notch, thickness, length : float
-        Notch depth, bar thickness and length (the width is 1).
+        Notch depth, bar thickness and length (the width is 1). The default notch, 0.4 deep,
+        starts the crack at 30 % of the unnotched bar's strength: with a shallower one the
+        halves, whose gliding ends keep them from turning, crack in bending while the first
+        crack runs at the higher load (docs/solid.md, "The scenes").
     weibull_m, weibull_scale, weibull_area, seed
         Random strength, see :func:`ngfracture.fracture.strength.scene_strength` (in 3D the
         size effect's reference is a volume): a Weibull modulus (None: uniform strength),
