@@ -10,6 +10,7 @@ using namespace ngfracture;
 
 void ExportCrack (py::module & m);   // python_crack.cpp
 void ExportCollision (py::module & m);  // python_collision.cpp
+void ExportCollision3d (py::module & m);  // python_collision3d.cpp
 void ExportSplit3d (py::module & m);   // python_split3d.cpp
 void ExportCriterion3D (py::module & m);  // python_criterion3d.cpp
 
@@ -298,6 +299,7 @@ PYBIND11_MODULE(_ngfracture, m)
   ExportSupernodalLDL(m);
   ExportCrack(m);
   ExportCollision(m);
+  ExportCollision3d(m);
   ExportSplit3d(m);
   ExportCriterion3D(m);
 }

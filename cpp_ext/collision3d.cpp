@@ -1,0 +1,425 @@
+// Collision detection between fragments of a tetrahedral mesh (3D analogue of collision.cpp).
+#include "collision3d.hpp"
+#include "predicates.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <map>
+#include <stdexcept>
+#include <string>
+#include <tuple>
+#include <unordered_map>
+
+namespace ngfracture
+{
+  namespace
+  {
+    // A hashed uniform grid: items sorted by cell key, each occupied cell a range.
+    struct HashGrid
+    {
+      double origin[3], h;
+      int64_t span;                                   // cells per axis that may be occupied
+      std::vector<int32_t> items;
+      std::unordered_map<uint64_t, std::pair<int32_t,int32_t>> range;
+
+      int64_t Cell (double v, int d) const { return int64_t(std::floor((v - origin[d]) / h)); }
+      static uint64_t Key (int64_t i, int64_t j, int64_t k)
+      { return (uint64_t(i) << 42) | (uint64_t(j) << 21) | uint64_t(k); }
+      bool Valid (int64_t i) const { return i >= 0 && i < span; }
+
+      // items with closed boxes lo..hi (3 doubles each per item), in every cell they overlap
+      void Build (const std::vector<double> & lo, const std::vector<double> & hi)
+      {
+        std::vector<std::pair<uint64_t,int32_t>> keyed;
+        size_t n = lo.size() / 3;
+        for (size_t t = 0; t < n; t++)
+          {
+            int64_t a[3], b[3];
+            for (int d = 0; d < 3; d++) { a[d] = Cell(lo[3*t+d], d); b[d] = Cell(hi[3*t+d], d); }
+            for (int64_t i = a[0]; i <= b[0]; i++)
+              for (int64_t j = a[1]; j <= b[1]; j++)
+                for (int64_t k = a[2]; k <= b[2]; k++)
+                  keyed.push_back({ Key(i, j, k), int32_t(t) });
+          }
+        std::sort(keyed.begin(), keyed.end());
+        items.resize(keyed.size());
+        range.reserve(keyed.size());
+        for (size_t s = 0; s < keyed.size(); s++)
+          {
+            items[s] = keyed[s].second;
+            auto [it, fresh] = range.try_emplace(keyed[s].first, int32_t(s), int32_t(s));
+            it->second.second = int32_t(s + 1);
+          }
+      }
+
+      template <typename F> void Visit (int64_t i, int64_t j, int64_t k, F && f) const
+      {
+        if (!Valid(i) || !Valid(j) || !Valid(k)) return;
+        auto it = range.find(Key(i, j, k));
+        if (it == range.end()) return;
+        for (int32_t s = it->second.first; s < it->second.second; s++) f(items[s]);
+      }
+    };
+
+    inline void Sub (const double * a, const double * b, double * r)
+    { r[0] = a[0]-b[0]; r[1] = a[1]-b[1]; r[2] = a[2]-b[2]; }
+    inline double Dot (const double * a, const double * b) { return a[0]*b[0] + a[1]*b[1] + a[2]*b[2]; }
+    inline void Cross (const double * a, const double * b, double * r)
+    { r[0] = a[1]*b[2]-a[2]*b[1]; r[1] = a[2]*b[0]-a[0]*b[2]; r[2] = a[0]*b[1]-a[1]*b[0]; }
+
+    // p in the closed tetrahedron t (any orientation; false if flat), exactly
+    bool InClosedTet (const double * x, const int32_t * t, const double * p)
+    {
+      const double * v[4] = { x + 3*t[0], x + 3*t[1], x + 3*t[2], x + 3*t[3] };
+      int s = Orient3dSign(v[0], v[1], v[2], v[3]);
+      if (s == 0) return false;
+      for (int i = 0; i < 4; i++)
+        {
+          const double * w[4] = { v[0], v[1], v[2], v[3] };
+          w[i] = p;
+          if (Orient3dSign(w[0], w[1], w[2], w[3]) * s < 0) return false;
+        }
+      return true;
+    }
+
+    // squared distance from p to the triangle point with barycentrics bary
+    double Dist2 (const double * p, const double * a, const double * b, const double * c,
+                  const double * bary, double * q)
+    {
+      double d2 = 0;
+      for (int k = 0; k < 3; k++)
+        {
+          q[k] = bary[0]*a[k] + bary[1]*b[k] + bary[2]*c[k];
+          d2 += (p[k]-q[k]) * (p[k]-q[k]);
+        }
+      return d2;
+    }
+  }
+
+  bool PointInClosedTriangle3 (const double * p, const double * a, const double * b, const double * c)
+  {
+    if (Orient3dSign(a, b, c, p) != 0) return false;
+    // Coplanar: dropping a coordinate keeps every orientation sign, for a projection
+    // in which the triangle is not degenerate.
+    for (int drop = 0; drop < 3; drop++)
+      {
+        int u = (drop + 1) % 3, v = (drop + 2) % 3;
+        double pa[2] = { a[u], a[v] }, pb[2] = { b[u], b[v] }, pc[2] = { c[u], c[v] }, pp[2] = { p[u], p[v] };
+        int o = Orient2dSign(pa, pb, pc);
+        if (o == 0) continue;
+        return o * Orient2dSign(pa, pb, pp) >= 0 && o * Orient2dSign(pb, pc, pp) >= 0
+          && o * Orient2dSign(pc, pa, pp) >= 0;
+      }
+    return false;
+  }
+
+  void ClosestPointOnTriangle3 (const double * p, const double * a, const double * b, const double * c,
+                                double * bary)
+  {
+    // The projection onto the plane (normal equations in the edge basis) if it falls in
+    // the triangle; else the nearest point of one of the three edges.
+    double e0[3], e1[3], r[3];
+    Sub(b, a, e0); Sub(c, a, e1); Sub(p, a, r);
+    double g00 = Dot(e0, e0), g01 = Dot(e0, e1), g11 = Dot(e1, e1);
+    double r0 = Dot(r, e0), r1 = Dot(r, e1);
+    double det = g00*g11 - g01*g01;
+    if (det > 0)
+      {
+        double s = (g11*r0 - g01*r1) / det, t = (g00*r1 - g01*r0) / det;
+        if (s >= 0 && t >= 0 && s + t <= 1)
+          { bary[0] = 1 - s - t; bary[1] = s; bary[2] = t; return; }
+      }
+    const double * V[3] = { a, b, c };
+    double best = std::numeric_limits<double>::infinity();
+    for (int k = 0; k < 3; k++)
+      {
+        const double * u = V[k], * w = V[(k+1)%3];
+        double e[3], q[3];
+        Sub(w, u, e); Sub(p, u, q);
+        double l2 = Dot(e, e);
+        double t = l2 > 0 ? std::clamp(Dot(q, e) / l2, 0.0, 1.0) : 0.0;
+        double cand[3] = { 0, 0, 0 }, pt[3];
+        cand[k] = 1 - t; cand[(k+1)%3] = t;
+        double d2 = Dist2(p, a, b, c, cand, pt);
+        if (d2 < best) { best = d2; std::copy(cand, cand + 3, bary); }
+      }
+  }
+
+  namespace
+  {
+    [[noreturn]] void Bad (const std::string & what) { throw std::invalid_argument("ngfracture.DetectPenetrations3d: " + what); }
+
+    // What the search needs besides the arrays: fragment per vertex and per face, the
+    // boundary vertices, their (area-weighted) outward normals, unit face normals.
+    struct Derived
+    {
+      std::vector<int32_t> vfrag, ffrag, bverts;
+      std::vector<double> vnormal, fnormal;
+    };
+
+    Derived Derive (const TetMesh3 & m)
+    {
+      Derived D;
+      D.vfrag.assign(m.nv, -1);
+      for (int64_t t = 0; t < m.ne; t++)
+        for (int k = 0; k < 4; k++)
+          {
+            int32_t v = m.tets[4*t+k], f = m.fragment[t];
+            if (v < 0 || v >= m.nv) Bad("tets[" + std::to_string(t) + "] holds a vertex out of range");
+            if (D.vfrag[v] >= 0 && D.vfrag[v] != f)
+              Bad("vertex " + std::to_string(v) + " belongs to tetrahedra of fragments " + std::to_string(D.vfrag[v])
+                  + " and " + std::to_string(f) + " (fragments must not share vertices)");
+            D.vfrag[v] = f;
+          }
+      std::map<std::array<int32_t,3>, int32_t> face_of;
+      for (int64_t f = 0; f < m.nf; f++)
+        {
+          std::array<int32_t,3> key { m.faces[3*f], m.faces[3*f+1], m.faces[3*f+2] };
+          for (int32_t v : key)
+            if (v < 0 || v >= m.nv) Bad("faces[" + std::to_string(f) + "] holds a vertex out of range");
+          std::sort(key.begin(), key.end());
+          face_of[key] = int32_t(f);
+        }
+      D.ffrag.assign(m.nf, -1);
+      static const int opp[4][3] = { {1,2,3}, {0,2,3}, {0,1,3}, {0,1,2} };
+      for (int64_t t = 0; t < m.ne && !face_of.empty(); t++)
+        for (int k = 0; k < 4; k++)
+          {
+            std::array<int32_t,3> key { m.tets[4*t+opp[k][0]], m.tets[4*t+opp[k][1]], m.tets[4*t+opp[k][2]] };
+            std::sort(key.begin(), key.end());
+            auto it = face_of.find(key);
+            if (it != face_of.end()) D.ffrag[it->second] = m.fragment[t];
+          }
+      std::vector<uint8_t> onb(m.nv, 0);
+      D.vnormal.assign(3*m.nv, 0.0);
+      D.fnormal.assign(3*m.nf, 0.0);
+      for (int64_t f = 0; f < m.nf; f++)
+        {
+          if (D.ffrag[f] < 0) Bad("faces[" + std::to_string(f) + "] is not a face of any tetrahedron");
+          const int32_t * F = m.faces + 3*f;
+          double e0[3], e1[3], n[3];
+          Sub(m.x + 3*F[1], m.x + 3*F[0], e0); Sub(m.x + 3*F[2], m.x + 3*F[0], e1); Cross(e0, e1, n);
+          double len = std::sqrt(Dot(n, n));
+          for (int d = 0; d < 3; d++) D.fnormal[3*f+d] = len > 0 ? n[d] / len : 0.0;
+          for (int k = 0; k < 3; k++)
+            {
+              onb[F[k]] = 1;
+              for (int d = 0; d < 3; d++) D.vnormal[3*F[k]+d] += n[d];
+            }
+        }
+      for (int64_t v = 0; v < m.nv; v++)
+        if (onb[v]) D.bverts.push_back(int32_t(v));
+      return D;
+    }
+
+    // The grid geometry: origin at the low corner of the boundary vertices, cell size the
+    // mean largest extent of a tetrahedron (coarser if needed to keep 21 bits per axis).
+    void SetupGrid (const TetMesh3 & m, const Derived & D, HashGrid & g)
+    {
+      double lo[3], hi[3];
+      for (int d = 0; d < 3; d++) { lo[d] = std::numeric_limits<double>::infinity(); hi[d] = -lo[d]; }
+      for (int32_t v : D.bverts)
+        for (int d = 0; d < 3; d++)
+          { lo[d] = std::min(lo[d], m.x[3*v+d]); hi[d] = std::max(hi[d], m.x[3*v+d]); }
+      double ext = 0;
+      for (int64_t t = 0; t < m.ne; t++)
+        {
+          double e = 0;
+          for (int d = 0; d < 3; d++)
+            {
+              double a = m.x[3*m.tets[4*t]+d], b = a;
+              for (int k = 1; k < 4; k++) { a = std::min(a, m.x[3*m.tets[4*t+k]+d]); b = std::max(b, m.x[3*m.tets[4*t+k]+d]); }
+              e = std::max(e, b - a);
+            }
+          ext += e;
+        }
+      double range = std::max({ hi[0]-lo[0], hi[1]-lo[1], hi[2]-lo[2] });
+      g.h = m.ne ? ext / double(m.ne) : 1.0;
+      if (!(g.h > 0)) g.h = range > 0 ? range : 1.0;
+      g.h = std::max(g.h, range / double((1 << 20)));
+      std::copy(lo, lo + 3, g.origin);
+      g.span = int64_t(std::floor(range / g.h)) + 2;
+    }
+
+    using Hit = std::tuple<int32_t,int32_t,int32_t>;   // vertex, fragment, tet
+
+    // Every (boundary vertex, tetrahedron of another fragment) with the vertex in the
+    // closed tetrahedron: each tetrahedron's box swept over the vertex grid.
+    std::vector<Hit> SweepTets (const TetMesh3 & m, const Derived & D, const HashGrid & g, Collision3Stats & st)
+    {
+      std::vector<Hit> hits;
+      for (int64_t t = 0; t < m.ne; t++)
+        {
+          const int32_t * T = m.tets + 4*t;
+          double lo[3], hi[3];
+          int64_t a[3], b[3];
+          for (int d = 0; d < 3; d++)
+            {
+              lo[d] = hi[d] = m.x[3*T[0]+d];
+              for (int k = 1; k < 4; k++) { lo[d] = std::min(lo[d], m.x[3*T[k]+d]); hi[d] = std::max(hi[d], m.x[3*T[k]+d]); }
+              a[d] = std::max<int64_t>(g.Cell(lo[d], d), 0);
+              b[d] = std::min<int64_t>(g.Cell(hi[d], d), g.span - 1);
+            }
+          for (int64_t i = a[0]; i <= b[0]; i++)
+            for (int64_t j = a[1]; j <= b[1]; j++)
+              for (int64_t k = a[2]; k <= b[2]; k++)
+                g.Visit(i, j, k, [&] (int32_t v)
+                  {
+                    st.box_tests++;
+                    if (D.vfrag[v] == m.fragment[t]) return;
+                    const double * p = m.x + 3*v;
+                    for (int d = 0; d < 3; d++)
+                      if (p[d] < lo[d] || p[d] > hi[d]) return;
+                    st.exact_tests++;
+                    if (InClosedTet(m.x, T, p)) hits.emplace_back(v, m.fragment[t], int32_t(t));
+                  });
+        }
+      std::sort(hits.begin(), hits.end());
+      return hits;
+    }
+
+    // Master face, step 1: a face of F that holds v exactly (closed triangle) and whose
+    // normal does not point along v's (dot <= 0): v touches it, gap 0. Such a face is
+    // in v's own cell. Returns the smallest such face number or -1.
+    int32_t TouchedFace (const TetMesh3 & m, const Derived & D, const HashGrid & fg, int32_t v, int32_t F)
+    {
+      const double * p = m.x + 3*v;
+      int32_t found = -1;
+      fg.Visit(fg.Cell(p[0], 0), fg.Cell(p[1], 1), fg.Cell(p[2], 2), [&] (int32_t f)
+        {
+          if (D.ffrag[f] != F || (found >= 0 && f > found)) return;
+          if (!(Dot(&D.fnormal[3*f], &D.vnormal[3*v]) <= 0)) return;
+          const int32_t * T = m.faces + 3*f;
+          if (PointInClosedTriangle3(p, m.x + 3*T[0], m.x + 3*T[1], m.x + 3*T[2])) found = f;
+        });
+      return found;
+    }
+
+    // Step 2: the nearest face of F opposing v (normal dot < 0), or of any orientation if
+    // none does, ring by ring of cells around v; ties to the smaller face number.
+    int32_t NearestFace (const TetMesh3 & m, const Derived & D, const HashGrid & fg, int32_t v, int32_t F,
+                         bool opposing, double * bary_out)
+    {
+      const double * p = m.x + 3*v;
+      int64_t c[3] = { fg.Cell(p[0], 0), fg.Cell(p[1], 1), fg.Cell(p[2], 2) };
+      double best = std::numeric_limits<double>::infinity();
+      int32_t bf = -1;
+      auto consider = [&] (int32_t f)
+        {
+          if (D.ffrag[f] != F) return;
+          if (opposing && !(Dot(&D.fnormal[3*f], &D.vnormal[3*v]) < 0)) return;
+          const int32_t * T = m.faces + 3*f;
+          const double * a = m.x + 3*T[0], * b = m.x + 3*T[1], * cc = m.x + 3*T[2];
+          double bary[3], q[3];
+          ClosestPointOnTriangle3(p, a, b, cc, bary);
+          double d2 = Dist2(p, a, b, cc, bary, q);
+          if (d2 < best || (d2 == best && f < bf)) { best = d2; bf = f; std::copy(bary, bary + 3, bary_out); }
+        };
+      for (int64_t r = 0; r <= fg.span; r++)
+        {
+          // the shell of cells at Chebyshev distance r, clipped to the grid
+          for (int64_t i = std::max<int64_t>(c[0]-r, 0); i <= std::min(c[0]+r, fg.span-1); i++)
+            for (int64_t j = std::max<int64_t>(c[1]-r, 0); j <= std::min(c[1]+r, fg.span-1); j++)
+              {
+                bool side = std::abs(i-c[0]) == r || std::abs(j-c[1]) == r;
+                int64_t step = side || r == 0 ? 1 : 2*r;
+                for (int64_t k = c[2]-r; k <= c[2]+r; k += step)
+                  fg.Visit(i, j, k, consider);
+              }
+          // faces not seen yet lie beyond distance r h
+          if (bf >= 0 && best <= (double(r) * fg.h) * (double(r) * fg.h)) break;
+        }
+      return bf;
+    }
+
+    bool MasterFace (const TetMesh3 & m, const Derived & D, const HashGrid & fg, int32_t v, int32_t F,
+                     Penetration3 & out)
+    {
+      const double * p = m.x + 3*v;
+      int32_t f = TouchedFace(m, D, fg, v, F);
+      const int32_t * T = nullptr;
+      if (f >= 0)
+        {
+          T = m.faces + 3*f;
+          ClosestPointOnTriangle3(p, m.x + 3*T[0], m.x + 3*T[1], m.x + 3*T[2], out.bary);
+          std::copy(p, p + 3, out.proj);
+          out.gap = 0.0;
+        }
+      else
+        {
+          f = NearestFace(m, D, fg, v, F, true, out.bary);
+          if (f < 0) f = NearestFace(m, D, fg, v, F, false, out.bary);
+          if (f < 0) return false;
+          T = m.faces + 3*f;
+          double d2 = Dist2(p, m.x + 3*T[0], m.x + 3*T[1], m.x + 3*T[2], out.bary, out.proj);
+          out.gap = -std::sqrt(d2);
+        }
+      out.face = f;
+      std::copy(&D.fnormal[3*f], &D.fnormal[3*f] + 3, out.normal);
+      return true;
+    }
+
+    struct BitsHash
+    {
+      size_t operator() (const std::array<uint64_t,3> & k) const
+      { return size_t(k[0] * 0x9E3779B97F4A7C15ull ^ (k[1] + 0x632BE59BD9B4E019ull) * 0xBF58476D1CE4E5B9ull ^ k[2]); }
+    };
+    std::array<uint64_t,3> Bits (const double * p)
+    {
+      std::array<uint64_t,3> k;
+      std::memcpy(k.data(), p, 3 * sizeof(double));
+      return k;
+    }
+  }
+
+  std::vector<Penetration3> DetectPenetrations3 (const TetMesh3 & m, Collision3Stats * stats)
+  {
+    Collision3Stats st;
+    Derived D = Derive(m);
+    st.boundary_vertices = int64_t(D.bverts.size());
+    std::vector<Penetration3> out;
+    if (D.bverts.empty() || m.ne == 0) { if (stats) *stats = st; return out; }
+    HashGrid vg;
+    SetupGrid(m, D, vg);
+    st.cell = vg.h;
+    std::vector<double> lo(3*D.bverts.size()), hi;
+    for (size_t s = 0; s < D.bverts.size(); s++)
+      std::copy(m.x + 3*D.bverts[s], m.x + 3*D.bverts[s] + 3, &lo[3*s]);
+    vg.Build(lo, lo);
+    for (auto & it : vg.items) it = D.bverts[it];        // grid items: vertex numbers
+    std::vector<Hit> hits = SweepTets(m, D, vg, st);
+    if (hits.empty()) { if (stats) *stats = st; return out; }
+
+    HashGrid fg = vg;                                    // same cells, boundary faces
+    lo.assign(3*m.nf, 0.0); hi.assign(3*m.nf, 0.0);
+    for (int64_t f = 0; f < m.nf; f++)
+      for (int d = 0; d < 3; d++)
+        {
+          double a = m.x[3*m.faces[3*f]+d], b = m.x[3*m.faces[3*f+1]+d], c = m.x[3*m.faces[3*f+2]+d];
+          lo[3*f+d] = std::min({a, b, c}); hi[3*f+d] = std::max({a, b, c});
+        }
+    fg.items.clear(); fg.range.clear();
+    fg.Build(lo, hi);
+    std::unordered_map<std::array<uint64_t,3>, std::vector<int32_t>, BitsHash> copies;
+    for (int32_t v : D.bverts) copies[Bits(m.X + 3*v)].push_back(v);
+
+    for (size_t s = 0; s < hits.size(); s++)
+      {
+        auto [v, F, t] = hits[s];
+        if (s > 0 && std::get<0>(hits[s-1]) == v && std::get<1>(hits[s-1]) == F) continue;
+        Penetration3 pen;
+        pen.vertex = v; pen.fragment = F; pen.tet = t; pen.twin = -1;
+        for (int32_t w : copies[Bits(m.X + 3*v)])        // increasing: the first twin on F
+          if (w != v && D.vfrag[w] == F) { pen.twin = w; break; }
+        if (pen.twin >= 0 && std::memcmp(m.x + 3*v, m.x + 3*pen.twin, 3 * sizeof(double)) == 0)
+          { st.closed_seams++; continue; }                 // a closed seam: the twins' business
+        if (!MasterFace(m, D, fg, v, F, pen)) continue;
+        out.push_back(pen);
+      }
+    if (stats) *stats = st;
+    return out;
+  }
+}

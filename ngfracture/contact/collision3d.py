@@ -1,0 +1,216 @@
+"""Collision detection between the fragments of a tetrahedral mesh (3D, paper section 3.1).
+
+The 3D analogue of :mod:`ngfracture.contact.collision`, and the first building block of
+3D contact: it finds the slave vertices and their master triangles; the contact rows are
+not built here. Everything works on plain arrays in the convention of
+:mod:`ngfracture.geometry.solid` (tets positively oriented, boundary faces pointing out of
+the body, crack lips as coincident faces whose vertices are bitwise-equal copies), plus a
+fragment number per tetrahedron (:func:`ngfracture.fracture.split3d.fragments_3d`).
+
+What is found. A *penetration* is a pair (boundary vertex v of fragment A, fragment
+F != A) with v, at its current position, in the closed volume of F: in some closed
+tetrahedron of F. The closed test makes touching (a vertex on F's surface) a candidate
+with gap 0 instead of nothing, so contact can be activated at zero gap, as the 2D
+precision threshold does; pairs with gap < 0 are the penetrations proper. Fragments must
+not share vertices (a vertex in tetrahedra of two fragments is refused).
+
+Predicate. Point-in-tetrahedron uses the exact ``orient3d`` (sign of det[a-d, b-d, c-d];
+a positively oriented tetrahedron gives -1): the point is in the closed tetrahedron iff
+replacing any vertex by the point never flips the tetrahedron's sign. ``orient3d`` is
+adaptive like ``orient2d``: a floating-point filter with Shewchuk's bound (7 + 56 eps) eps
+times the permanent decides almost every call; then, if the nine coordinate differences
+are exact, the 24 exact triple products of the differences; else the 96-term expansion of
+the 4 x 4 determinant [[a, 1], [b, 1], [c, 1], [d, 1]]. Exact barring overflow and
+underflow of products (coordinates in about [1e-100, 1e100] or zero). "On a face" is
+exact too: orient3d = 0 and, in a coordinate plane where the triangle is not degenerate
+(dropping a coordinate keeps orientation signs of coplanar points), three orient2d >= 0.
+
+Search, O(n) expected. One cell size h, the mean largest extent of a tetrahedron's
+bounding box. The boundary vertices are hashed into cells of h; every tetrahedron sweeps
+the cells its bounding box overlaps (about 8 for h of the element size) and the vertices
+there of other fragments that pass the box test get the exact test. Memory and time are
+linear in the numbers of tetrahedra and boundary vertices for bounded cell occupancy
+(a few huge tetrahedra among small ones make them sweep many cells, correctly but slowly).
+
+Master face. For each pair, in this order:
+
+1. touching: a boundary face of F that holds v exactly (closed triangle, exact
+   predicates) and whose outward normal does not point along v's normal (dot <= 0; v's
+   normal is the area-weighted sum of the normals of its own boundary faces): gap 0
+   exactly, projection x_v itself;
+2. else the boundary face of F nearest to v (Euclidean distance to the closed triangle)
+   among those whose normal opposes v's (dot < 0);
+3. else the nearest face of F of any orientation.
+
+The orientation filter is the 3D form of the 2D rule 3 (angle between master and slave):
+a vertex at the edge of a crack lip, pushed across the crack, lies exactly on the other
+piece's side face (distance 0) but its master is the opposite lip, at the depth of the
+penetration; a vertex of a box pushed 1/4 into another one is pushed back along the
+overlap direction, not through side faces that are nearer but perpendicular to it. Faces
+are hashed into the same cells (every cell their box overlaps) and searched ring by ring
+of cells around v, until the best distance is at most r h after ring r (faces not seen
+are farther). Ties go to the smaller face number. The gap is -|x_v - p| with p the
+nearest point (0 in case 1); p, its barycentric coordinates on the face and the face's
+unit normal are returned.
+
+Seams. Where the splitting made copies of a vertex, v has a *twin* on F: a vertex with
+the bitwise-equal reference point. A closed seam (twin at the bitwise-equal current
+point) is not reported at all: as in 2D (:mod:`ngfracture.contact.seams`), coincident
+lips are the business of node-to-node rows between twins, not of the node-to-face search
+(whose master choice there would depend on rounding). Once the twins have moved apart and
+v lies in F, the pair is reported with its twin, so the rows can use either.
+
+Output order is deterministic: sorted by (vertex, fragment).
+"""
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import _ngfracture as _ext
+
+__all__ = ["orient3d", "Penetrations3d", "detect_penetrations_3d"]
+
+
+def _points(p, name):
+    p = np.atleast_2d(np.asarray(p, dtype=np.float64))
+    if p.ndim != 2 or p.shape[1] != 3:
+        raise ValueError(f"{name} must have shape (n, 3), got {p.shape}")
+    if not np.isfinite(p).all():
+        raise ValueError(f"{name} contains NaN or inf")
+    return np.ascontiguousarray(p)
+
+
+def orient3d(a, b, c, d):
+    """Exact sign of det[a_i - d_i, b_i - d_i, c_i - d_i] for rows of points.
+
+    Parameters
+    ----------
+    a, b, c, d : array_like, shape (n, 3) or (3,)
+        Points.
+
+    Returns
+    -------
+    numpy.ndarray of int8, shape (n,)
+        +1, -1, or 0 if the four points are coplanar. A positively oriented tetrahedron
+        (det[x1-x0, x2-x0, x3-x0] > 0) gives -1.
+
+    Raises
+    ------
+    ValueError
+        If shapes differ or a coordinate is not finite.
+    """
+    pts = [_points(p, name) for name, p in (("a", a), ("b", b), ("c", c), ("d", d))]
+    if not all(p.shape == pts[0].shape for p in pts):
+        raise ValueError("a, b, c and d must have the same shape")
+    return _ext.Orient3d(*pts)
+
+
+@dataclass
+class Penetrations3d:
+    """Boundary vertices in the closed volume of another fragment (one row per pair).
+
+    Parameters
+    ----------
+    vertex : numpy.ndarray of int, shape (k,)
+        The slave vertex.
+    fragment : numpy.ndarray of int, shape (k,)
+        The fragment it is in.
+    tet : numpy.ndarray of int, shape (k,)
+        The smallest-numbered tetrahedron of that fragment holding it (closed).
+    face : numpy.ndarray of int, shape (k,)
+        The master boundary face (row of ``faces``).
+    twin : numpy.ndarray of int, shape (k,)
+        The vertex's copy on that fragment (bitwise-equal reference point), or -1.
+    projection : numpy.ndarray, shape (k, 3)
+        The nearest point of the master face.
+    bary : numpy.ndarray, shape (k, 3)
+        Its barycentric coordinates on the face's vertices (in the face's order).
+    normal : numpy.ndarray, shape (k, 3)
+        The master face's unit outward normal.
+    gap : numpy.ndarray, shape (k,)
+        Minus the distance to the master face: 0 exactly for a vertex on it, < 0 inside.
+    stats : dict
+        Search counts: ``cell`` (cell size), ``boundary_vertices``, ``box_tests``,
+        ``exact_tests``, ``closed_seams`` (pairs left out as closed seams).
+    """
+    vertex: np.ndarray
+    fragment: np.ndarray
+    tet: np.ndarray
+    face: np.ndarray
+    twin: np.ndarray
+    projection: np.ndarray
+    bary: np.ndarray
+    normal: np.ndarray
+    gap: np.ndarray
+    stats: dict
+
+    def __len__(self):
+        return len(self.vertex)
+
+    @property
+    def penetrating(self):
+        """Rows with a negative gap (touching vertices, gap 0, excluded).
+
+        Returns
+        -------
+        numpy.ndarray of bool, shape (k,)
+        """
+        return self.gap < 0
+
+
+def _indices(a, name, cols, n):
+    a = np.asarray(a)
+    if a.ndim != 2 or a.shape[1] != cols:
+        raise ValueError(f"{name} must have shape (m, {cols}), got {a.shape}")
+    if a.size and (a.min() < 0 or a.max() >= n):
+        raise ValueError(f"{name} holds vertex numbers outside [0, {n})")
+    return np.ascontiguousarray(a, dtype=np.int32)
+
+
+def detect_penetrations_3d(points, tets, faces, fragment, displacement=None):
+    """Boundary vertices of each fragment in the closed volume of another, with master faces.
+
+    Parameters
+    ----------
+    points : array_like, shape (nv, 3)
+        Reference coordinates (copies made by splitting are bitwise equal).
+    tets : array_like of int, shape (ne, 4)
+        Tetrahedra (positively oriented in the reference configuration; inverted ones in
+        the current configuration are tested with their own orientation, flat ones never
+        hold a point).
+    faces : array_like of int, shape (nf, 3)
+        Boundary triangles, outward (outer boundary and crack lips).
+    fragment : array_like of int, shape (ne,)
+        Fragment number per tetrahedron.
+    displacement : array_like, shape (nv, 3), optional
+        Current position = points + displacement; zero if omitted.
+
+    Returns
+    -------
+    Penetrations3d
+        Sorted by (vertex, fragment); see the module docstring for the rules.
+
+    Raises
+    ------
+    ValueError
+        On wrong shapes, non-finite coordinates, vertex numbers out of range, a face that
+        is no face of a tetrahedron, or a vertex in tetrahedra of two fragments.
+    """
+    X = _points(points, "points")
+    x = X
+    if displacement is not None:
+        U = _points(displacement, "displacement")
+        if U.shape != X.shape:
+            raise ValueError(f"displacement must have the shape of points {X.shape}, got {U.shape}")
+        x = X + U
+    T = _indices(tets, "tets", 4, len(X))
+    F = _indices(faces, "faces", 3, len(X))
+    frag = np.ascontiguousarray(fragment, dtype=np.int32)
+    if frag.shape != (len(T),):
+        raise ValueError(f"fragment must have shape ({len(T)},), got {frag.shape}")
+    ids, geo, stats = _ext.DetectPenetrations3d(X, np.ascontiguousarray(x), T, F, frag)
+    ids = np.asarray(ids, dtype=np.int64).reshape(-1, 5)
+    geo = np.asarray(geo, dtype=np.float64).reshape(-1, 10)
+    return Penetrations3d(vertex=ids[:, 0], fragment=ids[:, 1], tet=ids[:, 2], face=ids[:, 3],
+                          twin=ids[:, 4], projection=geo[:, 0:3], bary=geo[:, 3:6],
+                          normal=geo[:, 6:9], gap=geo[:, 9], stats=dict(stats))
