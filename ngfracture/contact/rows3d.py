@@ -1,0 +1,497 @@
+"""Node-to-face contact rows on tetrahedral meshes (paper section 3.2, eq. 12-14, in 3D).
+
+The 3D form of the node-to-segment rows of :mod:`ngfracture.contact.rows`, built from the
+pairs that :func:`ngfracture.contact.collision3d.detect_penetrations_3d` finds: for a slave
+vertex s and its master boundary triangle (i, j, k) of another fragment, with the
+barycentric coordinates b of the slave's projection on the master face and the face's unit
+outward normal n both frozen at the configuration of the detection (eq. 13),
+
+    g_N(u) = n . ( (X_s + u_s) - sum_l b_l (X_l + u_l) ) = C u + g,
+
+the signed distance of the slave from the master face's plane: positive = separated,
+negative = penetration. The non-penetration condition is g_N >= 0 (frictionless); an
+active row imposes C u + g = 0, i.e. the problem's constraint rows get ``C`` and ``-g``.
+g is the row applied to the reference coordinates, so for an interface flat in the
+reference configuration g = 0 exactly and C u is the whole gap.
+
+Layout and signs are those of the 2D rows, with a third component: the dof of component
+``comp`` (0 = x, 1 = y, 2 = z) of vertex ``v`` is ``comp * nv + v`` (P1 ``VectorH1``,
+component-blocked), and in [[K, G^T, C^T], [G, 0, 0], [C, 0, 0]] [u; lambda_D; lambda_c]
+= [f; b; -g] a compressive contact has lambda_c <= 0: the force the row puts on the slave
+node is -lambda_c n, along the master's outward normal, i.e. pushing the slave out. The
+rows have the fields the active set of :mod:`ngfracture.contact.active_set` consumes
+(``C``, ``g``, ``dist``, ``subset``, ``stack``, ``len``), so its primal-dual update, its
+redundancy removal and its records take them unchanged.
+
+Slave and master. A pair (v, F) of the detection gives one row, with v the slave; the
+caller chooses the slaves with ``slave`` (a vertex mask). On a flat interface between
+non-matching meshes the exact linear field of a uniform pressure satisfies every row of
+either pass, but equilibrium decides which passes reproduce it:
+
+- one pass (one side the slaves) does not. The slave's force reaches the master nodes
+  through the barycentrics, sum_i lambda_i b_ij, and for lambda_i = p A_i (A_i the slave's
+  consistent nodal area) that is p A_j of the master node j only where the meshes match
+  (Taylor and Papadopoulos' failure of node-to-segment contact). Measured on the test's
+  blocks (3 x 3 against 4 x 4 uneven cells): displacement error 3.4e-2 of the load
+  displacement, nodal pressures 0.51 to 1.23 of the exact one;
+- two passes (both sides slaves) do: the multipliers of the rows at a node are no longer
+  its pressure alone, but for the exact field the interface equations
+  lambda_j + sum_i lambda_i b_ij = p A_j (both sides) have a solution, and the solve finds
+  the exact field (1.5e-15 of the load displacement) and the force of all rows at every
+  interface node over its consistent nodal area is the exact pressure (1.4e-14 relative).
+
+Vertices whose copy on the other fragment sits at the same reference point (corners of a
+common face of two bodies meshed apart, closed seams of a crack) are left out by the
+detection; :func:`twin_rows` gives them a node-to-face row on a face at the twin. Rows of
+both passes at such a twin are the same row reversed, and the redundancy removal keeps one.
+The tributary area of a node, by which a force is a pressure, is the consistent nodal area
+of the surface: the integral of its hat function, a third of the area of every face at
+the node (:func:`nodal_areas`).
+
+The detection has no precision threshold: a node touching a face can be lost to rounding
+(nine perimeter nodes of the test's interface, moved out of the other block by 1e-18 in
+the prediction). Candidates are therefore gathered where touching is exact (the reference
+configuration of two blocks meshed apart) and joined by those found penetrating later,
+as the 2D active set keeps the rows it has found.
+"""
+from dataclasses import dataclass
+import functools
+
+import numpy as np
+import scipy.sparse as sp
+
+__all__ = ["NodeToFaceRows", "no_face_rows", "node_to_face_rows", "twin_rows", "face_gap_rows",
+           "relinearise_node_to_face", "nodal_areas", "space_columns_3d"]
+
+#: the per-row arrays of NodeToFaceRows, in constructor order
+_ROW_FIELDS = ("slave", "master", "face", "bary", "normal", "dist", "g")
+
+
+@dataclass
+class NodeToFaceRows:
+    """Node-to-face rows, one entry per row of C.
+
+    Parameters
+    ----------
+    slave : numpy.ndarray of int, shape (m,)
+        Slave vertex.
+    master : numpy.ndarray of int, shape (m, 3)
+        Vertices of the master face, in the face's order.
+    face : numpy.ndarray of int, shape (m,)
+        The master face (row of the mesh's boundary faces).
+    bary : numpy.ndarray, shape (m, 3)
+        Barycentric coordinates of the slave's projection on the master face.
+    normal : numpy.ndarray, shape (m, 3)
+        Unit outward normal of the master face.
+    dist : numpy.ndarray, shape (m,)
+        Signed distance at the configuration of the detection (negative = penetration).
+    g : numpy.ndarray, shape (m,)
+        Constant part: C u + g is the linearised signed gap.
+    nv : int
+        Number of vertices (C has 3 nv columns).
+
+    Attributes
+    ----------
+    C : scipy.sparse.csr_matrix, shape (m, 3 nv)
+        The gap rows (component-blocked dofs), built at first use and kept.
+    """
+    slave: np.ndarray
+    master: np.ndarray
+    face: np.ndarray
+    bary: np.ndarray
+    normal: np.ndarray
+    dist: np.ndarray
+    g: np.ndarray
+    nv: int
+
+    def __len__(self):
+        return len(self.g)
+
+    @functools.cached_property
+    def C(self):
+        """The gap rows as a sparse matrix, shape (m, 3 nv), built at first use."""
+        return _gap_matrix(self.slave, self.master, self.bary, self.normal, self.nv)
+
+    @classmethod
+    def stack(cls, parts):
+        """The rows of several NodeToFaceRows (same number of vertices), in order.
+
+        Parameters
+        ----------
+        parts : sequence of NodeToFaceRows
+            At least one.
+
+        Returns
+        -------
+        NodeToFaceRows
+            The rows of ``parts[0]``, then those of ``parts[1]``, ...
+
+        Raises
+        ------
+        ValueError
+            Parts of meshes with different numbers of vertices.
+        """
+        nv = parts[0].nv
+        if any(p.nv != nv for p in parts):
+            raise ValueError(f"NodeToFaceRows.stack: rows of meshes with {sorted(set(p.nv for p in parts))} vertices")
+        return cls(*(np.concatenate([getattr(p, f) for p in parts]) for f in _ROW_FIELDS), nv=nv)
+
+    def subset(self, rows):
+        """The rows ``rows`` (an index array or boolean mask).
+
+        Parameters
+        ----------
+        rows : array_like of int or bool
+            Row indices (in the order wanted) or a mask of shape (m,).
+
+        Returns
+        -------
+        NodeToFaceRows
+            New arrays holding the selected rows.
+        """
+        rows = np.asarray(rows)
+        if rows.dtype != bool:
+            rows = rows.astype(np.int64)
+        return NodeToFaceRows(*(getattr(self, f)[rows] for f in _ROW_FIELDS), nv=self.nv)
+
+    def keys(self):
+        """The key of every row, ("f", slave, master vertices sorted): a row's identity for the active set.
+
+        Returns
+        -------
+        list of tuple
+        """
+        return [("f", s) + tuple(sorted(m)) for s, m in zip(self.slave.tolist(), self.master.tolist())]
+
+
+def no_face_rows(nv):
+    """No rows, for a mesh of nv vertices.
+
+    Parameters
+    ----------
+    nv : int
+        Number of vertices (C has 3 nv columns).
+
+    Returns
+    -------
+    NodeToFaceRows
+        Zero rows.
+    """
+    e = np.zeros(0, dtype=np.int64)
+    return NodeToFaceRows(slave=e, master=np.zeros((0, 3), np.int64), face=e, bary=np.zeros((0, 3)),
+                          normal=np.zeros((0, 3)), dist=np.zeros(0), g=np.zeros(0), nv=nv)
+
+
+def _gap_matrix(slave, master, bary, normal, nv):
+    """C of :func:`face_gap_rows`, for arrays already checked."""
+    m = len(slave)
+    w = np.concatenate([np.ones((m, 1)), -bary], axis=1)                  # weights of s, i, j, k
+    verts = np.concatenate([slave[:, None], master], axis=1).astype(np.int64)
+    rows = np.repeat(np.arange(m), 12)
+    cols = np.concatenate([verts + comp * nv for comp in range(3)], axis=1).ravel()
+    vals = np.concatenate([w * normal[:, comp:comp + 1] for comp in range(3)], axis=1).ravel()
+    C = sp.csr_matrix((vals, (rows, cols)), shape=(m, 3 * nv))        # duplicates summed
+    C.eliminate_zeros()                                                # projection on an edge or vertex
+    return C
+
+
+def _gap_offset(X, slave, master, bary, normal):
+    pos = X[slave] - np.einsum("ij,ijk->ik", bary, X[master])
+    return np.einsum("ij,ij->i", pos, normal)
+
+
+def _vertices(v, name, nv, shape):
+    v = np.asarray(v)
+    if v.shape != shape or (v.size and not np.issubdtype(v.dtype, np.integer)):
+        raise ValueError(f"{name} must be integers of shape {shape}, got {v.dtype} {v.shape}")
+    v = v.astype(np.int64)
+    if v.size and (v.min() < 0 or v.max() >= nv):
+        raise ValueError(f"{name} holds vertex numbers outside [0, {nv})")
+    return v
+
+
+def _coordinates(p, name, nv=None):
+    p = np.asarray(p, dtype=np.float64)
+    if p.ndim != 2 or p.shape[1] != 3 or (nv is not None and p.shape[0] != nv):
+        raise ValueError(f"{name} must have shape ({'nv' if nv is None else nv}, 3), got {p.shape}")
+    if not np.isfinite(p).all():
+        raise ValueError(f"{name} contains NaN or inf")
+    return p
+
+
+def face_gap_rows(points, slave, master, bary, normal):
+    """Rows of the linearised gap: C u + g = n . (x_s - sum_l b_l x_l).
+
+    Parameters
+    ----------
+    points : array_like, shape (nv, 3)
+        Reference vertex coordinates X.
+    slave : array_like of int, shape (m,)
+        Slave vertices.
+    master : array_like of int, shape (m, 3)
+        Master face vertices.
+    bary : array_like, shape (m, 3)
+        Barycentric weights of the projection point on the master face.
+    normal : array_like, shape (m, 3)
+        Unit normals (outward from the master, towards the slave).
+
+    Returns
+    -------
+    C : scipy.sparse.csr_matrix, shape (m, 3 nv)
+        Component-blocked dofs: dof(v, comp) = comp * nv + v.
+    g : numpy.ndarray, shape (m,)
+        n . (X_s - sum_l b_l X_l).
+
+    Raises
+    ------
+    ValueError
+        On inconsistent shapes, non-finite numbers or vertex numbers out of range.
+    """
+    X = _coordinates(points, "points")
+    nv = len(X)
+    slave = _vertices(np.ravel(slave), "slave", nv, (np.size(slave),))
+    m = len(slave)
+    master = _vertices(master, "master", nv, (m, 3))
+    bary, normal = _coordinates(bary, "bary", m), _coordinates(normal, "normal", m)
+    return _gap_matrix(slave, master, bary, normal, nv), _gap_offset(X, slave, master, bary, normal)
+
+
+def node_to_face_rows(points, faces, penetrations, slave=None):
+    """The node-to-face rows of detected pairs (one per pair, its vertex the slave).
+
+    Parameters
+    ----------
+    points : array_like, shape (nv, 3)
+        Reference coordinates (those the detection had).
+    faces : array_like of int, shape (nf, 3)
+        The boundary faces the detection had.
+    penetrations : ngfracture.contact.collision3d.Penetrations3d
+        Pairs at the configuration of the detection, with master face, barycentrics,
+        normal and gap.
+    slave : array_like of bool, shape (nv,), optional
+        Vertices that may be slaves (single-pass contact, see the module docstring);
+        all if omitted.
+
+    Returns
+    -------
+    NodeToFaceRows
+        In the order of the pairs; ``dist`` is the detected gap.
+
+    Raises
+    ------
+    ValueError
+        On wrong shapes, or face or vertex numbers out of range.
+    """
+    X = _coordinates(points, "points")
+    nv = len(X)
+    F = np.asarray(faces)
+    F = _vertices(F, "faces", nv, (F.shape[0] if F.ndim == 2 else -1, 3))
+    pen = penetrations
+    keep = np.ones(len(pen), dtype=bool)
+    if slave is not None:
+        mask = np.asarray(slave)
+        if mask.shape != (nv,) or mask.dtype != bool:
+            raise ValueError(f"slave must be a boolean mask of shape ({nv},), got {mask.dtype} {mask.shape}")
+        vertex = _vertices(pen.vertex, "penetrations.vertex", nv, (len(pen),))
+        keep = mask[vertex]
+    face = np.asarray(pen.face, dtype=np.int64)[keep]
+    if face.size and (face.min() < 0 or face.max() >= len(F)):
+        raise ValueError(f"penetrations.face holds face numbers outside [0, {len(F)})")
+    s = _vertices(np.asarray(pen.vertex)[keep], "penetrations.vertex", nv, (len(face),))
+    bary = _coordinates(np.asarray(pen.bary)[keep], "penetrations.bary", len(face))
+    normal = _coordinates(np.asarray(pen.normal)[keep], "penetrations.normal", len(face))
+    master = F[face]
+    return NodeToFaceRows(slave=s, master=master, face=face, bary=bary.copy(), normal=normal.copy(),
+                          dist=np.asarray(pen.gap, dtype=np.float64)[keep].copy(),
+                          g=_gap_offset(X, s, master, bary, normal), nv=nv)
+
+
+def twin_rows(points, faces, slave):
+    """Rows for slave vertices whose copy on another fragment sits at the same reference point.
+
+    :func:`~ngfracture.contact.collision3d.detect_penetrations_3d` leaves such pairs out while
+    they coincide (closed seams), and two bodies meshed apart share the corners of a common
+    face in the same way. The row of slave s with twin t is a node-to-face row on the face
+    of t's fragment at t whose unit outward normal opposes s's normal most (s's normal: the
+    area-weighted sum of the normals of its own boundary faces), with the projection at t
+    (barycentric 1 there): at a flat interface the interface's normal. Slaves whose faces at
+    the twin all face along their normal (dot >= 0) get no row. Ties go to the smaller face.
+
+    Parameters
+    ----------
+    points : array_like, shape (nv, 3)
+        Reference coordinates (copies bitwise equal).
+    faces : array_like of int, shape (nf, 3)
+        Boundary faces, outward.
+    slave : array_like of bool, shape (nv,)
+        Vertices that may be slaves (one side of the contact); a twin of a slave is any
+        boundary vertex at the same reference point that is not in ``slave``.
+
+    Returns
+    -------
+    NodeToFaceRows
+        Sorted by slave vertex; ``dist`` is the gap at the reference configuration (0).
+
+    Raises
+    ------
+    ValueError
+        On wrong shapes or vertex numbers out of range.
+    """
+    X = _coordinates(points, "points")
+    nv = len(X)
+    F = np.asarray(faces)
+    F = _vertices(F, "faces", nv, (F.shape[0] if F.ndim == 2 else -1, 3))
+    mask = np.asarray(slave)
+    if mask.shape != (nv,) or mask.dtype != bool:
+        raise ValueError(f"slave must be a boolean mask of shape ({nv},), got {mask.dtype} {mask.shape}")
+    p = X[F]
+    area2 = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+    unit = area2 / np.linalg.norm(area2, axis=1)[:, None]
+    vnormal = np.zeros((nv, 3))
+    np.add.at(vnormal, F.ravel(), np.repeat(area2, 3, axis=0))
+    on = np.unique(F)
+    _, group = np.unique(X[on], axis=0, return_inverse=True)
+    order = np.argsort(group.ravel(), kind="stable")
+    on, group = on[order], group.ravel()[order]
+    first = np.searchsorted(group, group)                                  # start of each vertex's group
+    size = np.searchsorted(group, group, side="right") - first
+    # pairs (slave s, twin t): every other vertex of s's group outside the slaves
+    who, other = _ranges(first, size)
+    s, t = on[who], on[other]
+    pick = mask[s] & ~mask[t]
+    s, t = s[pick], t[pick]
+    # candidate faces: every face at the twin
+    inc = np.argsort(F.ravel(), kind="stable")
+    start = np.searchsorted(F.ravel()[inc], t)
+    count = np.searchsorted(F.ravel()[inc], t, side="right") - start
+    pair, slot = _ranges(start, count)
+    face, k = np.divmod(inc[slot], 3)
+    s = s[pair]
+    dots = np.einsum("ij,ij->i", unit[face], vnormal[s])
+    best = np.lexsort((face, dots, s))                                      # per slave: most opposed, smaller face
+    best = best[np.r_[True, s[best][1:] != s[best][:-1]]] if len(best) else best
+    best = best[dots[best] < 0]
+    if not len(best):
+        return no_face_rows(nv)
+    s, face, k = s[best], face[best], k[best]
+    bary = np.zeros((len(s), 3))
+    bary[np.arange(len(s)), k] = 1.0
+    master, normal = F[face], unit[face]
+    g = _gap_offset(X, s, master, bary, normal)
+    return NodeToFaceRows(slave=s, master=master, face=face, bary=bary, normal=normal, dist=g.copy(), g=g, nv=nv)
+
+
+def _ranges(start, count):
+    """For entries e with ranges [start_e, start_e + count_e): (e, index) for every index of every range."""
+    owner = np.repeat(np.arange(len(start)), count)
+    offset = np.arange(len(owner)) - np.repeat(np.cumsum(count) - count, count)
+    return owner, np.repeat(start, count) + offset
+
+
+def relinearise_node_to_face(rows, points, displacement):
+    """The rows with the master face's normal and the slave's projection at X + U.
+
+    The projection is onto the face's plane, its barycentrics clipped to the triangle
+    (negative weights set to 0 and the rest rescaled to sum 1); the normal keeps its
+    side. A master face squeezed below 1e-16 of its reference area keeps its previous
+    normal and barycentrics.
+
+    Parameters
+    ----------
+    rows : NodeToFaceRows
+        The rows to re-linearise.
+    points, displacement : array_like, shape (nv, 3)
+        Reference coordinates X and displacements U.
+
+    Returns
+    -------
+    NodeToFaceRows
+        The same rows in the same order with bary, normal, dist (signed distance at
+        X + U) and g recomputed; ``rows`` itself when empty.
+
+    Raises
+    ------
+    ValueError
+        On shapes that do not match the rows' vertices, or non-finite numbers.
+    """
+    if len(rows) == 0:
+        return rows
+    X = _coordinates(points, "points", rows.nv)
+    x = X + _coordinates(displacement, "displacement", rows.nv)
+    p = x[rows.master]
+    area2 = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+    length = np.linalg.norm(area2, axis=1)
+    P = X[rows.master]
+    reference = np.linalg.norm(np.cross(P[:, 1] - P[:, 0], P[:, 2] - P[:, 0]), axis=1)
+    degenerate = ~(length > 1e-16 * reference)
+    face_normal = area2 / np.where(degenerate, 1.0, length)[:, None]
+    # barycentrics of the slave's projection: signed sub-areas over the area, along the face normal
+    q = x[rows.slave]
+    b = np.stack([np.einsum("ij,ij->i", np.cross(p[:, (l + 1) % 3] - q, p[:, (l + 2) % 3] - q), face_normal)
+                  for l in range(3)], axis=1) / np.where(degenerate, 1.0, length)[:, None]
+    n = face_normal * np.where(np.einsum("ij,ij->i", face_normal, rows.normal) < 0, -1.0, 1.0)[:, None]
+    n[degenerate] = rows.normal[degenerate]
+    b = np.clip(b, 0.0, None)
+    b /= np.where(b.sum(axis=1) > 0, b.sum(axis=1), 1.0)[:, None]
+    b[degenerate] = rows.bary[degenerate]
+    dist = np.einsum("ij,ij->i", q - np.einsum("ij,ijk->ik", b, p), n)
+    return NodeToFaceRows(rows.slave, rows.master, rows.face, b, n, dist,
+                          _gap_offset(X, rows.slave, rows.master, b, n), nv=rows.nv)
+
+
+def nodal_areas(points, faces):
+    """Consistent nodal areas of a triangulated surface: the integral of each vertex's hat function.
+
+    Parameters
+    ----------
+    points : array_like, shape (nv, 3)
+        Vertex coordinates.
+    faces : array_like of int, shape (nf, 3)
+        The surface's triangles.
+
+    Returns
+    -------
+    numpy.ndarray, shape (nv,)
+        A third of the area of every face at the vertex, summed (0 off the surface).
+
+    Raises
+    ------
+    ValueError
+        On wrong shapes or vertex numbers out of range.
+    """
+    X = _coordinates(points, "points")
+    F = np.asarray(faces)
+    F = _vertices(F, "faces", len(X), (F.shape[0] if F.ndim == 2 else -1, 3))
+    p = X[F]
+    area = 0.5 * np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1)
+    out = np.zeros(len(X))
+    np.add.at(out, F.ravel(), np.repeat(area / 3.0, 3))
+    return out
+
+
+def space_columns_3d(C, nv, n):
+    """Rows with their columns moved from the P1 layout (comp * nv + v) to the space's (comp * n + v).
+
+    Parameters
+    ----------
+    C : scipy.sparse matrix, shape (m, 3 nv)
+        Rows in the P1 layout.
+    nv : int
+        Number of vertices.
+    n : int
+        Dofs per component of the space (``fes.ndof // 3``; n >= nv, the vertex dofs first).
+
+    Returns
+    -------
+    scipy.sparse.csr_matrix, shape (m, 3 n)
+
+    Raises
+    ------
+    ValueError
+        If C does not have 3 nv columns or n < nv.
+    """
+    C = sp.csr_matrix(C)
+    if C.shape[1] != 3 * nv or n < nv:
+        raise ValueError(f"space_columns_3d: C has {C.shape[1]} columns, expected 3 nv = {3 * nv} (n = {n})")
+    comp, v = np.divmod(C.indices, nv)
+    return sp.csr_matrix((C.data, comp * n + v, C.indptr), shape=(C.shape[0], 3 * n))
