@@ -52,7 +52,7 @@ def plate_results(tmp_path_factory):
 
 
 @pytest.mark.parametrize("args,message", [
-    (["run", "plat"], "unknown scene 'plat': the built-in scenes are bar3d, beam, disintegration, disk, holed_beam, plate, plate3d, shaft3d"),
+    (["run", "plat"], "unknown scene 'plat': the built-in scenes are bar3d, beam, blocks3d, disintegration, disk, holed_beam, plate, plate3d, shaft3d"),
     (["run", "plate", "--set", "E"], "'E': expected NAME=VALUE"),
     (["run", "plate", "--set", "young=1"], "unknown scene parameter 'young'; the known ones are: maxh,"),
     (["run", "plate", "--set", "E=soft"], "E=soft: expected a number"),

@@ -37,7 +37,7 @@ def test_file_spec(tmp_path):
 
 
 @pytest.mark.parametrize("spec,message", [
-    ("plat", "unknown scene 'plat': the built-in scenes are bar3d, beam, disintegration, disk, holed_beam, plate, plate3d, shaft3d"),
+    ("plat", "unknown scene 'plat': the built-in scenes are bar3d, beam, blocks3d, disintegration, disk, holed_beam, plate, plate3d, shaft3d"),
     ("missing/file.py", "scene file 'missing/file.py' does not exist"),
     ("ngfracture.scenes:nothing", "module 'ngfracture.scenes' has no attribute 'nothing'"),
     ("ngfracture.nomodule:f", "module 'ngfracture.nomodule' failed to import"),

@@ -131,9 +131,9 @@ def refreshed(old, fresh, U, limit):
 
     Parameters
     ----------
-    old, fresh : ngfracture.contact.rows.ContactConstraints
+    old, fresh : ngfracture.contact.rows.ContactConstraints or ngfracture.contact.rows3d.NodeToFaceRows
         The same rows (same order, same keys) in two linearisations.
-    U : numpy.ndarray, shape (nv, 2)
+    U : numpy.ndarray, shape (nv, 2) or (nv, 3)
         Vertex displacements.
     limit : float
         Largest difference of the two gaps (a length) that keeps the old row.
@@ -152,7 +152,7 @@ def refreshed(old, fresh, U, limit):
     if not keep.any():
         return fresh
     kept, renewed = np.flatnonzero(keep), np.flatnonzero(~keep)
-    rows = ContactConstraints.stack([old.subset(kept), fresh.subset(renewed)])
+    rows = type(old).stack([old.subset(kept), fresh.subset(renewed)])
     return rows.subset(np.argsort(np.concatenate([kept, renewed])))
 
 

@@ -32,6 +32,8 @@ import numpy as np
 import scipy.sparse as sp
 
 from .active_set import ActiveSet, Geometry, max_penetration
+from .active_set3d import ActiveSet3d
+from .rows3d import space_columns_3d
 from ..fracture.strain import vertex_displacement
 from ..geometry.meshio import boundary_only
 from .seams import KINK_ANGLE, find_seams
@@ -222,14 +224,22 @@ class ContactSolver:
         """The geometry of the rounds, and the fixed dofs in the space's layout.
 
         None of it changes while the problem is solved on one mesh: computed once per solve.
+        In 3D the arrays are the problem's tetrahedral mesh (its faces are the boundary and
+        crack faces), the fragment is given per tetrahedron and there are no 2D seams.
         """
         prob = self.problem
-        arrays = boundary_only(prob.arrays)   # no bonded-interface segments
+        dim = prob.dim
         _, comp = prob.fragments()
-        nv, n = prob.mesh.nv, prob.fes.ndof // 2
+        nv, n = prob.mesh.nv, prob.fes.ndof // dim
         fixed = prob.assemble_constraints().fixed_dofs
         v, c = fixed % n, fixed // n
         holds = self._held_modes()
+        if dim == 3:
+            arrays = prob.arrays
+            geometry = Geometry(arrays=arrays, fragment=comp[arrays.tets[:, 0]], seams=None,
+                                fixed=(c * nv + v)[v < nv], holds=holds)
+            return geometry, fixed
+        arrays = boundary_only(prob.arrays)   # no bonded-interface segments
         geometry = Geometry(arrays=arrays, fragment=comp[arrays.triangles[:, 0]],
                             seams=find_seams(arrays.points, arrays.segments), fixed=(c * nv + v)[v < nv],
                             holds=holds)
@@ -243,11 +253,27 @@ class ContactSolver:
         if self.options["fix_free_modes"] != "all":
             return None
         prob = self.problem
+        dim = prob.dim
         modes = prob.support(prob.assemble_constraints()).modes.T.tocoo()
-        nv, n = prob.mesh.nv, prob.fes.ndof // 2
+        nv, n = prob.mesh.nv, prob.fes.ndof // dim
         v, c = modes.col % n, modes.col // n
         keep = v < nv          # the modes live on the vertex dofs
-        return sp.csr_matrix((modes.data[keep], (modes.row[keep], (c * nv + v)[keep])), shape=(modes.shape[0], 2 * nv))
+        return sp.csr_matrix((modes.data[keep], (modes.row[keep], (c * nv + v)[keep])),
+                             shape=(modes.shape[0], dim * nv))
+
+    def _active_set(self, geometry, warm):
+        """The active set of a solve: ActiveSet on triangles, ActiveSet3d on tetrahedra."""
+        options = dict(rank_tol=self.rank_tol, pdas_rounds=self.pdas_rounds, max_updates=self.max_updates, warm=warm)
+        if self.problem.dim == 3:
+            return ActiveSet3d(geometry, self.penetration_tol, **options)
+        return ActiveSet(geometry, self.tol, self.penetration_tol, kink_angle=self.kink_angle, **options)
+
+    def _columns(self, C):
+        """Rows in the P1 layout moved to the space's layout (2 or 3 components)."""
+        prob = self.problem
+        if prob.dim == 3:
+            return space_columns_3d(C, prob.mesh.nv, prob.fes.ndof // 3)
+        return space_columns(C, prob.mesh.nv, prob.fes.ndof // 2)
 
     def _contact_offset(self):
         offset = 0
@@ -262,7 +288,7 @@ class ContactSolver:
         prob = self.problem
         prob.constraints.clear_rows(LABEL)
         if len(rows):
-            prob.constraints.add_rows(space_columns(rows.C, prob.mesh.nv, prob.fes.ndof // 2), -rows.g, label=LABEL)
+            prob.constraints.add_rows(self._columns(rows.C), -rows.g, label=LABEL)
 
     def _complementarity(self, rows, candidates, tangent, result):
         """The candidate rows closed in the exact solution of the linearised contact problem.
@@ -282,8 +308,7 @@ class ContactSolver:
         t0 = time.perf_counter()
         prob = self.problem
         prob.constraints.clear_rows(LABEL)
-        prob.constraints.add_rows(space_columns(rows.C[candidates], prob.mesh.nv, prob.fes.ndof // 2),
-                                  -rows.g[candidates], label=LABEL)
+        prob.constraints.add_rows(self._columns(rows.C[candidates]), -rows.g[candidates], label=LABEL)
         offset = self._contact_offset()
         options = {k: v for k, v in self.options.items() if k != "load_steps"}
         try:
@@ -387,9 +412,7 @@ class ContactSolver:
                 return result
         t0 = time.perf_counter()
         geometry, fixed = self._geometry()
-        active = ActiveSet(geometry, self.tol, self.penetration_tol, kink_angle=self.kink_angle,
-                           rank_tol=self.rank_tol, pdas_rounds=self.pdas_rounds, max_updates=self.max_updates,
-                           warm=warm)
+        active = self._active_set(geometry, warm)
         result.timings["contact"] += time.perf_counter() - t0
         return self._rounds(active, result, tangent, scale, fixed)
 

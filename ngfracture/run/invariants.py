@@ -18,8 +18,13 @@ the step and the size of the violation in its reason.
   below 1e-10 of its detection threshold, a length; the overlap of the polygonal lips that
   remains is of second order in that (the scenes end with 1e-16 of the area or less,
   docs/verification.md). A run without contact (``contact="never"``) is held to the same
-  bound: pieces that only separate never overlap. In 3D the overlap is not measured:
-  contact is two-dimensional, and a 3D scene with contact is refused.
+  bound: pieces that only separate never overlap. In 3D the overlap volume is not
+  measured; what is checked is that no boundary vertex of a piece lies deeper than
+  :data:`OVERLAP_TOL` of the body's diameter (the diagonal of its bounding box) inside
+  another piece, by :func:`ngfracture.contact.collision3d.detect_penetrations_3d` (exact
+  predicates), and the largest depth is what the step records as its overlap. This is
+  checked where a 3D run solves with contact (``Scene.contact``); 3D cracks have no
+  contact rows yet, and their lips are not checked.
 
 The checks cost a few percent of a run (docs/performance.md): the overlap is measured only
 where there are cracks or separate bodies.
@@ -28,10 +33,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..contact.collision3d import detect_penetrations_3d
 from ..contact.overlap import fragment_overlap_area
+from ..fracture.strain import vertex_displacement
 from ..fracture.fragments import FragmentStatistics
 
-__all__ = ["OVERLAP_TOL", "Violation", "check_state"]
+__all__ = ["OVERLAP_TOL", "Violation", "check_state", "penetration_depth_3d"]
 
 #: overlap accepted between pieces, relative to the body's area
 OVERLAP_TOL = 1e-10
@@ -82,10 +89,46 @@ def check_state(problem, area_initial, with_overlap):
         return Violation("inverted_element", float(det_f[worst]),
                          f"{'tetrahedron' if problem.dim == 3 else 'triangle'} {worst} is inverted in the deformed configuration (det F "
                          f"{det_f[worst]:.3g})"), 0.0
-    # 3D: pieces that only separate (contact is two-dimensional, Scene refuses it in 3D)
-    overlap = fragment_overlap_area(problem) if with_overlap and problem.dim == 2 else 0.0
+    if problem.dim == 3:
+        depth = penetration_depth_3d(problem) if with_overlap else 0.0
+        P = problem.arrays.points
+        diameter = float(np.linalg.norm(P.max(axis=0) - P.min(axis=0)))
+        if not depth <= OVERLAP_TOL * diameter:
+            return Violation("overlap", depth,
+                             f"a vertex lies {depth:.3g} deep in another piece ({depth / diameter:.2g} of the "
+                             f"body's diameter; at most {OVERLAP_TOL:g} of it is accepted)"), depth
+        return None, depth
+    overlap = fragment_overlap_area(problem) if with_overlap else 0.0
     if not overlap <= OVERLAP_TOL * area_initial:
         return Violation("overlap", overlap,
                          f"pieces overlap by {overlap:.3g} ({overlap / area_initial:.2g} of the area; "
                          f"at most {OVERLAP_TOL:g} of it is accepted)"), overlap
     return None, overlap
+
+
+def penetration_depth_3d(problem):
+    """The deepest boundary vertex of a piece inside another piece, on a tetrahedral mesh.
+
+    Parameters
+    ----------
+    problem : ElasticProblem
+        A problem on a tetrahedral mesh, at its current displacement.
+
+    Returns
+    -------
+    float
+        max(0, -gap) over the pairs of :func:`ngfracture.contact.collision3d.detect_penetrations_3d`
+        (the distance to the master face); 0 with no pair.
+
+    Raises
+    ------
+    ValueError
+        If the problem is not three-dimensional.
+    """
+    if problem.dim != 3:
+        raise ValueError(f"penetration_depth_3d needs a tetrahedral mesh, got dimension {problem.dim}")
+    a = problem.arrays
+    _, piece = problem.fragments()
+    pen = detect_penetrations_3d(a.points, a.tets, a.faces, piece[a.tets[:, 0]],
+                                 displacement=vertex_displacement(problem.u))
+    return float(max(0.0, -pen.gap.min(initial=0.0)))

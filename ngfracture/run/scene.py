@@ -120,8 +120,8 @@ class Scene:
         ValueError
             Naming the first bad field (a non-positive load or increment, an unknown
             region, a bad critical strain, radius or toughness, both a radius and a
-            toughness, no region that can crack, a bad material or strength, contact or
-            refinement on a 3D mesh).
+            toughness, no region that can crack, a bad material or strength, refinement
+            on a 3D mesh).
             What ``apply_load`` adds is checked by :class:`Simulation` before any work.
         """
         if not isinstance(self.name, str) or not self.name:
@@ -139,9 +139,8 @@ class Scene:
         if not isinstance(self.material, (Material, dict)):
             raise ValueError(f"Scene {self.name!r}: material must be a Material or a dict of them")
         self._check_regions()
-        if self.mesh.dim == 3 and (self.contact or self.refine is not None):
-            raise ValueError(f"Scene {self.name!r}: a 3D scene cannot use {'contact' if self.contact else 'refine'} "
-                             f"(contact and refinement work on 2D meshes; 3D fragments must not touch)")
+        if self.mesh.dim == 3 and self.refine is not None:
+            raise ValueError(f"Scene {self.name!r}: a 3D scene cannot use refine (refinement works on 2D meshes)")
         self.refinement()
         if self.strength is not None:
             s = np.asarray(self.strength)

@@ -121,8 +121,10 @@ class LoadStep:
         -------
         bool
         """
-        if self.contact == "never" or mesh.dim == 3:      # contact is 2D (Scene refuses it in 3D)
+        if self.contact == "never":
             return False
+        if mesh.dim == 3:       # 3D: contact between bodies meshed apart; cracks' lips are not in contact yet
+            return bool(self.scene.contact)
         return self.scene.contact or "crack" in mesh.GetBoundaries()
 
     def equilibrium(self, prob, phase, method, timings, substeps=1, warm=(), lineage=None, start=None):
@@ -417,6 +419,8 @@ class LoadStep:
         """
         with timings.timed("checks"):
             pieces = self.scene.contact or "crack" in prob.mesh.GetBoundaries() or prob.fragments()[0] > 1
+            if prob.dim == 3:       # without contact a 3D crack's lips are free to overlap (not checked)
+                pieces = self.needs_contact(prob.mesh)
             violation, overlap = check_state(prob, area, pieces)
         if violation is not None:
             raise StepFailed(violation.invariant, "invariant", violation.message)

@@ -17,10 +17,13 @@ pass it to :class:`ngfracture.run.simulation.Simulation`.
 * :func:`plate3d`: the notched plate extruded to a thickness, on tetrahedra.
 * :func:`shaft3d`: a glass shaft twisted about its axis, on tetrahedra: one crack along a
   helicoid, a curved crack surface.
+* :func:`blocks3d`: a block pressed on another, meshed apart with non-matching grids, on
+  tetrahedra: contact without cracks, the contact patch test as a run.
 
 Every scene judges cracks at a critical distance ``radius`` (docs/criterion.md);
 ``radius=None`` selects the paper's one-ring criterion.
 """
+from .contact3d import BLOCKS_LOAD, blocks3d, two_blocks_mesh
 from .solids import bar3d, extruded_plate_mesh, notched_bar_mesh, plate3d
 from .beams import beam, holed_beam, holed_beam_mesh, notched_beam_mesh, senb_factor
 from .common import (BAR_LOAD, BAR_RADIUS, BEAM_LOAD, CORE_INNER, DISINTEGRATION_RADIUS, DISK_LOAD, DISK_RADIUS, FIRST_CRACK, GLASS, HOLE,
@@ -33,14 +36,14 @@ __all__ = ["plate", "disk", "disintegration", "beam", "holed_beam", "notched_pla
            "notched_beam_mesh", "holed_beam_mesh", "senb_factor", "GLASS", "PLATE_RADIUS", "DISK_RADIUS",
            "DISINTEGRATION_RADIUS", "HOLE", "CORE_INNER", "FIRST_CRACK", "PLATE_LOAD", "DISK_LOAD", "BEAM_LOAD",
            "SCENES", "LOAD_DESCRIPTIONS", "bar3d", "notched_bar_mesh", "plate3d", "extruded_plate_mesh", "BAR_RADIUS",
-           "BAR_LOAD", "shaft3d", "shaft_mesh", "SHAFT_RADIUS", "SHAFT_LOAD"]
+           "BAR_LOAD", "shaft3d", "shaft_mesh", "SHAFT_RADIUS", "SHAFT_LOAD", "blocks3d", "two_blocks_mesh", "BLOCKS_LOAD"]
 
 #: the scenes of ``python -m ngfracture run``
 SCENES = {"plate": plate, "disk": disk, "disintegration": disintegration, "beam": beam, "holed_beam": holed_beam,
           "bar3d": bar3d, "plate3d": plate3d,
-          "shaft3d": shaft3d}
+          "shaft3d": shaft3d, "blocks3d": blocks3d}
 #: what the load parameter x of each scene is (Scene.load_description)
 LOAD_DESCRIPTIONS = {"plate": PLATE_LOAD, "disk": DISK_LOAD, "disintegration": DISK_LOAD, "beam": BEAM_LOAD,
                      "holed_beam": BEAM_LOAD, "bar3d": BAR_LOAD, "plate3d": PLATE_LOAD,
-                     "shaft3d": SHAFT_LOAD}
+                     "shaft3d": SHAFT_LOAD, "blocks3d": BLOCKS_LOAD}
 

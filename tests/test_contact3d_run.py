@@ -1,0 +1,108 @@
+"""Contact in 3D runs: the blocks3d scene (the contact patch test through Scene and Simulation).
+
+Two blocks of one linear elastic material, meshed apart with non-matching grids, the upper
+pushed down by x (see ngfracture.scenes.contact3d). The exact solution is uniaxial stress
+sigma_zz = -E x / (2 h), linear, in the P1 space; with two-pass node-to-face rows the run
+must reproduce it to rounding at every step: the contact force at every interface node
+(the out-of-balance of the body's internal forces there, which only the contact rows
+balance) over the node's consistent nodal area is E x / (2 h), pushing each block away
+from the other, to 1e-8 relative. Each step ends without a penetrating vertex, and the
+volume is the scene's to the last bit.
+"""
+import math
+
+import numpy as np
+import pytest
+
+from ngfracture.contact.active_set3d import fixed_rows_3d
+from ngfracture.contact.rows3d import nodal_areas
+from ngfracture.geometry.solid import total_volume
+from ngfracture.run.invariants import penetration_depth_3d
+from ngfracture.run.scene import Scene
+from ngfracture.run.simulation import Simulation
+from ngfracture.scenes import SCENES, blocks3d, two_blocks_mesh
+from ngfracture.scenes.common import GLASS
+
+E, NU = GLASS["E"], GLASS["nu"]
+
+
+def interface_forces(prob):
+    """(vertex, z force of the contact rows, consistent nodal area, block sign) at the interface.
+
+    The sign is +1 for the upper block (pushed up), -1 for the lower one."""
+    a = prob.arrays
+    X = a.points
+    n = prob.fes.ndof // 3
+    f = -prob.out_of_balance()                 # internal minus external: the constraints' forces
+    out = []
+    for name, sign in (("upper_zmin", 1.0), ("lower_zmax", -1.0)):
+        faces = a.faces[a.face_bc == a.bc_names.index(name) + 1]
+        area = nodal_areas(X, faces)
+        for v in np.unique(faces):
+            out.append((v, f[2 * n + v], f[v], f[n + v], area[v], sign))
+    return out
+
+
+@pytest.fixture(scope="module")
+def run(tmp_path_factory):
+    steps = []
+
+    def on_step(accepted):
+        prob = accepted.problem
+        steps.append((accepted.state.x, interface_forces(prob), penetration_depth_3d(prob),
+                      total_volume(prob.arrays.points, prob.arrays.tets), accepted.record))
+
+    result = Simulation(blocks3d(), out=tmp_path_factory.mktemp("blocks3d"), pictures="none").run(on_step=on_step)
+    return result, steps
+
+
+def test_blocks3d_ends_at_load_max(run):
+    result, steps = run
+    assert result.ok and result.reason == "load_max", result.message
+    assert steps[-1][0] == blocks3d().load_max
+    assert len(steps) >= 2
+
+
+def test_every_step_transmits_the_uniform_pressure(run):
+    _, steps = run
+    for x, forces, _, _, _ in steps:
+        p = E * x / 2.0                           # |sigma_zz| with h = 1
+        assert len(forces) == 16 + 25             # 4 x 4 lower and 5 x 5 upper interface vertices
+        for v, fz, fx, fy, area, sign in forces:
+            assert abs(fz / area - sign * p) <= 1e-8 * p, (x, v, fz / area, sign * p)
+            assert abs(fx) <= 1e-8 * p * area and abs(fy) <= 1e-8 * p * area, (x, v, fx, fy)
+
+
+def test_no_penetration_and_volume_to_the_last_bit(run):
+    _, steps = run
+    a = two_blocks_mesh()
+    volume = total_volume(a.points, a.tets)
+    assert volume == 2.0
+    diameter = math.sqrt(1 + 1 + 4)
+    for x, _, depth, vol, record in steps:
+        assert vol == volume
+        assert depth <= 1e-10 * diameter, (x, depth)
+        assert record["overlap_area"] == depth
+
+
+def test_fixed_rows_are_the_touching_pairs_and_twins_of_both_passes():
+    a = two_blocks_mesh()
+    rows, keys = fixed_rows_3d(a.points, a.tets, a.faces, a.regions - 1)
+    assert len(set(keys)) == len(keys) == len(rows)
+    interface = set(np.flatnonzero(a.points[:, 2] == 1.0).tolist())
+    assert set(rows.slave.tolist()) == interface               # every interface vertex a slave
+    assert np.all(np.abs(rows.normal[:, 2]) == 1.0)
+    assert np.all(rows.g == 0.0)
+
+
+def test_scene_is_registered_and_3d_refine_still_refused():
+    assert SCENES["blocks3d"] is blocks3d
+    s = blocks3d()
+    with pytest.raises(ValueError, match="refine"):
+        Scene(name="x", mesh=s.mesh, material=s.material, critical=s.critical, apply_load=s.apply_load,
+              load_max=s.load_max, dx=s.dx, contact_tol=s.contact_tol, contact=True, radius=s.radius,
+              refine=True).validate()
+    with pytest.raises(ValueError, match="steps"):
+        blocks3d(steps=0)
+    with pytest.raises(ValueError, match="displacement"):
+        blocks3d(displacement=-1.0)
