@@ -106,3 +106,24 @@ def test_scene_is_registered_and_3d_refine_still_refused():
         blocks3d(steps=0)
     with pytest.raises(ValueError, match="displacement"):
         blocks3d(displacement=-1.0)
+
+
+@pytest.mark.parametrize("fix", [True, "all"])
+def test_contact_solver_holds_the_free_modes_of_3d_pieces(fix):
+    """Without the corner holds the in-plane rigid modes of both blocks are free: the solver
+    holds them (fix_free_modes True: the modes contact leaves free; "all": all six modes of
+    every piece, contact rows dependent on them dropped), and the pressure is still exact."""
+    from ngfracture.contact.solver import ContactSolver
+    from ngfracture.geometry.solid import solid_mesh
+    from ngfracture.mechanics.materials import LinearElastic
+    from ngfracture.mechanics.problem import ElasticProblem
+    a = two_blocks_mesh()
+    prob = ElasticProblem(solid_mesh(a), LinearElastic(E=3.0, nu=0.25))
+    prob.add_dirichlet("lower_zmin", 0.0, component="z")
+    prob.add_dirichlet("upper_zmax", -1e-3, component="z")
+    result = ContactSolver(prob, tol=1e-4, fix_free_modes=fix, method="full").solve()
+    assert result.converged, result.reason
+    assert all(k[0] == "f" for k in result.active_keys) and np.all(result.multipliers <= 0.0)
+    p = 3.0 * 1e-3 / 2
+    for v, fz, fx, fy, area, sign in interface_forces(prob):
+        assert abs(fz / area - sign * p) <= 1e-8 * p, (v, fz / area)

@@ -21,6 +21,12 @@ linearised at the solution: g_N >= -``penetration_tol``, lambda <= 0, lambda g_N
 rows have g_N = 0, inactive ones carry no force). What overlap remains is that of the
 polygonal lips between the rows' nodes, of second order in the last update. The
 measurements behind these choices are in ``docs/contact.md``.
+
+On a tetrahedral mesh (``problem.dim == 3``) the same rounds run with
+:class:`~ngfracture.contact.active_set3d.ActiveSet3d` (node-to-face rows,
+:mod:`ngfracture.contact.rows3d`), rows in the three-component layout and six held rigid
+modes per free piece; ``tol`` then only sets the default ``penetration_tol`` and
+``kink_angle`` has no role (docs/contact.md, "Contact in 3D runs").
 """
 import functools
 import math
