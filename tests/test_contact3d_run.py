@@ -127,3 +127,24 @@ def test_contact_solver_holds_the_free_modes_of_3d_pieces(fix):
     p = 3.0 * 1e-3 / 2
     for v, fz, fx, fy, area, sign in interface_forces(prob):
         assert abs(fz / area - sign * p) <= 1e-8 * p, (v, fz / area)
+
+
+def test_the_invariant_finds_a_penetrating_vertex():
+    """Upper block moved down by 0.01 rigidly, no contact: its lower face is 0.01 deep in the
+    lower block (and the lower block's top face 0.01 deep in it), which check_state refuses."""
+    from ngfracture.geometry.solid import solid_mesh
+    from ngfracture.mechanics.materials import LinearElastic
+    from ngfracture.mechanics.problem import ElasticProblem
+    from ngfracture.run.invariants import check_state
+    a = two_blocks_mesh()
+    prob = ElasticProblem(solid_mesh(a), LinearElastic(E=3.0, nu=0.25))
+    n = prob.fes.ndof // 3
+    upper = np.unique(a.tets[a.regions == 2])
+    prob.u.vec.FV().NumPy()[2 * n + upper] = -0.01
+    assert penetration_depth_3d(prob) == pytest.approx(0.01, rel=1e-12)
+    violation, depth = check_state(prob, total_volume(a.points, a.tets), True)
+    assert violation is not None and violation.invariant == "overlap" and depth == violation.size
+    assert check_state(prob, total_volume(a.points, a.tets), False) == (None, 0.0)
+    with pytest.raises(ValueError, match="dimension"):
+        from ngfracture.scenes import plate
+        penetration_depth_3d(ElasticProblem(plate(maxh=0.2).mesh, LinearElastic(E=3.0, nu=0.25)))
