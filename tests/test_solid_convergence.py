@@ -26,7 +26,7 @@ from ngfracture.scenes import bar3d
 from ngfracture.scenes.common import BAR_RADIUS
 from ngfracture.studies.initiation import initiation_load
 
-#: the issue's bound on the change between the two finest levels
+#: the bound on the change between the two finest of four levels
 BOUND = 0.03
 #: bar3d's notch depth
 NOTCH = 0.4

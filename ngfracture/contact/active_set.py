@@ -359,15 +359,7 @@ class ActiveSet:
             For "update", the candidates linearised at U (see :func:`refreshed`), with
             their fresh gaps; else the candidates given.
         """
-        X = self.geometry.arrays.points
-        if candidates.relinearised is None:
-            fresh = self._relinearised(candidates.rows, U)
-        else:
-            # a row re-linearised twice at one U is the same, bit for bit: only the rows
-            # found new in this round are not re-linearised yet
-            n = len(candidates.relinearised)
-            new = candidates.rows.subset(np.arange(n, len(candidates.rows)))
-            fresh = ContactConstraints.stack([candidates.relinearised, relinearise_node_to_segment(new, X, U)])
+        fresh = self._fresh_rows(candidates, U)
         gap = fresh.C @ U.T.ravel() + fresh.g
         penetration = max_penetration(gap, other)
         if penetration <= self.penetration_tol:
@@ -425,6 +417,17 @@ class ActiveSet:
         """Candidate rows as (seam rows, node-to-segment rows)."""
         n_seam = len(self.seam_keys)
         return rows.subset(np.arange(n_seam)), rows.subset(np.arange(n_seam, len(rows)))
+
+    def _fresh_rows(self, candidates, U):
+        """The candidate rows re-linearised at X + U, in their order (what settle judges)."""
+        if candidates.relinearised is None:
+            return self._relinearised(candidates.rows, U)
+        # a row re-linearised twice at one U is the same, bit for bit: only the rows
+        # found new in this round are not re-linearised yet
+        n = len(candidates.relinearised)
+        new = candidates.rows.subset(np.arange(n, len(candidates.rows)))
+        return ContactConstraints.stack([candidates.relinearised,
+                                         relinearise_node_to_segment(new, self.geometry.arrays.points, U)])
 
     def _relinearised(self, rows, U):
         """The candidate rows (seam rows first) linearised at X + U, in the same order."""

@@ -40,7 +40,7 @@ import time
 
 import numpy as np
 
-from .active_set import ActiveSet, Candidates, max_penetration, refreshed
+from .active_set import ActiveSet, Candidates, refreshed
 from .collision3d import detect_penetrations_3d
 from .rows3d import NodeToFaceRows, no_face_rows, node_to_face_rows, relinearise_node_to_face, twin_rows
 
@@ -76,13 +76,19 @@ def fixed_rows_3d(points, tets, faces, fragment):
     """
     nv = len(points)
     touching = node_to_face_rows(points, faces, detect_penetrations_3d(points, tets, faces, fragment))
-    vertex_fragment = np.full(nv, -1, dtype=np.int64)
-    vertex_fragment[np.asarray(tets).ravel()] = np.repeat(np.asarray(fragment, dtype=np.int64), 4)
+    vertex_fragment = _vertex_fragment(nv, tets, fragment)
     parts = [touching] + [twin_rows(points, faces, vertex_fragment == f) for f in np.unique(fragment)]
     rows = NodeToFaceRows.stack(parts)
     keys = rows.keys()
     first = sorted({k: i for i, k in reversed(list(enumerate(keys)))}.values())
     return rows.subset(np.array(first, dtype=np.int64)), [keys[i] for i in first]
+
+
+def _vertex_fragment(nv, tets, fragment):
+    """The fragment of every vertex (-1: in no tetrahedron)."""
+    vertex_fragment = np.full(nv, -1, dtype=np.int64)
+    vertex_fragment[np.asarray(tets).ravel()] = np.repeat(np.asarray(fragment, dtype=np.int64), 4)
+    return vertex_fragment
 
 
 class ActiveSet3d(ActiveSet):
@@ -131,8 +137,7 @@ class ActiveSet3d(ActiveSet):
             t0 = time.perf_counter()
             self.seam_rows, self.seam_keys = fixed_rows_3d(a.points, a.tets, a.faces, self.geometry.fragment)
             timings["collision"] += time.perf_counter() - t0
-            self.vertex_fragment = np.full(len(a.points), -1, dtype=np.int64)
-            self.vertex_fragment[a.tets.ravel()] = np.repeat(self.geometry.fragment.astype(np.int64), 4)
+            self.vertex_fragment = _vertex_fragment(len(a.points), a.tets, self.geometry.fragment)
         elif self.moving:
             old = NodeToFaceRows.stack([self.seam_rows, self.n2s])
             relinearised = relinearise_node_to_face(old, a.points, U)
@@ -151,42 +156,9 @@ class ActiveSet3d(ActiveSet):
                                                                n_fixed + np.array(retained, dtype=np.int64)]))
         return Candidates(rows, self.seam_keys + self.n2s_keys, rows.C @ U.T.ravel() + rows.g, relinearised)
 
-    def settle(self, candidates, other, U):
-        """Judge a settled set by its candidates re-linearised at X + U.
-
-        Parameters
-        ----------
-        candidates : ngfracture.contact.active_set.Candidates
-            The candidates of this round.
-        other : numpy.ndarray of int
-            The rows whose penetration counts (from :meth:`primal_dual`).
-        U : numpy.ndarray, shape (nv, 3)
-            The displacements of the last solve.
-
-        Returns
-        -------
-        verdict : str
-            "converged", "update" or "penetration", as
-            :meth:`ngfracture.contact.active_set.ActiveSet.settle`.
-        penetration : float
-            The largest penetration of those rows at U.
-        candidates : ngfracture.contact.active_set.Candidates
-            For "update", the candidates linearised at U; else the candidates given.
-        """
-        fresh = relinearise_node_to_face(candidates.rows, self.geometry.arrays.points, U)
-        gap = fresh.C @ U.T.ravel() + fresh.g
-        penetration = max_penetration(gap, other)
-        if penetration <= self.penetration_tol:
-            return "converged", penetration, candidates
-        if self.moving and penetration >= self.last_penetration and self.updates < self.max_updates:
-            self.moving = False
-        elif self.updates == self.max_updates or penetration >= self.last_penetration:
-            return "penetration", penetration, candidates
-        self.last_penetration = penetration
-        self.updates += 1
-        rows = refreshed(candidates.rows, fresh, U, 0.01 * self.penetration_tol)
-        self.seam_rows, self.n2s = self._split(rows)
-        return "update", penetration, Candidates(rows, candidates.keys, gap)
+    def _fresh_rows(self, candidates, U):
+        """The candidate rows re-linearised at X + U (all of them: settle's judgement)."""
+        return relinearise_node_to_face(candidates.rows, self.geometry.arrays.points, U)
 
     def _node_to_face(self, U, timings):
         """The pairs detected at X + U that no twin row covers, as rows with their keys."""

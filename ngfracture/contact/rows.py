@@ -67,6 +67,7 @@ gap it adds are what the active set must release when their multiplier is adhesi
 """
 from dataclasses import dataclass
 import functools
+from typing import ClassVar
 
 import numpy as np
 import scipy.sparse as sp
@@ -81,8 +82,61 @@ __all__ = ["ContactConstraints", "no_constraints", "select_contacts", "gap_rows"
            "contact_constraints"]
 
 
+class RowTable:
+    """What the contact row sets share (2D :class:`ContactConstraints`, 3D
+    ``rows3d.NodeToFaceRows``): per-row arrays named by the class's ``FIELDS`` in
+    constructor order, then ``nv``; ``len``, stacking and selecting rows.
+    """
+    FIELDS = ()
+
+    def __len__(self):
+        return len(self.g)
+
+    @classmethod
+    def stack(cls, parts):
+        """The rows of several row sets of one mesh, in order.
+
+        Parameters
+        ----------
+        parts : sequence of RowTable
+            At least one, of this class.
+
+        Returns
+        -------
+        RowTable
+            The rows of ``parts[0]``, then those of ``parts[1]``, ...
+
+        Raises
+        ------
+        ValueError
+            Parts of meshes with different numbers of vertices.
+        """
+        nv = parts[0].nv
+        if any(p.nv != nv for p in parts):
+            raise ValueError(f"{cls.__name__}.stack: rows of meshes with {sorted(set(p.nv for p in parts))} vertices")
+        return cls(*(np.concatenate([getattr(p, f) for p in parts]) for f in cls.FIELDS), nv=nv)
+
+    def subset(self, rows):
+        """The rows ``rows`` (an index array or boolean mask).
+
+        Parameters
+        ----------
+        rows : array_like of int or bool
+            Row indices (in the order wanted) or a mask of shape (m,).
+
+        Returns
+        -------
+        RowTable
+            New arrays holding the selected rows.
+        """
+        rows = np.asarray(rows)
+        if rows.dtype != bool:
+            rows = rows.astype(np.int64)
+        return type(self)(*(getattr(self, f)[rows] for f in self.FIELDS), nv=self.nv)
+
+
 @dataclass
-class ContactConstraints:
+class ContactConstraints(RowTable):
     """Node-to-segment constraints, one entry per row of C.
 
     Parameters
@@ -124,56 +178,13 @@ class ContactConstraints:
     angle: np.ndarray
     g: np.ndarray
     nv: int
-
-    def __len__(self):
-        return len(self.g)
+    FIELDS: ClassVar[tuple] = ("slave", "a", "c", "master_tri", "slave_tri", "pair", "xi", "normal", "dist",
+                               "angle", "g")
 
     @functools.cached_property
     def C(self):
         """The gap rows as a sparse matrix, shape (m, 2 nv), built at first use (see the class)."""
         return _gap_matrix(self.slave, self.a, self.c, self.xi, self.normal, self.nv)
-
-    @classmethod
-    def stack(cls, parts):
-        """The rows of several ContactConstraints (same number of dofs), in order.
-
-        Parameters
-        ----------
-        parts : sequence of ContactConstraints
-            At least one; all with the same number of columns in C.
-
-        Returns
-        -------
-        ContactConstraints
-            The rows of ``parts[0]``, then those of ``parts[1]``, ...
-
-        Raises
-        ------
-        ValueError
-            Parts of meshes with different numbers of vertices.
-        """
-        nv = parts[0].nv
-        if any(p.nv != nv for p in parts):
-            raise ValueError(f"ContactConstraints.stack: rows of meshes with {sorted(set(p.nv for p in parts))} vertices")
-        return cls(*(np.concatenate([getattr(p, f) for p in parts]) for f in _ROW_FIELDS), nv=nv)
-
-    def subset(self, rows):
-        """The constraints ``rows`` (an index array or boolean mask), C and g included.
-
-        Parameters
-        ----------
-        rows : array_like of int or bool
-            Row indices (in the order wanted) or a mask of shape (m,).
-
-        Returns
-        -------
-        ContactConstraints
-            New arrays holding the selected rows.
-        """
-        rows = np.asarray(rows)
-        if rows.dtype != bool:
-            rows = rows.astype(np.int64)
-        return ContactConstraints(*(getattr(self, f)[rows] for f in _ROW_FIELDS), nv=self.nv)
 
 
 def no_constraints(nv):
@@ -196,7 +207,6 @@ def no_constraints(nv):
 
 
 #: the per-row arrays of ContactConstraints, in constructor order
-_ROW_FIELDS = ("slave", "a", "c", "master_tri", "slave_tri", "pair", "xi", "normal", "dist", "angle", "g")
 
 
 def gap_rows(coords, slave, a, c, xi, normal):

@@ -56,19 +56,18 @@ as the 2D active set keeps the rows it has found.
 """
 from dataclasses import dataclass
 import functools
+from typing import ClassVar
 
 import numpy as np
 import scipy.sparse as sp
 
+from .rows import RowTable
+
 __all__ = ["NodeToFaceRows", "no_face_rows", "node_to_face_rows", "twin_rows", "face_gap_rows",
            "relinearise_node_to_face", "nodal_areas", "space_columns_3d"]
 
-#: the per-row arrays of NodeToFaceRows, in constructor order
-_ROW_FIELDS = ("slave", "master", "face", "bary", "normal", "dist", "g")
-
-
 @dataclass
-class NodeToFaceRows:
+class NodeToFaceRows(RowTable):
     """Node-to-face rows, one entry per row of C.
 
     Parameters
@@ -103,56 +102,12 @@ class NodeToFaceRows:
     dist: np.ndarray
     g: np.ndarray
     nv: int
-
-    def __len__(self):
-        return len(self.g)
+    FIELDS: ClassVar[tuple] = ("slave", "master", "face", "bary", "normal", "dist", "g")
 
     @functools.cached_property
     def C(self):
         """The gap rows as a sparse matrix, shape (m, 3 nv), built at first use."""
         return _gap_matrix(self.slave, self.master, self.bary, self.normal, self.nv)
-
-    @classmethod
-    def stack(cls, parts):
-        """The rows of several NodeToFaceRows (same number of vertices), in order.
-
-        Parameters
-        ----------
-        parts : sequence of NodeToFaceRows
-            At least one.
-
-        Returns
-        -------
-        NodeToFaceRows
-            The rows of ``parts[0]``, then those of ``parts[1]``, ...
-
-        Raises
-        ------
-        ValueError
-            Parts of meshes with different numbers of vertices.
-        """
-        nv = parts[0].nv
-        if any(p.nv != nv for p in parts):
-            raise ValueError(f"NodeToFaceRows.stack: rows of meshes with {sorted(set(p.nv for p in parts))} vertices")
-        return cls(*(np.concatenate([getattr(p, f) for p in parts]) for f in _ROW_FIELDS), nv=nv)
-
-    def subset(self, rows):
-        """The rows ``rows`` (an index array or boolean mask).
-
-        Parameters
-        ----------
-        rows : array_like of int or bool
-            Row indices (in the order wanted) or a mask of shape (m,).
-
-        Returns
-        -------
-        NodeToFaceRows
-            New arrays holding the selected rows.
-        """
-        rows = np.asarray(rows)
-        if rows.dtype != bool:
-            rows = rows.astype(np.int64)
-        return NodeToFaceRows(*(getattr(self, f)[rows] for f in _ROW_FIELDS), nv=self.nv)
 
     def keys(self):
         """The key of every row, ("f", slave, master vertices sorted): a row's identity for the active set.
