@@ -24,8 +24,8 @@ from ngfracture.contact.collision3d import detect_penetrations_3d
 from ngfracture.contact.rows3d import (NodeToFaceRows, face_gap_rows, no_face_rows, node_to_face_rows,
                                        nodal_areas, relinearise_node_to_face, space_columns_3d, twin_rows)
 from ngfracture.fracture.strain import vertex_displacement
-from ngfracture.geometry.solid import SolidArrays, solid_mesh
-from ngfracture.geometry.structured import BOX_FACES, box_mesh
+from ngfracture.geometry.solid import merge_bodies, solid_mesh
+from ngfracture.geometry.structured import box_mesh
 from ngfracture.mechanics.materials import LinearElastic
 from ngfracture.mechanics.problem import ElasticProblem
 
@@ -40,15 +40,7 @@ def two_blocks(lift=0.0):
     Boundary names are those of box_mesh prefixed by "lower_" / "upper_"."""
     lower = box_mesh(LOWER_GRID, LOWER_GRID, [0.0, 0.5, 1.0])
     upper = box_mesh(UPPER_GRID, UPPER_GRID, [1.0 + lift, 1.5, 2.0])
-    nv = len(lower.points)
-    return SolidArrays(
-        points=np.concatenate([lower.points, upper.points]),
-        tets=np.concatenate([lower.tets, upper.tets + nv]),
-        regions=np.concatenate([np.full(len(lower.tets), 1), np.full(len(upper.tets), 2)]),
-        region_names=["lower", "upper"],
-        faces=np.concatenate([lower.faces, upper.faces + nv]),
-        face_bc=np.concatenate([lower.face_bc, upper.face_bc + len(BOX_FACES)]),
-        bc_names=["lower_" + b for b in BOX_FACES] + ["upper_" + b for b in BOX_FACES])
+    return merge_bodies([("lower", lower), ("upper", upper)])
 
 
 def exact_u(X):

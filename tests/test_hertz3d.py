@@ -61,6 +61,7 @@ compliance (finite size L = 8 a_target) does not enter the check, only the finit
 effect on the contact stresses (order (a / L)^2).
 """
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -69,8 +70,8 @@ from ngfracture.contact.active_set import ActiveSet, Candidates, Geometry
 from ngfracture.contact.collision3d import detect_penetrations_3d
 from ngfracture.contact.rows3d import nodal_areas, node_to_face_rows, space_columns_3d
 from ngfracture.fracture.strain import vertex_displacement
-from ngfracture.geometry.solid import SolidArrays, solid_mesh
-from ngfracture.geometry.structured import BOX_FACES, box_mesh
+from ngfracture.geometry.solid import merge_bodies, solid_mesh
+from ngfracture.geometry.structured import box_mesh
 from ngfracture.mechanics.materials import LinearElastic
 from ngfracture.mechanics.problem import ElasticProblem
 
@@ -102,15 +103,8 @@ def hertz_bodies(h_block, h_sphere):
     r2 = P[:, 0] ** 2 + P[:, 1] ** 2
     P[:, 2] += (R - np.sqrt(R ** 2 - r2)) * (1.0 - P[:, 2] / L)
     P[P[:, 2] == 0.0, 2] = 0.0                    # no -0.0
-    nv = len(block.points)
-    return SolidArrays(
-        points=np.concatenate([block.points, P]),
-        tets=np.concatenate([block.tets, sphere.tets + nv]),
-        regions=np.concatenate([np.full(len(block.tets), 1), np.full(len(sphere.tets), 2)]),
-        region_names=["block", "sphere"],
-        faces=np.concatenate([block.faces, sphere.faces + nv]),
-        face_bc=np.concatenate([block.face_bc, sphere.face_bc + len(BOX_FACES)]),
-        bc_names=["block_" + b for b in BOX_FACES] + ["sphere_" + b for b in BOX_FACES])
+    sphere = replace(sphere, points=P)
+    return merge_bodies([("block", block), ("sphere", sphere)])
 
 
 def contact_offset(prob):

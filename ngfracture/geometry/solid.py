@@ -24,7 +24,8 @@ import netgen.meshing as nm
 import ngsolve as ng
 import numpy as np
 
-__all__ = ["SolidArrays", "solid_to_arrays", "solid_mesh", "tet_volumes", "total_volume", "is_solid", "crack_area"]
+__all__ = ["SolidArrays", "solid_to_arrays", "solid_mesh", "tet_volumes", "total_volume", "is_solid", "crack_area",
+           "merge_bodies"]
 
 #: from this many tetrahedra NGSolve builds a mesh's topology in its task manager
 PARALLEL_MIN_TETS = 20000
@@ -293,3 +294,39 @@ def crack_area(arrays, name="crack"):
         return 0.0
     x = np.asarray(arrays.points, dtype=float)[faces]
     return 0.25 * math.fsum(np.linalg.norm(np.cross(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0]), axis=1))
+
+
+def merge_bodies(bodies):
+    """Bodies meshed apart as one mesh: a region per body, boundary names prefixed by its name.
+
+    The vertices are not joined (coincident points stay two vertices), as contact between
+    bodies meshed apart needs (docs/contact.md, "Contact in 3D runs").
+
+    Parameters
+    ----------
+    bodies : sequence of (str, SolidArrays)
+        Name and mesh of every body, in order; a body's own regions are merged into one.
+
+    Returns
+    -------
+    SolidArrays
+        Region k + 1 is body k (named by it); boundary ``b`` of body ``name`` is
+        ``name + "_" + b``.
+
+    Raises
+    ------
+    ValueError
+        Without bodies.
+    """
+    if not bodies:
+        raise ValueError("merge_bodies: no bodies")
+    offsets = np.cumsum([0] + [len(a.points) for _, a in bodies])
+    bc_offsets = np.cumsum([0] + [len(a.bc_names) for _, a in bodies])
+    return SolidArrays(
+        points=np.concatenate([a.points for _, a in bodies]),
+        tets=np.concatenate([a.tets + o for (_, a), o in zip(bodies, offsets)]),
+        regions=np.concatenate([np.full(len(a.tets), k + 1) for k, (_, a) in enumerate(bodies)]),
+        region_names=[name for name, _ in bodies],
+        faces=np.concatenate([a.faces + o for (_, a), o in zip(bodies, offsets)]),
+        face_bc=np.concatenate([a.face_bc + o for (_, a), o in zip(bodies, bc_offsets)]),
+        bc_names=[f"{name}_{b}" for name, a in bodies for b in a.bc_names])

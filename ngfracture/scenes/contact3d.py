@@ -12,8 +12,8 @@ rounding and the contact pressure is uniform.
 """
 import numpy as np
 
-from ..geometry.solid import SolidArrays, solid_mesh
-from ..geometry.structured import BOX_FACES, box_mesh
+from ..geometry.solid import merge_bodies, solid_mesh
+from ..geometry.structured import box_mesh
 from ..mechanics.materials import LinearElastic
 from ..run.scene import Scene
 from .common import GLASS, positive
@@ -49,15 +49,7 @@ def two_blocks_mesh(width=1.0, height=1.0):
     w, h = positive("width", width), positive("height", height)
     lower = box_mesh(w * LOWER_CELLS, w * LOWER_CELLS, [0.0, h / 2, h])
     upper = box_mesh(w * UPPER_CELLS, w * UPPER_CELLS, [h, 1.5 * h, 2 * h])
-    nv = len(lower.points)
-    return SolidArrays(
-        points=np.concatenate([lower.points, upper.points]),
-        tets=np.concatenate([lower.tets, upper.tets + nv]),
-        regions=np.concatenate([np.full(len(lower.tets), 1), np.full(len(upper.tets), 2)]),
-        region_names=["lower", "upper"],
-        faces=np.concatenate([lower.faces, upper.faces + nv]),
-        face_bc=np.concatenate([lower.face_bc, upper.face_bc + len(BOX_FACES)]),
-        bc_names=["lower_" + b for b in BOX_FACES] + ["upper_" + b for b in BOX_FACES])
+    return merge_bodies([("lower", lower), ("upper", upper)])
 
 
 def blocks3d(displacement=1e-3, steps=4, width=1.0, height=1.0, E=GLASS["E"], nu=GLASS["nu"]):
