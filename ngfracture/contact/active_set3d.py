@@ -42,7 +42,8 @@ import numpy as np
 
 from .active_set import ActiveSet, Candidates, refreshed
 from .collision3d import detect_penetrations_3d
-from .rows3d import NodeToFaceRows, no_face_rows, node_to_face_rows, relinearise_node_to_face, twin_rows
+from .rows3d import (NodeToFaceRows, lip_rows, no_face_rows, node_to_face_rows, relinearise_node_to_face,
+                     twin_rows)
 
 __all__ = ["ActiveSet3d", "fixed_rows_3d"]
 
@@ -78,6 +79,7 @@ def fixed_rows_3d(points, tets, faces, fragment):
     touching = node_to_face_rows(points, faces, detect_penetrations_3d(points, tets, faces, fragment))
     vertex_fragment = _vertex_fragment(nv, tets, fragment)
     parts = [touching] + [twin_rows(points, faces, vertex_fragment == f) for f in np.unique(fragment)]
+    parts.append(lip_rows(points, faces, vertex_fragment))
     rows = NodeToFaceRows.stack(parts)
     keys = rows.keys()
     first = sorted({k: i for i, k in reversed(list(enumerate(keys)))}.values())
@@ -167,12 +169,14 @@ class ActiveSet3d(ActiveSet):
         pen = detect_penetrations_3d(a.points, a.tets, a.faces, self.geometry.fragment, displacement=U)
         timings["collision"] += time.perf_counter() - t0
         rows = node_to_face_rows(a.points, a.faces, pen)
-        # a vertex with a twin on the master fragment talks to it through its twin row
+        # a vertex with a twin on the master fragment talks to it through its twin row; a
+        # lip vertex in its own fragment, through the lip row of its pair of copies
         twin = np.asarray(pen.twin, dtype=np.int64)
         keep = twin < 0
         if not keep.all():
             covered = {(k[1], int(self.vertex_fragment[k[2]])) for k in self.seam_keys}
-            keep |= np.array([(int(v), int(f)) not in covered
-                              for v, f in zip(pen.vertex.tolist(), pen.fragment.tolist())], dtype=bool)
+            own = pen.fragment == self.vertex_fragment[pen.vertex]
+            keep |= ~own & np.array([(int(v), int(f)) not in covered
+                                     for v, f in zip(pen.vertex.tolist(), pen.fragment.tolist())], dtype=bool)
         rows = rows.subset(np.flatnonzero(keep))
         return rows, rows.keys()
