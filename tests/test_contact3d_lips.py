@@ -18,16 +18,22 @@ are not cracked) left whole. Both lips are on one fragment, so only the lip rows
    >= 0) and the field differs from the uncracked one by the crack's opening.
 3. A crack on the plane z = x (45 degrees), |x - 1/2|, |y - 1/2| <= 1/4, the bottom clamped,
    the top moved by (D, 0, -D): compression and shear on the crack, frictionless. The
-   lips slide (tangential jump at the crack's centre a sizeable part of D), no lip vertex
-   is deeper than 1e-10 of the cube's size in the other lip (exact detection), every
+   lips slide (tangential jump a sizeable part of D), no slave vertex (the copies) is
+   deeper than 1e-10 of the cube's size in the other lip (exact detection), a master
+   vertex (one row per pair: the lower lip is not a slave) no deeper than the slide times
+   the sine of the largest angle between the deformed faces of the upper lip, every
    multiplier is compressive and the rows' force at every lip vertex along its own
    outward normal pushes it back (compressive), none pulling.
-4. (bar3d, small) a run with contact breaks in two with the crack of a run without.
+4. bar3d at the --quick sizes of benchmarks/solid.py: a run with contact (the lips get rows
+   once cracked) breaks in two with the steps, split vertices and crack faces of a run
+   without, the displacements equal to 1e-8 (slow: two runs, about 20 s).
 """
 import math
 
 import numpy as np
 import pytest
+
+import ngfracture as nf
 
 from ngfracture.contact.active_set3d import fixed_rows_3d
 from ngfracture.contact.collision3d import detect_penetrations_3d
@@ -161,10 +167,13 @@ def test_lip_rows_pair_every_copy_on_its_own_fragment():
     U = np.zeros_like(a.points)
     U[copies, 2] = -1e-4                                  # the upper lip's inner vertices sink
     pen = detect_penetrations_3d(a.points, a.tets, a.faces, np.zeros(len(a.tets), dtype=np.int64), U)
-    assert sorted(pen.vertex.tolist()) == copies.tolist()
-    assert np.all(pen.twin == parent[copies]) and np.all(pen.fragment == 0)
-    assert np.allclose(pen.gap, -1e-4, rtol=0, atol=1e-15)
-    assert np.array_equal(pen.normal, np.tile([0.0, 0.0, 1.0], (len(pen), 1)))
+    # both lips: the copies in the lower lip's tets, their parents in the upper lip's
+    assert pen.vertex.tolist() == sorted(parent[copies].tolist() + copies.tolist())
+    assert np.all(pen.fragment == 0) and np.all(pen.twin[pen.vertex >= copies[0]] == parent[copies])
+    down = pen.vertex >= copies[0]
+    assert np.allclose(pen.gap[down], -1e-4, rtol=0, atol=1e-15)
+    assert np.array_equal(pen.normal[down], np.tile([0.0, 0.0, 1.0], (len(copies), 1)))
+    assert np.all((pen.gap[~down] < 0) & (pen.gap[~down] >= -1e-4 - 1e-15)) and np.all(pen.normal[~down, 2] < 0)
     # the fixed rows of a solve have them (one fragment: no twin rows across fragments)
     fixed, keys = fixed_rows_3d(a.points, a.tets, a.faces, np.zeros(len(a.tets), dtype=np.int64))
     assert len(fixed) == 9 and len(set(keys)) == 9
@@ -234,19 +243,56 @@ def test_inclined_crack_slides_without_penetration():
     normal_jump = jump @ n
     slide = np.linalg.norm(jump - np.outer(normal_jump, n), axis=1)
     pen = detect_penetrations_3d(X, a.tets, a.faces, np.zeros(len(a.tets), dtype=np.int64), U)
-    depth = float(max(0.0, -pen.gap.min(initial=0.0)))
+    slaves = pen.vertex >= copies[0]                         # the copies: slaves of the lip rows
+    depth = float(max(0.0, -pen.gap[slaves].min(initial=0.0)))
+    depth_master = float(max(0.0, -pen.gap[~slaves].min(initial=0.0)))
+    # one row per pair: a master vertex can sink into the slave lip where that lip kinks, by
+    # at most the slide times the sine of the largest angle between two of its faces
+    C = crack_faces(a)
+    upper = C[np.all(np.isin(C, copies) | ~np.isin(C, parent[copies]), axis=1) & np.isin(C, copies).any(axis=1)]
+    x = X + U
+    nrm = np.cross(x[upper[:, 1]] - x[upper[:, 0]], x[upper[:, 2]] - x[upper[:, 0]])
+    nrm /= np.linalg.norm(nrm, axis=1)[:, None]
+    kink = math.sqrt(max(0.0, 1.0 - (nrm @ nrm.T).min() ** 2))
     f = lip_forces(result, len(X))
     lower = parent[copies]
     push_lower = -(f[lower] @ n)                             # >= 0: pushed back below the crack
     push_upper = f[copies] @ n                               # >= 0: pushed back above
     scale = np.abs(result.multipliers).max()
     print(f"\ninclined crack: slide / D {slide.min() / D:.3g} ... {slide.max() / D:.3g}, normal jump / D "
-          f"{normal_jump.min() / D:.2g} ... {normal_jump.max() / D:.2g}, deepest {depth:.2g}, "
+          f"{normal_jump.min() / D:.2g} ... {normal_jump.max() / D:.2g}, deepest slave {depth:.2g}, "
+          f"master {depth_master:.2g} (bound {slide.max() * kink:.2g}, kink {kink:.2g}), "
           f"multipliers {result.multipliers.min():.3g} ... {result.multipliers.max():.3g}, rounds {result.rounds}, "
           f"active {len(result.constraints)}")
     assert slide.max() >= 0.1 * D
     assert depth <= 1e-10 * math.sqrt(3.0)
+    assert depth_master <= slide.max() * kink
     assert np.all(normal_jump >= -1e-10)
     assert np.all(result.multipliers <= 1e-10 * scale)
     assert np.all(push_lower >= -1e-10 * scale) and np.all(push_upper >= -1e-10 * scale)
     assert push_lower.max() > 0
+
+
+def bar_run(tmp_path, contact):
+    """The smallest bar3d that breaks across its notch (benchmarks/solid.py --quick sizes)."""
+    scene = nf.scenes.bar3d(maxh=0.4, fine=0.1, radius=0.2, thickness=0.25)
+    result = nf.Simulation(scene, out=tmp_path / contact, pictures="none", contact=contact).run()
+    a = result.problem.arrays
+    C = crack_faces(a)
+    return result, a, np.unique(np.sort(a.points[C].reshape(len(C), -1), axis=1), axis=0)
+
+
+@pytest.mark.slow
+def test_bar3d_breaks_in_two_with_the_crack_of_a_run_without_contact(tmp_path):
+    # two bar runs and their meshes: about 20 s
+    with_contact, a, crack = bar_run(tmp_path, "auto")
+    without, b, crack_never = bar_run(tmp_path, "never")
+    s, t = with_contact.summary, without.summary
+    print(f"\nbar3d: {s['n_steps']} steps, {s['n_split_vertices']} split vertices, {len(crack)} distinct crack "
+          f"faces; wall {s['timings']['wall']:.2f} s with contact, {t['timings']['wall']:.2f} s without")
+    assert with_contact.reason == without.reason == "broken"
+    assert s["n_fragments"] == t["n_fragments"] == 2
+    assert s["n_steps"] == t["n_steps"] and s["n_split_vertices"] == t["n_split_vertices"]
+    assert np.array_equal(a.points, b.points) and np.array_equal(crack, crack_never)
+    U, V = (vertex_displacement(r.problem.u) for r in (with_contact, without))
+    assert np.abs(U - V).max() <= 1e-8 * np.abs(V).max()

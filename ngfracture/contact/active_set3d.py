@@ -24,11 +24,14 @@ Candidates, each identified by its key ("f", slave, master vertices sorted):
     form of the 2D seam rows: the detection leaves closed seams out (their master face
     would depend on rounding), and with a row identified by its key the candidate set of
     a seam is the same in every round;
+  * lip rows (:func:`~ngfracture.contact.rows3d.lip_rows`), one per pair of copies on one
+    fragment: the two lips of a crack that does not cut its fragment through;
 
 - *found* rows: the pairs the detection finds at the configuration of the last solve
   (touching or penetrating), in two passes (every boundary vertex of every fragment a
   slave: the pass that passes the patch test, rows3d's docstring). A found pair whose
-  vertex has a twin on the master fragment talks to it through its twin row only. A found
+  vertex has a twin on the master fragment talks to it through its twin row only; a lip
+  vertex found in its own fragment, through the lip row of its pair of copies. A found
   row stays a candidate while it is active or found again, as in 2D.
 
 Every round re-linearises all candidates at the configuration of the last solve
@@ -66,7 +69,8 @@ def fixed_rows_3d(points, tets, faces, fragment):
     -------
     rows : NodeToFaceRows
         The pairs touching in the reference configuration (sorted by vertex and fragment),
-        then the twin rows of every fragment's vertices (fragment by fragment, by slave).
+        then the twin rows of every fragment's vertices (fragment by fragment, by slave),
+        then the lip rows (by slave and copy).
     keys : list of tuple
         Their keys, without repeats (a repeated key keeps its first row).
 

@@ -355,9 +355,10 @@ def lip_rows(points, faces, vertex_fragment):
 def _copy_pairs(X, F):
     """Every ordered pair (s, t) of boundary vertices at the bitwise-equal reference point, s == t included."""
     on = np.unique(F)
-    _, group = np.unique(X[on], axis=0, return_inverse=True)
-    order = np.argsort(group.ravel(), kind="stable")
-    on, group = on[order], group.ravel()[order]
+    P = X[on]
+    order = np.lexsort((P[:, 2], P[:, 1], P[:, 0]))                     # equal points together, stable
+    on, P = on[order], P[order]
+    group = np.cumsum(np.r_[False, np.any(P[1:] != P[:-1], axis=1)])
     first = np.searchsorted(group, group)                                  # start of each vertex's group
     size = np.searchsorted(group, group, side="right") - first
     who, other = _ranges(first, size)
