@@ -158,6 +158,7 @@ namespace ngfracture
     {
       std::vector<int32_t> vfrag, ffrag, bverts;
       std::vector<double> vnormal, fnormal;
+      std::vector<uint8_t> lip;    // the vertex has a copy on its own fragment (a lip of a crack inside it)
     };
 
     Derived Derive (const TetMesh3 & m)
@@ -247,7 +248,8 @@ namespace ngfracture
     using Hit = std::tuple<int32_t,int32_t,int32_t>;   // vertex, fragment, tet
 
     // Every (boundary vertex, tetrahedron of another fragment) with the vertex in the
-    // closed tetrahedron: each tetrahedron's box swept over the vertex grid.
+    // closed tetrahedron, and (lip vertex, tetrahedron of its own fragment not at the
+    // vertex): each tetrahedron's box swept over the vertex grid.
     std::vector<Hit> SweepTets (const TetMesh3 & m, const Derived & D, const HashGrid & g, Collision3Stats & st)
     {
       std::vector<Hit> hits;
@@ -269,7 +271,12 @@ namespace ngfracture
                 g.Visit(i, j, k, [&] (int32_t v)
                   {
                     st.box_tests++;
-                    if (D.vfrag[v] == m.fragment[t]) return;
+                    if (D.vfrag[v] == m.fragment[t])
+                      {
+                        // self-contact across a crack: a lip vertex in a tetrahedron of
+                        // its own fragment that is not one of its own
+                        if (!D.lip[v] || T[0] == v || T[1] == v || T[2] == v || T[3] == v) return;
+                      }
                     const double * p = m.x + 3*v;
                     for (int d = 0; d < 3; d++)
                       if (p[d] < lo[d] || p[d] > hi[d]) return;
@@ -280,6 +287,9 @@ namespace ngfracture
       std::sort(hits.begin(), hits.end());
       return hits;
     }
+
+    // A face at v is never v's master (only possible on v's own fragment, self-contact).
+    inline bool AtVertex (const int32_t * T, int32_t v) { return T[0] == v || T[1] == v || T[2] == v; }
 
     // Master face, step 1: a face of F that holds v exactly (closed triangle) and whose
     // normal does not point along v's (dot <= 0): v touches it, gap 0. Such a face is
@@ -293,6 +303,7 @@ namespace ngfracture
           if (D.ffrag[f] != F || (found >= 0 && f > found)) return;
           if (!(Dot(&D.fnormal[3*f], &D.vnormal[3*v]) <= 0)) return;
           const int32_t * T = m.faces + 3*f;
+          if (AtVertex(T, v)) return;
           if (PointInClosedTriangle3(p, m.x + 3*T[0], m.x + 3*T[1], m.x + 3*T[2])) found = f;
         });
       return found;
@@ -312,6 +323,7 @@ namespace ngfracture
           if (D.ffrag[f] != F) return;
           if (opposing && !(Dot(&D.fnormal[3*f], &D.vnormal[3*v]) < 0)) return;
           const int32_t * T = m.faces + 3*f;
+          if (AtVertex(T, v)) return;
           const double * a = m.x + 3*T[0], * b = m.x + 3*T[1], * cc = m.x + 3*T[2];
           double bary[3], q[3];
           ClosestPointOnTriangle3(p, a, b, cc, bary);
@@ -390,6 +402,13 @@ namespace ngfracture
       std::copy(m.x + 3*D.bverts[s], m.x + 3*D.bverts[s] + 3, &lo[3*s]);
     vg.Build(lo, lo);
     for (auto & it : vg.items) it = D.bverts[it];        // grid items: vertex numbers
+    std::unordered_map<std::array<uint64_t,3>, std::vector<int32_t>, BitsHash> copies;
+    for (int32_t v : D.bverts) copies[Bits(m.X + 3*v)].push_back(v);
+    D.lip.assign(m.nv, 0);
+    for (const auto & [key, group] : copies)
+      for (size_t i = 0; i < group.size(); i++)
+        for (size_t j = i + 1; j < group.size(); j++)
+          if (D.vfrag[group[i]] == D.vfrag[group[j]]) D.lip[group[i]] = D.lip[group[j]] = 1;
     std::vector<Hit> hits = SweepTets(m, D, vg, st);
     if (hits.empty()) { if (stats) *stats = st; return out; }
 
@@ -403,8 +422,6 @@ namespace ngfracture
         }
     fg.items.clear(); fg.range.clear();
     fg.Build(lo, hi);
-    std::unordered_map<std::array<uint64_t,3>, std::vector<int32_t>, BitsHash> copies;
-    for (int32_t v : D.bverts) copies[Bits(m.X + 3*v)].push_back(v);
 
     for (size_t s = 0; s < hits.size(); s++)
       {

@@ -44,7 +44,10 @@ namespace ngfracture
   };
 
   // Every (boundary vertex, other fragment) pair with the vertex in the fragment's closed
-  // volume, except closed seams (the vertex's twin on that fragment at the same current
+  // volume, and every (lip vertex, own fragment) pair with the vertex in a closed
+  // tetrahedron of its own fragment that is not at the vertex (a lip vertex: one with a
+  // copy on its own fragment, i.e. a lip of a crack that does not cut the fragment
+  // through), except closed seams (the vertex's twin on that fragment at the same current
   // point), sorted by (vertex, fragment). Throws std::invalid_argument on inconsistent input.
   std::vector<Penetration3> DetectPenetrations3 (const TetMesh3 & mesh, Collision3Stats * stats);
 

@@ -24,11 +24,14 @@ Candidates, each identified by its key ("f", slave, master vertices sorted):
     form of the 2D seam rows: the detection leaves closed seams out (their master face
     would depend on rounding), and with a row identified by its key the candidate set of
     a seam is the same in every round;
+  * lip rows (:func:`~ngfracture.contact.rows3d.lip_rows`), one per pair of copies on one
+    fragment: the two lips of a crack that does not cut its fragment through;
 
 - *found* rows: the pairs the detection finds at the configuration of the last solve
   (touching or penetrating), in two passes (every boundary vertex of every fragment a
   slave: the pass that passes the patch test, rows3d's docstring). A found pair whose
-  vertex has a twin on the master fragment talks to it through its twin row only. A found
+  vertex has a twin on the master fragment talks to it through its twin row only; a lip
+  vertex found in its own fragment, through the lip row of its pair of copies. A found
   row stays a candidate while it is active or found again, as in 2D.
 
 Every round re-linearises all candidates at the configuration of the last solve
@@ -42,7 +45,8 @@ import numpy as np
 
 from .active_set import ActiveSet, Candidates, refreshed
 from .collision3d import detect_penetrations_3d
-from .rows3d import NodeToFaceRows, no_face_rows, node_to_face_rows, relinearise_node_to_face, twin_rows
+from .rows3d import (NodeToFaceRows, lip_rows, no_face_rows, node_to_face_rows, relinearise_node_to_face,
+                     twin_rows)
 
 __all__ = ["ActiveSet3d", "fixed_rows_3d"]
 
@@ -65,7 +69,8 @@ def fixed_rows_3d(points, tets, faces, fragment):
     -------
     rows : NodeToFaceRows
         The pairs touching in the reference configuration (sorted by vertex and fragment),
-        then the twin rows of every fragment's vertices (fragment by fragment, by slave).
+        then the twin rows of every fragment's vertices (fragment by fragment, by slave),
+        then the lip rows (by slave and copy).
     keys : list of tuple
         Their keys, without repeats (a repeated key keeps its first row).
 
@@ -78,6 +83,7 @@ def fixed_rows_3d(points, tets, faces, fragment):
     touching = node_to_face_rows(points, faces, detect_penetrations_3d(points, tets, faces, fragment))
     vertex_fragment = _vertex_fragment(nv, tets, fragment)
     parts = [touching] + [twin_rows(points, faces, vertex_fragment == f) for f in np.unique(fragment)]
+    parts.append(lip_rows(points, faces, vertex_fragment))
     rows = NodeToFaceRows.stack(parts)
     keys = rows.keys()
     first = sorted({k: i for i, k in reversed(list(enumerate(keys)))}.values())
@@ -167,12 +173,14 @@ class ActiveSet3d(ActiveSet):
         pen = detect_penetrations_3d(a.points, a.tets, a.faces, self.geometry.fragment, displacement=U)
         timings["collision"] += time.perf_counter() - t0
         rows = node_to_face_rows(a.points, a.faces, pen)
-        # a vertex with a twin on the master fragment talks to it through its twin row
+        # a vertex with a twin on the master fragment talks to it through its twin row; a
+        # lip vertex in its own fragment, through the lip row of its pair of copies
         twin = np.asarray(pen.twin, dtype=np.int64)
         keep = twin < 0
         if not keep.all():
             covered = {(k[1], int(self.vertex_fragment[k[2]])) for k in self.seam_keys}
-            keep |= np.array([(int(v), int(f)) not in covered
-                              for v, f in zip(pen.vertex.tolist(), pen.fragment.tolist())], dtype=bool)
+            own = pen.fragment == self.vertex_fragment[pen.vertex]
+            keep |= ~own & np.array([(int(v), int(f)) not in covered
+                                     for v, f in zip(pen.vertex.tolist(), pen.fragment.tolist())], dtype=bool)
         rows = rows.subset(np.flatnonzero(keep))
         return rows, rows.keys()

@@ -9,10 +9,20 @@ fragment number per tetrahedron (:func:`ngfracture.fracture.split3d.fragments_3d
 
 What is found. A *penetration* is a pair (boundary vertex v of fragment A, fragment
 F != A) with v, at its current position, in the closed volume of F: in some closed
-tetrahedron of F. The closed test makes touching (a vertex on F's surface) a candidate
+tetrahedron of F; or F = A for a lip vertex (below). The closed test makes touching (a vertex on F's surface) a candidate
 with gap 0 instead of nothing, so contact can be activated at zero gap, as the 2D
 precision threshold does; pairs with gap < 0 are the penetrations proper. Fragments must
 not share vertices (a vertex in tetrahedra of two fragments is refused).
+
+Self-contact across a crack. The lips of a crack that does not cut its fragment through
+are on one fragment. A *lip vertex* (a boundary vertex with a copy, at the bitwise-equal
+reference point, on its own fragment) is also tested against the tetrahedra of its own
+fragment that are not at the vertex, and the pair (v, own fragment) is reported like a
+pair across fragments, its masters the faces of the fragment not at v. A lip vertex of a
+closed crack lies in such a tetrahedron only on the other lip at its copy (a closed seam,
+left out below), so an intact or closed body reports nothing. Other boundary vertices are
+not tested against their own fragment: they lie in no tetrahedron of it but their own
+while the tetrahedra stay positive, unless the body folds onto itself (not searched).
 
 Predicate. Point-in-tetrahedron uses the exact ``orient3d`` (sign of det[a-d, b-d, c-d];
 a positively oriented tetrahedron gives -1): the point is in the closed tetrahedron iff
@@ -169,6 +179,9 @@ def _indices(a, name, cols, n):
 
 def detect_penetrations_3d(points, tets, faces, fragment, displacement=None):
     """Boundary vertices of each fragment in the closed volume of another, with master faces.
+
+    Lip vertices (with a copy on their own fragment) are also tested against the
+    tetrahedra of their own fragment that are not at them: self-contact across a crack.
 
     Parameters
     ----------

@@ -63,7 +63,7 @@ import scipy.sparse as sp
 
 from .rows import RowTable
 
-__all__ = ["NodeToFaceRows", "no_face_rows", "node_to_face_rows", "twin_rows", "face_gap_rows",
+__all__ = ["NodeToFaceRows", "no_face_rows", "node_to_face_rows", "twin_rows", "lip_rows", "face_gap_rows",
            "relinearise_node_to_face", "nodal_areas", "space_columns_3d"]
 
 @dataclass
@@ -299,32 +299,90 @@ def twin_rows(points, faces, slave):
     mask = np.asarray(slave)
     if mask.shape != (nv,) or mask.dtype != bool:
         raise ValueError(f"slave must be a boolean mask of shape ({nv},), got {mask.dtype} {mask.shape}")
+    s, t = _copy_pairs(X, F)
+    pick = mask[s] & ~mask[t]
+    return _rows_at_copies(X, F, s[pick], t[pick], s[pick])
+
+
+def lip_rows(points, faces, vertex_fragment):
+    """Rows between the coincident lips of a crack inside one fragment, one per pair of copies.
+
+    The lips of a crack that does not cut its fragment through are on one fragment: every
+    lip vertex has a copy on its own fragment at the same reference point, and
+    :func:`twin_rows` (copies on other fragments) gives them nothing. For copies t < s the
+    row is the node-to-face row of :func:`twin_rows` with s the slave: on the face at t
+    whose unit outward normal opposes s's normal most, projection at t. One row per pair,
+    as the 2D seams have one row per twin pair: the lips are matching meshes, so one pass
+    transmits a uniform pressure exactly, and a second row of the pair (on a face at s) is
+    the same row only while the two faces stay parallel; once the lips deform their
+    normals differ, the pair of rows is no longer dependent and imposed together they
+    block the slip between the copies. At a junction of three or more copies every pair
+    has its row.
+
+    Parameters
+    ----------
+    points : array_like, shape (nv, 3)
+        Reference coordinates (copies bitwise equal).
+    faces : array_like of int, shape (nf, 3)
+        Boundary faces, outward (the crack faces among them).
+    vertex_fragment : array_like of int, shape (nv,)
+        Fragment of every vertex.
+
+    Returns
+    -------
+    NodeToFaceRows
+        Sorted by (slave, copy), the slave the higher-numbered copy; ``dist`` is the gap at
+        the reference configuration (0).
+
+    Raises
+    ------
+    ValueError
+        On wrong shapes or vertex numbers out of range.
+    """
+    X = _coordinates(points, "points")
+    nv = len(X)
+    F = np.asarray(faces)
+    F = _vertices(F, "faces", nv, (F.shape[0] if F.ndim == 2 else -1, 3))
+    frag = np.asarray(vertex_fragment)
+    if frag.shape != (nv,) or not np.issubdtype(frag.dtype, np.integer):
+        raise ValueError(f"vertex_fragment must be integers of shape ({nv},), got {frag.dtype} {frag.shape}")
+    s, t = _copy_pairs(X, F)
+    pick = (frag[s] == frag[t]) & (s > t)
+    s, t = s[pick], t[pick]
+    return _rows_at_copies(X, F, s, t, s * nv + t)
+
+
+def _copy_pairs(X, F):
+    """Every ordered pair (s, t) of boundary vertices at the bitwise-equal reference point, s == t included."""
+    on = np.unique(F)
+    P = X[on]
+    order = np.lexsort((P[:, 2], P[:, 1], P[:, 0]))                     # equal points together, stable
+    on, P = on[order], P[order]
+    group = np.cumsum(np.r_[False, np.any(P[1:] != P[:-1], axis=1)])
+    first = np.searchsorted(group, group)                                  # start of each vertex's group
+    size = np.searchsorted(group, group, side="right") - first
+    who, other = _ranges(first, size)
+    return on[who], on[other]
+
+
+def _rows_at_copies(X, F, s, t, per):
+    """Rows of slaves s on the face at their copy t opposing s's normal most, one per value of ``per``."""
+    nv = len(X)
     p = X[F]
     area2 = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
     unit = area2 / np.linalg.norm(area2, axis=1)[:, None]
     vnormal = np.zeros((nv, 3))
     np.add.at(vnormal, F.ravel(), np.repeat(area2, 3, axis=0))
-    on = np.unique(F)
-    _, group = np.unique(X[on], axis=0, return_inverse=True)
-    order = np.argsort(group.ravel(), kind="stable")
-    on, group = on[order], group.ravel()[order]
-    first = np.searchsorted(group, group)                                  # start of each vertex's group
-    size = np.searchsorted(group, group, side="right") - first
-    # pairs (slave s, twin t): every other vertex of s's group outside the slaves
-    who, other = _ranges(first, size)
-    s, t = on[who], on[other]
-    pick = mask[s] & ~mask[t]
-    s, t = s[pick], t[pick]
-    # candidate faces: every face at the twin
+    # candidate faces: every face at the copy
     inc = np.argsort(F.ravel(), kind="stable")
     start = np.searchsorted(F.ravel()[inc], t)
     count = np.searchsorted(F.ravel()[inc], t, side="right") - start
     pair, slot = _ranges(start, count)
     face, k = np.divmod(inc[slot], 3)
-    s = s[pair]
+    s, per = s[pair], per[pair]
     dots = np.einsum("ij,ij->i", unit[face], vnormal[s])
-    best = np.lexsort((face, dots, s))                                      # per slave: most opposed, smaller face
-    best = best[np.r_[True, s[best][1:] != s[best][:-1]]] if len(best) else best
+    best = np.lexsort((face, dots, per))                                   # per group: most opposed, smaller face
+    best = best[np.r_[True, per[best][1:] != per[best][:-1]]] if len(best) else best
     best = best[dots[best] < 0]
     if not len(best):
         return no_face_rows(nv)

@@ -21,10 +21,10 @@ the step and the size of the violation in its reason.
   bound: pieces that only separate never overlap. In 3D the overlap volume is not
   measured; what is checked is that no boundary vertex of a piece lies deeper than
   :data:`OVERLAP_TOL` of the body's diameter (the diagonal of its bounding box) inside
-  another piece, by :func:`ngfracture.contact.collision3d.detect_penetrations_3d` (exact
-  predicates), and the largest depth is what the step records as its overlap. This is
-  checked where a 3D run solves with contact (``Scene.contact``); 3D cracks have no
-  contact rows yet, and their lips are not checked.
+  another piece, or a lip vertex deeper in the other lip of its own crack, by
+  :func:`ngfracture.contact.collision3d.detect_penetrations_3d` (exact predicates), and
+  the largest depth is what the step records as its overlap. This is checked where a 3D
+  run solves with contact (bodies meshed apart, or cracks).
 
 The checks cost a few percent of a run (docs/performance.md): the overlap is measured only
 where there are cracks or separate bodies.
@@ -118,7 +118,7 @@ def penetration_depth_3d(problem):
     -------
     float
         max(0, -gap) over the pairs of :func:`ngfracture.contact.collision3d.detect_penetrations_3d`
-        (the distance to the master face); 0 with no pair.
+        (the distance to the master face; crack lips of one piece included); 0 with no pair.
 
     Raises
     ------

@@ -123,9 +123,8 @@ class LoadStep:
         """
         if self.contact == "never":
             return False
-        if mesh.dim == 3:       # 3D: contact between bodies meshed apart; cracks' lips are not in contact yet
-            return bool(self.scene.contact)
-        return self.scene.contact or "crack" in mesh.GetBoundaries()
+        # 2D and 3D alike: separate bodies from the start, crack lips once there are cracks
+        return bool(self.scene.contact) or "crack" in mesh.GetBoundaries()
 
     def equilibrium(self, prob, phase, method, timings, substeps=1, warm=(), lineage=None, start=None):
         """Solve ``prob`` in ``substeps`` load steps, with contact where the mesh needs it.
@@ -419,7 +418,7 @@ class LoadStep:
         """
         with timings.timed("checks"):
             pieces = self.scene.contact or "crack" in prob.mesh.GetBoundaries() or prob.fragments()[0] > 1
-            if prob.dim == 3:       # without contact a 3D crack's lips are free to overlap (not checked)
+            if prob.dim == 3:       # 3D: checked where the solve had contact rows
                 pieces = self.needs_contact(prob.mesh)
             violation, overlap = check_state(prob, area, pieces)
         if violation is not None:
