@@ -143,7 +143,7 @@ class FragmentStatistics:
             frag = np.asarray(fragment)
             if frag.shape != (ne,):
                 raise ValueError(f"FragmentStatistics: fragment ids must have shape ({ne},) "
-                                 f"(one per element), got {frag.shape}")
+                                 f"(one per {'tetrahedron' if d == 3 else 'triangle'}), got {frag.shape}")
             if not np.issubdtype(frag.dtype, np.integer):
                 raise ValueError(f"FragmentStatistics: fragment ids must be integers, got dtype {frag.dtype}")
         self.dim = d
