@@ -19,6 +19,7 @@ from netgen.csg import CSGeometry, OrthoBrick, Pnt
 
 import benchmark_json
 from ngfracture.fracture import split3d as s3
+from ngfracture.fracture.fragments import FragmentStatistics
 from ngfracture.geometry.solid import solid_mesh, solid_to_arrays
 
 
@@ -50,7 +51,7 @@ def crack_work(arrays, k):
     t1 = time.perf_counter()
     mesh = solid_mesh(r.arrays)
     t2 = time.perf_counter()
-    frag = s3.fragments_3d(r.arrays)
+    frag = FragmentStatistics(r.arrays)
     t3 = time.perf_counter()
     return {"split": t1 - t0, "rebuild": t2 - t1, "fragments": t3 - t2, "total": t3 - t0,
             "nsplit": r.nsplit, "fragment_count": frag.count, "nv_new": mesh.nv}

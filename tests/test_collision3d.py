@@ -12,6 +12,7 @@ import pytest
 
 from ngfracture.contact.collision3d import detect_penetrations_3d, orient3d
 from ngfracture.fracture import split3d as s3
+from ngfracture.fracture.fragments import FragmentStatistics
 from ngfracture.geometry.structured import box_mesh
 from split3d_util import cube_bar
 
@@ -127,7 +128,7 @@ def cracked_bar():
     a = cube_bar(2, 2, 8)
     for v in np.flatnonzero(a.points[:, 2] == 4.0):
         a = s3.split_vertices_3d(a, [v], [np.array([0.0, 0.0, 1.0])]).arrays
-    fr = s3.fragments_3d(a)
+    fr = FragmentStatistics(a)
     assert fr.count == 2
     return a, fr.fragment
 

@@ -17,11 +17,14 @@ import time
 import numpy as np
 import pytest
 import pyvista as pv
+from overlap3d_util import check_run_overlap
 
 ARGS = ["run", "plate", "--maxh", "0.06", "--quiet", "--pictures", "none"]
 #: the notched bar on tetrahedra, coarse
 BAR3D_ARGS = ["run", "bar3d", "--maxh", "0.4", "--set", "radius=0.2", "--set", "thickness=0.25", "--quiet",
               "--pictures", "none"]
+#: the 3D contact scene: two blocks meshed apart, pressed on each other (contact rows from the start)
+BLOCKS3D_ARGS = ["run", "blocks3d", "--quiet", "--pictures", "none"]
 #: the plate from a coarse start, refined ahead of its crack tips (Scene.refine) in every step
 REFINED_ARGS = ["run", "plate", "--maxh", "0.1", "--set", "refine=true", "--quiet", "--pictures", "none"]
 
@@ -157,3 +160,20 @@ def test_a_3d_run_killed_during_a_checkpoint_write_resumes_to_the_same_result(tm
     proc.wait()
     _finish(_start(out, tmp_path, resume=True, args=BAR3D_ARGS))
     _compare(out, reference)
+    check_run_overlap(out)                   # every written step: the halves do not overlap
+
+
+@pytest.mark.slow
+def test_a_3d_contact_run_killed_during_a_checkpoint_write_resumes_to_the_same_result(tmp_path):
+    reference = tmp_path / "reference"
+    _finish(_start(reference, tmp_path, args=BLOCKS3D_ARGS))
+    summary = json.loads((reference / "summary.json").read_text())
+    assert summary["reason"] == "load_max" and summary["n_fragments"] == 2
+    out = tmp_path / "run"
+    proc = _start(out, tmp_path, slow=2, args=BLOCKS3D_ARGS)
+    assert proc.stdout.readline().strip() == "WRITING", proc.stderr.read()
+    proc.send_signal(signal.SIGKILL)
+    proc.wait()
+    _finish(_start(out, tmp_path, resume=True, args=BLOCKS3D_ARGS))
+    _compare(out, reference)
+    check_run_overlap(out)

@@ -1,6 +1,6 @@
 """3D runs are reproducible: a resumed run equals the uninterrupted one bit for bit, in
-process and after SIGKILL during a checkpoint write, and an ensemble of a 3D scene gives
-the same report on one and on two dask workers."""
+process and after SIGKILL during a checkpoint write, and an ensemble of a 3D scene, with
+and without contact, gives the same report on one and on two dask workers."""
 import json
 
 import numpy as np
@@ -54,3 +54,30 @@ def test_a_3d_ensemble_is_the_same_on_one_and_two_workers(tmp_path):
     assert all(s["ok"] and s["split_vertices"] > 0 for s in one["samples"])
     assert one["samples"][0]["fragments"] >= 1 and "fragment_volumes" in one["samples"][0]
     assert comparable_report(one) == comparable_report(two)
+
+
+def contact_bar3d_factory():
+    """bar3d of random strength solved with contact from the start (``Scene.contact``). A
+    closure: dask pickles it by value."""
+    def factory(seed):
+        import dataclasses
+        return dataclasses.replace(scenes.bar3d(weibull_m=8, seed=seed, **COARSE), contact=True)
+    return factory
+
+
+@pytest.mark.slow
+def test_a_3d_contact_ensemble_is_the_same_on_one_and_two_workers(tmp_path):
+    """The contact solver on tetrahedra (ActiveSet3d) in every step of every sample: the
+    workers do not change the ensemble, and no written step has fragments that overlap."""
+    from overlap3d_util import check_run_overlap
+
+    from ngfracture.studies.ensemble import Ensemble, comparable_report
+    options = dict(control={"max_steps": 8}, progress=False)
+    one, two = (Ensemble(contact_bar3d_factory(), [0, 1], out=tmp_path / str(n), workers=n, **options).run()
+                for n in (1, 2))
+    assert all(s["ok"] and s["split_vertices"] > 0 for s in one["samples"])
+    assert comparable_report(one) == comparable_report(two)
+    assert one["fragment_counts"]["mean"] >= 1 and one["fragment_sizes"]["count"] >= 2
+    for n in (1, 2):
+        for sample in sorted((tmp_path / str(n)).glob("sample_*")):
+            check_run_overlap(sample)

@@ -14,6 +14,7 @@ from netgen.csg import CSGeometry, OrthoBrick, Pnt
 
 from ngfracture.fracture.split import transfer_vertex_field
 from ngfracture.fracture import split3d as s3
+from ngfracture.fracture.fragments import FragmentStatistics
 from ngfracture.geometry.solid import solid_mesh, solid_to_arrays, tet_volumes, total_volume
 from split3d_util import check_twins, crack_area, crack_pieces, cube_bar, min_face_surface
 
@@ -49,7 +50,7 @@ def test_structured_bar_splits_in_two_across_its_mid_plane():
     plane = np.flatnonzero(a.points[:, 2] == 4.0)
     b, rec = split_each(a, plane, Z)
     check_invariants(a, b)
-    fr = s3.fragments_3d(b)
+    fr = FragmentStatistics(b)
     assert fr.count == 2
     assert [math.fsum(fr.volumes)] == [total_volume(a.points, a.tets)]
     assert crack_area(b) == pytest.approx(4.0, abs=1e-12)
@@ -91,7 +92,7 @@ def check_grown_crack(a, b, normal, centre, maxh):
     """Two fragments, volume kept, every crack vertex within maxh of the plane; returns the
     crack area."""
     check_invariants(a, b)
-    assert s3.fragments_3d(b).count == 2
+    assert FragmentStatistics(b).count == 2
     assert len(s3.front_edges_3d(b)) == 0
     x = b.points[b.boundary_faces("crack")]
     assert np.abs((x - centre) @ normal).max() <= maxh
@@ -166,14 +167,14 @@ def test_fronts_meet_the_free_surface():
     inner = [v for v in plane if 0 < a.points[v, 0] < 4 and 0 < a.points[v, 1] < 4]
     outer = [v for v in plane if v not in inner]
     b, rec = split_each(a, inner, Z)
-    assert s3.fragments_3d(b).count == 1 and len(s3.front_edges_3d(b))
+    assert FragmentStatistics(b).count == 1 and len(s3.front_edges_3d(b))
     b, rec2 = split_each(b, outer, Z)
     # the front reaches the surface: surface vertices on the front close it, the others had
     # fallen apart already (split per piece) or lie beside the crack on one side only
     flags = [names(r["flags"]) for r in rec + rec2]
     assert any({"surface", "front", "closed"} <= f for f in flags)
     assert any("far" in f for f in flags)
-    assert s3.fragments_3d(b).count == 2 and len(s3.front_edges_3d(b)) == 0
+    assert FragmentStatistics(b).count == 2 and len(s3.front_edges_3d(b)) == 0
     assert crack_area(b) == pytest.approx(16.0, abs=1e-12)
     check_invariants(a, b)
 
@@ -195,7 +196,7 @@ def test_two_fronts_meet():
 def test_junction_splits_a_crack_vertex_again():
     a = cube_bar(4, 2, 4)
     b, _ = split_each(a, np.flatnonzero(a.points[:, 2] == 2.0), Z)
-    assert s3.fragments_3d(b).count == 2
+    assert FragmentStatistics(b).count == 2
     # a second crack, x = 2, in the upper half, down to the first one (T-intersection): the
     # T-line's vertices are split again, their upper copies
     upper = np.unique(b.tets[b.points[b.tets].mean(axis=1)[:, 2] > 2.0])
@@ -207,7 +208,7 @@ def test_junction_splits_a_crack_vertex_again():
     # three copies of every point of the T-line: below, upper left, upper right
     on_t = c.points[(c.points[:, 0] == 2.0) & (c.points[:, 2] == 2.0)]
     assert len(on_t) == 9 and len(np.unique(on_t, axis=0)) == 3
-    fr = s3.fragments_3d(c)
+    fr = FragmentStatistics(c)
     assert fr.count == 3
     assert sorted(fr.volumes) == [8.0, 8.0, 16.0]
     assert crack_area(c) == pytest.approx(8.0 + 4.0, abs=1e-12)
@@ -230,7 +231,7 @@ def test_split_by_tensor_and_determinism():
     for name in ("points", "tets", "faces", "face_bc"):
         assert np.array_equal(getattr(r1.arrays, name), getattr(r2.arrays, name))
     assert np.array_equal(r1.parent, r2.parent)
-    assert s3.fragments_3d(r1.arrays).count == 2
+    assert FragmentStatistics(r1.arrays).count == 2
     check_invariants(a, r1.arrays)
 
 
@@ -289,7 +290,7 @@ def test_spread_pass_splits_no_two_neighbours_and_ends_planar():
         b, tb, passes = q.arrays, transfer_vertex_field(tb, q), passes + 1
         assert passes <= len(plane)
     check_invariants(a, b)
-    assert s3.fragments_3d(b).count == 2
+    assert FragmentStatistics(b).count == 2
     assert crack_area(b) == pytest.approx(16.0, abs=1e-12)
     assert np.all(b.points[b.boundary_faces("crack")][..., 2] == 2.0)
     assert len(s3.front_edges_3d(b)) == 0

@@ -5,7 +5,7 @@ The 3D analogue of :mod:`ngfracture.contact.collision`, and the first building b
 not built here. Everything works on plain arrays in the convention of
 :mod:`ngfracture.geometry.solid` (tets positively oriented, boundary faces pointing out of
 the body, crack lips as coincident faces whose vertices are bitwise-equal copies), plus a
-fragment number per tetrahedron (:func:`ngfracture.fracture.split3d.fragments_3d`).
+fragment number per tetrahedron (:func:`ngfracture.fracture.fragments.fragment_ids`).
 
 What is found. A *penetration* is a pair (boundary vertex v of fragment A, fragment
 F != A) with v, at its current position, in the closed volume of F: in some closed

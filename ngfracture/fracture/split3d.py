@@ -66,11 +66,11 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from .. import _ngfracture as _ext
-from ..geometry.solid import SolidArrays, tet_volumes
+from ..geometry.solid import SolidArrays
 from .solid_criterion import principal_3d
 
 __all__ = ["SPLIT3D_FLAGS", "SPLIT_MODES", "Split3dResult", "split_vertices_3d",
-           "split_by_tensor_3d", "Fragments3d", "fragments_3d", "front_edges_3d",
+           "split_by_tensor_3d", "front_edges_3d",
            "pinched_vertices_3d", "flag_names_3d"]
 
 #: bit flags of the record's "flags" entries, by name (cpp_ext/crack_split3d.hpp)
@@ -233,53 +233,6 @@ def split_by_tensor_3d(arrays, tensors, critical=1.0, mode="one", crack_name="cr
                             skip_neighbours=mode == "spread")
     res.record["principal"] = values[res.record["vertex"]]
     return res
-
-
-@dataclass
-class Fragments3d:
-    """The pieces of a cracked tetrahedral mesh.
-
-    Parameters
-    ----------
-    count : int
-    fragment : numpy.ndarray
-        Fragment of every tetrahedron, numbered by its smallest tetrahedron.
-    volumes : numpy.ndarray
-        Shape (count,), each ``math.fsum`` of its tetrahedra's volumes.
-    centroids : numpy.ndarray
-        Shape (count, 3), volume centroids in the reference configuration.
-    """
-    count: int
-    fragment: np.ndarray
-    volumes: np.ndarray
-    centroids: np.ndarray
-
-
-def fragments_3d(arrays):
-    """Fragments: tetrahedra connected through shared faces (C++ ``TetComponents``).
-
-    Parameters
-    ----------
-    arrays : SolidArrays
-
-    Returns
-    -------
-    Fragments3d
-
-    Raises
-    ------
-    ValueError
-        A tetrahedron vertex number out of range.
-    """
-    n, frag = _ext.TetComponents(np.asarray(arrays.tets), len(arrays.points))
-    frag = np.asarray(frag, dtype=np.int64)
-    vol = tet_volumes(arrays.points, arrays.tets)
-    centres = np.asarray(arrays.points)[arrays.tets].mean(axis=1)
-    order = np.argsort(frag, kind="stable")
-    cuts = np.searchsorted(frag[order], np.arange(1, n))
-    volumes = np.array([math.fsum(p) for p in np.split(vol[order], cuts)])
-    centroids = np.column_stack([np.bincount(frag, weights=vol * centres[:, k], minlength=n) for k in range(3)])
-    return Fragments3d(int(n), frag, volumes, centroids / volumes[:, None])
 
 
 def front_edges_3d(arrays, crack_name="crack"):

@@ -24,7 +24,8 @@ the step and the size of the violation in its reason.
   another piece, or a lip vertex deeper in the other lip of its own crack, by
   :func:`ngfracture.contact.collision3d.detect_penetrations_3d` (exact predicates), and
   the largest depth is what the step records as its overlap. This is checked where a 3D
-  run solves with contact (bodies meshed apart, or cracks).
+  run solves with contact (bodies meshed apart, or cracks). The overlap volume itself is
+  measured from a run's written files by :func:`ngfracture.output.overlap3d.vtu_overlap_volume`.
 
 The checks cost a few percent of a run (docs/performance.md): the overlap is measured only
 where there are cracks or separate bodies.

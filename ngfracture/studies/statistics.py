@@ -217,8 +217,9 @@ def _figure(size=(6, 4)):
 def plot_ensemble(report, folder):
     """The ensemble's three pictures (PNG, headless Agg).
 
-    ``fragment_sizes.png``: fraction of fragments with area > A, log-log, pooled, with the
-    bootstrap band and the fitted family; ``fragment_counts.png``: histogram of the
+    ``fragment_sizes.png``: fraction of fragments with area > A (volume > V for samples of a
+    3D scene, which report ``fragment_volumes``), log-log, pooled, with the bootstrap band
+    and the fitted family; ``fragment_counts.png``: histogram of the
     fragments per sample; ``peak_loads.png``: the peak load of every sample.
 
     Parameters
@@ -261,8 +262,9 @@ def plot_ensemble(report, folder):
             ax.plot(area, np.maximum(sf, floor), "k--", label=f"{report['fit']['family']} fit (ML)")
         ax.set_xscale("log")
         ax.set_yscale("log")
-        ax.set_xlabel("fragment area A")
-        ax.set_ylabel("fraction of fragments with area > A")
+        measure, sym = ("volume", "V") if any("fragment_volumes" in s for s in done) else ("area", "A")
+        ax.set_xlabel(f"fragment {measure} {sym}")
+        ax.set_ylabel(f"fraction of fragments with {measure} > {sym}")
         ax.set_title(f"{sizes['count']} fragments of {sizes['samples']} samples")
         ax.legend(fontsize=8)
         fig.subplots_adjust(left=0.14, right=0.97, bottom=0.13, top=0.9)
