@@ -63,7 +63,7 @@ import scipy.sparse as sp
 
 from .rows import RowTable
 
-__all__ = ["NodeToFaceRows", "no_face_rows", "node_to_face_rows", "twin_rows", "face_gap_rows",
+__all__ = ["NodeToFaceRows", "no_face_rows", "node_to_face_rows", "twin_rows", "fragment_twin_rows", "face_gap_rows",
            "relinearise_node_to_face", "nodal_areas", "space_columns_3d"]
 
 @dataclass
@@ -299,22 +299,72 @@ def twin_rows(points, faces, slave):
     mask = np.asarray(slave)
     if mask.shape != (nv,) or mask.dtype != bool:
         raise ValueError(f"slave must be a boolean mask of shape ({nv},), got {mask.dtype} {mask.shape}")
-    p = X[F]
-    area2 = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
-    unit = area2 / np.linalg.norm(area2, axis=1)[:, None]
-    vnormal = np.zeros((nv, 3))
-    np.add.at(vnormal, F.ravel(), np.repeat(area2, 3, axis=0))
+    s, t = _coincident_pairs(X, F)
+    pick = mask[s] & ~mask[t]
+    return _twin_face_rows(X, F, s[pick], t[pick])
+
+
+def fragment_twin_rows(points, faces, vertex_fragment):
+    """The twin rows of every fragment's vertices as slaves, all fragments in one pass.
+
+    The rows of ``twin_rows(points, faces, vertex_fragment == f)`` for every fragment f in
+    increasing order, stacked, bit for bit: a slave's twins are the vertices of other
+    fragments at its reference point. One sort of the boundary vertices serves all
+    fragments (a call per fragment sorts them once per fragment).
+
+    Parameters
+    ----------
+    points : array_like, shape (nv, 3)
+        Reference coordinates (copies bitwise equal).
+    faces : array_like of int, shape (nf, 3)
+        Boundary faces, outward.
+    vertex_fragment : array_like of int, shape (nv,)
+        The fragment of every vertex (vertices of one fragment never have twins among
+        themselves).
+
+    Returns
+    -------
+    NodeToFaceRows
+        Sorted by the slave's fragment, then by slave vertex.
+
+    Raises
+    ------
+    ValueError
+        On wrong shapes or vertex numbers out of range.
+    """
+    X = _coordinates(points, "points")
+    nv = len(X)
+    F = np.asarray(faces)
+    F = _vertices(F, "faces", nv, (F.shape[0] if F.ndim == 2 else -1, 3))
+    vf = np.asarray(vertex_fragment)
+    if vf.shape != (nv,) or (vf.size and not np.issubdtype(vf.dtype, np.integer)):
+        raise ValueError(f"vertex_fragment must be integers of shape ({nv},), got {vf.dtype} {vf.shape}")
+    s, t = _coincident_pairs(X, F)
+    pick = vf[s] != vf[t]
+    rows = _twin_face_rows(X, F, s[pick], t[pick])
+    return rows.subset(np.lexsort((rows.slave, vf[rows.slave])))
+
+
+def _coincident_pairs(X, F):
+    """Every ordered pair (s, t), s != t, of boundary vertices at the bitwise-equal reference point."""
     on = np.unique(F)
     _, group = np.unique(X[on], axis=0, return_inverse=True)
     order = np.argsort(group.ravel(), kind="stable")
     on, group = on[order], group.ravel()[order]
     first = np.searchsorted(group, group)                                  # start of each vertex's group
     size = np.searchsorted(group, group, side="right") - first
-    # pairs (slave s, twin t): every other vertex of s's group outside the slaves
     who, other = _ranges(first, size)
-    s, t = on[who], on[other]
-    pick = mask[s] & ~mask[t]
-    s, t = s[pick], t[pick]
+    return on[who], on[other]
+
+
+def _twin_face_rows(X, F, s, t):
+    """The rows of :func:`twin_rows` for the pairs (slave s, twin t), sorted by slave."""
+    nv = len(X)
+    p = X[F]
+    area2 = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+    unit = area2 / np.linalg.norm(area2, axis=1)[:, None]
+    vnormal = np.zeros((nv, 3))
+    np.add.at(vnormal, F.ravel(), np.repeat(area2, 3, axis=0))
     # candidate faces: every face at the twin
     inc = np.argsort(F.ravel(), kind="stable")
     start = np.searchsorted(F.ravel()[inc], t)
