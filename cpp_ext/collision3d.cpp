@@ -158,6 +158,7 @@ namespace ngfracture
     {
       std::vector<int32_t> vfrag, ffrag, bverts;
       std::vector<double> vnormal, fnormal;
+      std::vector<double> flo, fhi;       // boxes of the boundary faces (current positions)
     };
 
     Derived Derive (const TetMesh3 & m)
@@ -380,10 +381,28 @@ namespace ngfracture
       int64_t c[3] = { fg.Cell(p[0], 0), fg.Cell(p[1], 1), fg.Cell(p[2], 2) };
       double best = std::numeric_limits<double>::infinity();
       int32_t bf = -1;
+      // the distance from p to the walls of its own cell (less a margin for rounding): after
+      // ring r every face not seen is farther than r h + wall from p
+      double wall = std::numeric_limits<double>::infinity();
+      for (int d = 0; d < 3; d++)
+        {
+          double f = (p[d] - fg.origin[d]) / fg.h - double(c[d]);
+          wall = std::min({ wall, f * fg.h, (1.0 - f) * fg.h });
+        }
+      wall = std::max(0.0, wall - 1e-6 * fg.h);
       auto consider = [&] (int32_t f)
         {
           if (D.ffrag[f] != F) return;
           if (opposing && !(Dot(&D.fnormal[3*f], &D.vnormal[3*v]) < 0)) return;
+          // a face whose box is farther than the best is not nearer (a margin for rounding
+          // keeps the ties, which go to the smaller face number)
+          double box2 = 0;
+          for (int d = 0; d < 3; d++)
+            {
+              double e = std::max({ D.flo[3*f+d] - p[d], p[d] - D.fhi[3*f+d], 0.0 });
+              box2 += e * e;
+            }
+          if (box2 > best * (1.0 + 1e-9)) return;
           const int32_t * T = m.faces + 3*f;
           const double * a = m.x + 3*T[0], * b = m.x + 3*T[1], * cc = m.x + 3*T[2];
           double bary[3], q[3];
@@ -402,8 +421,10 @@ namespace ngfracture
                 for (int64_t k = c[2]-r; k <= c[2]+r; k += step)
                   fg.Visit(i, j, k, consider);
               }
-          // faces not seen yet lie beyond distance r h
-          if (bf >= 0 && best <= (double(r) * fg.h) * (double(r) * fg.h)) break;
+          // faces not seen yet lie beyond distance r h, and beyond r h + wall (strictly:
+          // no tie with a face not seen)
+          double reach = double(r) * fg.h + wall;
+          if (bf >= 0 && (best <= (double(r) * fg.h) * (double(r) * fg.h) || best < reach * reach)) break;
         }
       return bf;
     }
@@ -466,6 +487,7 @@ namespace ngfracture
         }
     fg.items.clear(); fg.range.clear();
     fg.Build(lo, hi);
+    D.flo = std::move(lo); D.fhi = std::move(hi);
 
     for (size_t s = 0; s < hits.size(); s++)
       {
