@@ -116,7 +116,8 @@ class NodeToFaceRows(RowTable):
         -------
         list of tuple
         """
-        return [("f", s) + tuple(sorted(m)) for s, m in zip(self.slave.tolist(), self.master.tolist())]
+        master = np.sort(self.master, axis=1).tolist()
+        return [("f", s, a, b, c) for s, (a, b, c) in zip(self.slave.tolist(), master)]
 
 
 def no_face_rows(nv):
