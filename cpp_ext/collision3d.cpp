@@ -7,11 +7,11 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
-#include <map>
 #include <stdexcept>
 #include <string>
 #include <tuple>
 #include <unordered_map>
+#include <unordered_set>
 
 namespace ngfracture
 {
@@ -71,10 +71,10 @@ namespace ngfracture
     { r[0] = a[1]*b[2]-a[2]*b[1]; r[1] = a[2]*b[0]-a[0]*b[2]; r[2] = a[0]*b[1]-a[1]*b[0]; }
 
     // p in the closed tetrahedron t (any orientation; false if flat), exactly
-    bool InClosedTet (const double * x, const int32_t * t, const double * p)
+    // p in the closed tetrahedron t whose own orientation sign is s (0: flat, holds nothing)
+    bool InClosedTet (const double * x, const int32_t * t, const double * p, int s)
     {
       const double * v[4] = { x + 3*t[0], x + 3*t[1], x + 3*t[2], x + 3*t[3] };
-      int s = Orient3dSign(v[0], v[1], v[2], v[3]);
       if (s == 0) return false;
       for (int i = 0; i < 4; i++)
         {
@@ -159,6 +159,7 @@ namespace ngfracture
       std::vector<int32_t> vfrag, ffrag, bverts;
       std::vector<double> vnormal, fnormal;
       std::vector<uint8_t> lip;    // the vertex has a copy on its own fragment (a lip of a crack inside it)
+      std::vector<double> flo, fhi;       // boxes of the boundary faces (current positions)
     };
 
     Derived Derive (const TetMesh3 & m)
@@ -175,25 +176,33 @@ namespace ngfracture
                   + " and " + std::to_string(f) + " (fragments must not share vertices)");
             D.vfrag[v] = f;
           }
-      std::map<std::array<int32_t,3>, int32_t> face_of;
+      // a face's fragment is its vertices' (fragments share no vertex); it must be a face
+      // of a tetrahedron: one of the tetrahedra at its first vertex holds all three
+      std::vector<int64_t> start(m.nv + 1, 0), at;
+      for (int64_t t = 0; t < m.ne; t++)
+        for (int k = 0; k < 4; k++) start[m.tets[4*t+k] + 1]++;
+      for (int64_t v = 0; v < m.nv; v++) start[v+1] += start[v];
+      at.resize(start[m.nv]);
+      {
+        std::vector<int64_t> fill(start.begin(), start.end() - 1);
+        for (int64_t t = 0; t < m.ne; t++)
+          for (int k = 0; k < 4; k++) at[fill[m.tets[4*t+k]]++] = t;
+      }
+      D.ffrag.assign(m.nf, -1);
       for (int64_t f = 0; f < m.nf; f++)
         {
-          std::array<int32_t,3> key { m.faces[3*f], m.faces[3*f+1], m.faces[3*f+2] };
-          for (int32_t v : key)
-            if (v < 0 || v >= m.nv) Bad("faces[" + std::to_string(f) + "] holds a vertex out of range");
-          std::sort(key.begin(), key.end());
-          face_of[key] = int32_t(f);
+          const int32_t * F = m.faces + 3*f;
+          for (int k = 0; k < 3; k++)
+            if (F[k] < 0 || F[k] >= m.nv) Bad("faces[" + std::to_string(f) + "] holds a vertex out of range");
+          for (int64_t s = start[F[0]]; s < start[F[0]+1] && D.ffrag[f] < 0; s++)
+            {
+              const int32_t * T = m.tets + 4*at[s];
+              int held = 0;
+              for (int k = 0; k < 3; k++)
+                held += (T[0] == F[k]) + (T[1] == F[k]) + (T[2] == F[k]) + (T[3] == F[k]);
+              if (held == 3 && F[0] != F[1] && F[1] != F[2] && F[0] != F[2]) D.ffrag[f] = m.fragment[at[s]];
+            }
         }
-      D.ffrag.assign(m.nf, -1);
-      static const int opp[4][3] = { {1,2,3}, {0,2,3}, {0,1,3}, {0,1,2} };
-      for (int64_t t = 0; t < m.ne && !face_of.empty(); t++)
-        for (int k = 0; k < 4; k++)
-          {
-            std::array<int32_t,3> key { m.tets[4*t+opp[k][0]], m.tets[4*t+opp[k][1]], m.tets[4*t+opp[k][2]] };
-            std::sort(key.begin(), key.end());
-            auto it = face_of.find(key);
-            if (it != face_of.end()) D.ffrag[it->second] = m.fragment[t];
-          }
       std::vector<uint8_t> onb(m.nv, 0);
       D.vnormal.assign(3*m.nv, 0.0);
       D.fnormal.assign(3*m.nf, 0.0);
@@ -245,17 +254,73 @@ namespace ngfracture
       g.span = int64_t(std::floor(range / g.h)) + 2;
     }
 
+    struct BitsHash
+    {
+      size_t operator() (const std::array<uint64_t,3> & k) const
+      { return size_t(k[0] * 0x9E3779B97F4A7C15ull ^ (k[1] + 0x632BE59BD9B4E019ull) * 0xBF58476D1CE4E5B9ull ^ k[2]); }
+    };
+    std::array<uint64_t,3> Bits (const double * p)
+    {
+      std::array<uint64_t,3> k;
+      std::memcpy(k.data(), p, 3 * sizeof(double));
+      return k;
+    }
+
     using Hit = std::tuple<int32_t,int32_t,int32_t>;   // vertex, fragment, tet
+
+    // The copies of every boundary vertex (bitwise-equal reference points), increasing.
+    struct Copies
+    {
+      std::vector<int32_t> group;          // per vertex: its group, -1 off the boundary
+      std::vector<int64_t> start;          // group g: members[start[g] .. start[g+1])
+      std::vector<int32_t> members;
+
+      // v's first copy on fragment F (-1: none)
+      int32_t Twin (const Derived & D, int32_t v, int32_t F) const
+      {
+        int32_t g = group[v];
+        for (int64_t s = start[g]; s < start[g+1]; s++)
+          if (members[s] != v && D.vfrag[members[s]] == F) return members[s];
+        return -1;
+      }
+    };
+
+    Copies MakeCopies (const TetMesh3 & m, const Derived & D)
+    {
+      std::unordered_map<std::array<uint64_t,3>, int32_t, BitsHash> index;
+      Copies c;
+      c.group.assign(m.nv, -1);
+      std::vector<int64_t> count;
+      for (int32_t v : D.bverts)
+        {
+          auto [it, fresh] = index.try_emplace(Bits(m.X + 3*v), int32_t(count.size()));
+          if (fresh) count.push_back(0);
+          c.group[v] = it->second;
+          count[it->second]++;
+        }
+      c.start.assign(count.size() + 1, 0);
+      for (size_t g = 0; g < count.size(); g++) c.start[g+1] = c.start[g] + count[g];
+      c.members.resize(D.bverts.size());
+      std::vector<int64_t> fill(c.start.begin(), c.start.end() - 1);
+      for (int32_t v : D.bverts) c.members[fill[c.group[v]]++] = v;      // bverts increasing
+      return c;
+    }
 
     // Every (boundary vertex, tetrahedron of another fragment) with the vertex in the
     // closed tetrahedron, and (lip vertex, tetrahedron of its own fragment not at the
-    // vertex): each tetrahedron's box swept over the vertex grid.
-    std::vector<Hit> SweepTets (const TetMesh3 & m, const Derived & D, const HashGrid & g, Collision3Stats & st)
+    // vertex): each tetrahedron's box swept over the vertex grid. A pair whose vertex sits
+    // on its twin of that fragment (a closed seam, or a closed lip) is no hit; the closed
+    // seams met in some closed tetrahedron are counted (their number), each tested until found.
+    std::vector<Hit> SweepTets (const TetMesh3 & m, const Derived & D, const Copies & copies, const HashGrid & g,
+                                Collision3Stats & st)
     {
       std::vector<Hit> hits;
+      std::unordered_set<uint64_t> closed;
       for (int64_t t = 0; t < m.ne; t++)
         {
           const int32_t * T = m.tets + 4*t;
+          const int32_t F = m.fragment[t];
+          int orientation = 2;                              // not computed yet
           double lo[3], hi[3];
           int64_t a[3], b[3];
           for (int d = 0; d < 3; d++)
@@ -271,7 +336,7 @@ namespace ngfracture
                 g.Visit(i, j, k, [&] (int32_t v)
                   {
                     st.box_tests++;
-                    if (D.vfrag[v] == m.fragment[t])
+                    if (D.vfrag[v] == F)
                       {
                         // self-contact across a crack: a lip vertex in a tetrahedron of
                         // its own fragment that is not one of its own
@@ -280,10 +345,19 @@ namespace ngfracture
                     const double * p = m.x + 3*v;
                     for (int d = 0; d < 3; d++)
                       if (p[d] < lo[d] || p[d] > hi[d]) return;
+                    int32_t twin = copies.Twin(D, v, F);
+                    bool seam = twin >= 0 && std::memcmp(p, m.x + 3*twin, 3 * sizeof(double)) == 0;
+                    uint64_t key = (uint64_t(uint32_t(v)) << 32) | uint32_t(F);
+                    if (seam && closed.count(key)) return;
                     st.exact_tests++;
-                    if (InClosedTet(m.x, T, p)) hits.emplace_back(v, m.fragment[t], int32_t(t));
+                    if (orientation == 2)
+                      orientation = Orient3dSign(m.x + 3*T[0], m.x + 3*T[1], m.x + 3*T[2], m.x + 3*T[3]);
+                    if (!InClosedTet(m.x, T, p, orientation)) return;
+                    if (seam) closed.insert(key);
+                    else hits.emplace_back(v, F, int32_t(t));
                   });
         }
+      st.closed_seams = int64_t(closed.size());
       std::sort(hits.begin(), hits.end());
       return hits;
     }
@@ -318,10 +392,28 @@ namespace ngfracture
       int64_t c[3] = { fg.Cell(p[0], 0), fg.Cell(p[1], 1), fg.Cell(p[2], 2) };
       double best = std::numeric_limits<double>::infinity();
       int32_t bf = -1;
+      // the distance from p to the walls of its own cell (less a margin for rounding): after
+      // ring r every face not seen is farther than r h + wall from p
+      double wall = std::numeric_limits<double>::infinity();
+      for (int d = 0; d < 3; d++)
+        {
+          double f = (p[d] - fg.origin[d]) / fg.h - double(c[d]);
+          wall = std::min({ wall, f * fg.h, (1.0 - f) * fg.h });
+        }
+      wall = std::max(0.0, wall - 1e-6 * fg.h);
       auto consider = [&] (int32_t f)
         {
           if (D.ffrag[f] != F) return;
           if (opposing && !(Dot(&D.fnormal[3*f], &D.vnormal[3*v]) < 0)) return;
+          // a face whose box is farther than the best is not nearer (a margin for rounding
+          // keeps the ties, which go to the smaller face number)
+          double box2 = 0;
+          for (int d = 0; d < 3; d++)
+            {
+              double e = std::max({ D.flo[3*f+d] - p[d], p[d] - D.fhi[3*f+d], 0.0 });
+              box2 += e * e;
+            }
+          if (box2 > best * (1.0 + 1e-9)) return;
           const int32_t * T = m.faces + 3*f;
           if (AtVertex(T, v)) return;
           const double * a = m.x + 3*T[0], * b = m.x + 3*T[1], * cc = m.x + 3*T[2];
@@ -341,8 +433,10 @@ namespace ngfracture
                 for (int64_t k = c[2]-r; k <= c[2]+r; k += step)
                   fg.Visit(i, j, k, consider);
               }
-          // faces not seen yet lie beyond distance r h
-          if (bf >= 0 && best <= (double(r) * fg.h) * (double(r) * fg.h)) break;
+          // faces not seen yet lie beyond distance r h, and beyond r h + wall (strictly:
+          // no tie with a face not seen)
+          double reach = double(r) * fg.h + wall;
+          if (bf >= 0 && (best <= (double(r) * fg.h) * (double(r) * fg.h) || best < reach * reach)) break;
         }
       return bf;
     }
@@ -374,17 +468,6 @@ namespace ngfracture
       return true;
     }
 
-    struct BitsHash
-    {
-      size_t operator() (const std::array<uint64_t,3> & k) const
-      { return size_t(k[0] * 0x9E3779B97F4A7C15ull ^ (k[1] + 0x632BE59BD9B4E019ull) * 0xBF58476D1CE4E5B9ull ^ k[2]); }
-    };
-    std::array<uint64_t,3> Bits (const double * p)
-    {
-      std::array<uint64_t,3> k;
-      std::memcpy(k.data(), p, 3 * sizeof(double));
-      return k;
-    }
   }
 
   std::vector<Penetration3> DetectPenetrations3 (const TetMesh3 & m, Collision3Stats * stats)
@@ -402,14 +485,16 @@ namespace ngfracture
       std::copy(m.x + 3*D.bverts[s], m.x + 3*D.bverts[s] + 3, &lo[3*s]);
     vg.Build(lo, lo);
     for (auto & it : vg.items) it = D.bverts[it];        // grid items: vertex numbers
-    std::unordered_map<std::array<uint64_t,3>, std::vector<int32_t>, BitsHash> copies;
-    for (int32_t v : D.bverts) copies[Bits(m.X + 3*v)].push_back(v);
-    D.lip.assign(m.nv, 0);
-    for (const auto & [key, group] : copies)
-      for (size_t i = 0; i < group.size(); i++)
-        for (size_t j = i + 1; j < group.size(); j++)
-          if (D.vfrag[group[i]] == D.vfrag[group[j]]) D.lip[group[i]] = D.lip[group[j]] = 1;
-    std::vector<Hit> hits = SweepTets(m, D, vg, st);
+    Copies copies = MakeCopies(m, D);
+    D.lip.assign(m.nv, 0);           // two copies of a point on one fragment: the lips of a crack inside it
+    for (size_t g = 0; g + 1 < copies.start.size(); g++)
+      for (int64_t i = copies.start[g]; i < copies.start[g+1]; i++)
+        for (int64_t j = i + 1; j < copies.start[g+1]; j++)
+          {
+            int32_t a = copies.members[i], b = copies.members[j];
+            if (D.vfrag[a] == D.vfrag[b]) D.lip[a] = D.lip[b] = 1;
+          }
+    std::vector<Hit> hits = SweepTets(m, D, copies, vg, st);
     if (hits.empty()) { if (stats) *stats = st; return out; }
 
     HashGrid fg = vg;                                    // same cells, boundary faces
@@ -422,17 +507,15 @@ namespace ngfracture
         }
     fg.items.clear(); fg.range.clear();
     fg.Build(lo, hi);
+    D.flo = std::move(lo); D.fhi = std::move(hi);
 
     for (size_t s = 0; s < hits.size(); s++)
       {
         auto [v, F, t] = hits[s];
         if (s > 0 && std::get<0>(hits[s-1]) == v && std::get<1>(hits[s-1]) == F) continue;
         Penetration3 pen;
-        pen.vertex = v; pen.fragment = F; pen.tet = t; pen.twin = -1;
-        for (int32_t w : copies[Bits(m.X + 3*v)])        // increasing: the first twin on F
-          if (w != v && D.vfrag[w] == F) { pen.twin = w; break; }
-        if (pen.twin >= 0 && std::memcmp(m.x + 3*v, m.x + 3*pen.twin, 3 * sizeof(double)) == 0)
-          { st.closed_seams++; continue; }                 // a closed seam: the twins' business
+        pen.vertex = v; pen.fragment = F; pen.tet = t;
+        pen.twin = copies.Twin(D, v, F);                   // closed seams were left out by the sweep
         if (!MasterFace(m, D, fg, v, F, pen)) continue;
         out.push_back(pen);
       }

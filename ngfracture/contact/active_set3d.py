@@ -45,8 +45,8 @@ import numpy as np
 
 from .active_set import ActiveSet, Candidates, refreshed
 from .collision3d import detect_penetrations_3d
-from .rows3d import (NodeToFaceRows, lip_rows, no_face_rows, node_to_face_rows, relinearise_node_to_face,
-                     twin_rows)
+from .rows3d import (NodeToFaceRows, fragment_twin_rows, lip_rows, no_face_rows, node_to_face_rows,
+                     relinearise_node_to_face)
 
 __all__ = ["ActiveSet3d", "fixed_rows_3d"]
 
@@ -82,9 +82,8 @@ def fixed_rows_3d(points, tets, faces, fragment):
     nv = len(points)
     touching = node_to_face_rows(points, faces, detect_penetrations_3d(points, tets, faces, fragment))
     vertex_fragment = _vertex_fragment(nv, tets, fragment)
-    parts = [touching] + [twin_rows(points, faces, vertex_fragment == f) for f in np.unique(fragment)]
-    parts.append(lip_rows(points, faces, vertex_fragment))
-    rows = NodeToFaceRows.stack(parts)
+    rows = NodeToFaceRows.stack([touching, fragment_twin_rows(points, faces, vertex_fragment),
+                                 lip_rows(points, faces, vertex_fragment)])
     keys = rows.keys()
     first = sorted({k: i for i, k in reversed(list(enumerate(keys)))}.values())
     return rows.subset(np.array(first, dtype=np.int64)), [keys[i] for i in first]

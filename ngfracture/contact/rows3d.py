@@ -63,7 +63,7 @@ import scipy.sparse as sp
 
 from .rows import RowTable
 
-__all__ = ["NodeToFaceRows", "no_face_rows", "node_to_face_rows", "twin_rows", "lip_rows", "face_gap_rows",
+__all__ = ["NodeToFaceRows", "no_face_rows", "node_to_face_rows", "twin_rows", "fragment_twin_rows", "lip_rows", "face_gap_rows",
            "relinearise_node_to_face", "nodal_areas", "space_columns_3d"]
 
 @dataclass
@@ -116,7 +116,8 @@ class NodeToFaceRows(RowTable):
         -------
         list of tuple
         """
-        return [("f", s) + tuple(sorted(m)) for s, m in zip(self.slave.tolist(), self.master.tolist())]
+        master = np.sort(self.master, axis=1).tolist()
+        return [("f", s, a, b, c) for s, (a, b, c) in zip(self.slave.tolist(), master)]
 
 
 def no_face_rows(nv):
@@ -302,6 +303,47 @@ def twin_rows(points, faces, slave):
     s, t = _copy_pairs(X, F)
     pick = mask[s] & ~mask[t]
     return _rows_at_copies(X, F, s[pick], t[pick], s[pick])
+
+
+def fragment_twin_rows(points, faces, vertex_fragment):
+    """The twin rows of every fragment's vertices as slaves, all fragments in one pass.
+
+    The rows of ``twin_rows(points, faces, vertex_fragment == f)`` for every fragment f in
+    increasing order, stacked, bit for bit: a slave's twins are the vertices of other
+    fragments at its reference point. One sort of the boundary vertices serves all
+    fragments (a call per fragment sorts them once per fragment).
+
+    Parameters
+    ----------
+    points : array_like, shape (nv, 3)
+        Reference coordinates (copies bitwise equal).
+    faces : array_like of int, shape (nf, 3)
+        Boundary faces, outward.
+    vertex_fragment : array_like of int, shape (nv,)
+        The fragment of every vertex (vertices of one fragment never have twins among
+        themselves).
+
+    Returns
+    -------
+    NodeToFaceRows
+        Sorted by the slave's fragment, then by slave vertex.
+
+    Raises
+    ------
+    ValueError
+        On wrong shapes or vertex numbers out of range.
+    """
+    X = _coordinates(points, "points")
+    nv = len(X)
+    F = np.asarray(faces)
+    F = _vertices(F, "faces", nv, (F.shape[0] if F.ndim == 2 else -1, 3))
+    vf = np.asarray(vertex_fragment)
+    if vf.shape != (nv,) or (vf.size and not np.issubdtype(vf.dtype, np.integer)):
+        raise ValueError(f"vertex_fragment must be integers of shape ({nv},), got {vf.dtype} {vf.shape}")
+    s, t = _copy_pairs(X, F)
+    pick = vf[s] != vf[t]
+    rows = _rows_at_copies(X, F, s[pick], t[pick], s[pick])
+    return rows.subset(np.lexsort((rows.slave, vf[rows.slave])))
 
 
 def lip_rows(points, faces, vertex_fragment):

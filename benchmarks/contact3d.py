@@ -1,0 +1,305 @@
+"""Benchmark of 3D contact work on a fragmented body against one factorisation + solve.
+
+Body (``ngfracture.geometry.pieces.fragmented_box``): the unit cube, ``cells``^3 structured
+cells of 6 tetrahedra, cut by grid planes into ``pieces``^3 blocks (default 4^3 = 64
+fragments, 9 cut planes); every vertex on a cut has one copy per block, bitwise equal, and
+the cut faces are crack lips (boundary ``crack``), as the node splitting leaves them. The
+cube's faces glide (u_n prescribed: a hydrostatic compression e = 1e-3), so the blocks at
+the surface are held and the inner ones float (pins and rigid modes, as a run has them).
+Sizes (``--cells``): 15, 20, 26 cells: 20250, 48000, 105456 tetrahedra.
+
+Configurations. The solution is the hydrostatic compression u = -e x (the P1 solution of
+the closed body, twins staying bitwise together). The prediction, the state a solve's
+first round judges, is that with every block also expanded about its own centroid by
+1 + delta, delta chosen so that two neighbouring blocks overlap by 0.2 h (h = 1 / cells)
+across their common lip: every lip penetrates at every vertex, with junctions of 4 blocks
+along the lines and of 8 where cut planes cross (the 2D benchmark's configuration,
+benchmarks/contact.py). The contact work of a contact solve (``ContactSolver``'s
+"contact" timing: detection, rows, primal-dual choice and redundancy removal, settling) is
+run by the solver's own active set (``ActiveSet3d``) over the two rounds of the shortest
+solve, without the Newton solves between them (their cost is the unit):
+
+  round 1  at the prediction: the fixed rows (the reference detection and the twin rows of
+           every block), the detection and its rows, the primal-dual choice
+           (``independent_rows``: redundancy), and every chosen row recorded as pressing;
+  round 2  at the solution: every candidate re-linearised, the detection (closed lips: no
+           pair), the choice (the set of round 1 again: settled) and the settling (every
+           candidate re-linearised and judged: converged).
+
+A real contact solve has 2 to 10 such rounds (docs/contact.md); the report gives each
+round's seconds, so the work of a longer solve follows. The full ``ContactSolver`` on these
+bodies does not settle (docs/contact.md, "Contact work in 3D"): the rounds of a solve that
+converges are not there to be timed at 100k tetrahedra.
+
+Reported per size (seconds are the best of ``--repeat``):
+
+  tets, vertices, fragments, lip_faces, dofs
+  t_round1, t_round2   the contact work of each round; t_collision the detection within
+                       both; t_rows the rows (fixed rows, found rows, re-linearisation);
+                       t_choice the primal-dual choices (with the QR); t_settle the settling
+  contact_work         t_round1 + t_round2
+  candidates, wanted, active_rows   rows of round 2: candidates, rows the update wants,
+                       independent rows kept (the rows a solve imposes)
+  t_unit               one sparse Cholesky factorisation + solve of the body's linear
+                       elasticity (the fixed dofs eliminated, one pin per free rigid mode of
+                       the floating blocks: what a contact round factorises), one thread,
+                       best of ``--repeat``, measured before and after the contact work
+                       (their mean)
+  ratio                contact_work / t_unit (the issue's target: at most 0.15 at 100k)
+  ratio_per_round      contact_work / 2 / t_unit
+  cpu_contact_work, cpu_t_unit, cpu_ratio   the same in CPU seconds of this process
+                       (``time.process_time``; one thread): on a shared machine the wall
+                       clock also counts the time other jobs take the core, the CPU time not.
+                       The repeat kept is the one of least CPU time
+
+and over the sizes: the least-squares exponents p of value ~ tets^p for contact_work,
+t_unit and ratio (wall and CPU).
+
+``--scene NAME`` runs a registered scene instead (``ngfracture.scenes.SCENES``): at the
+three ``--maxh`` values (default the scene's own maxh times 1, 0.7, 0.5: each about 3 times
+the tetrahedra of the one before) when the scene takes ``maxh``, else once at its defaults.
+Every run is a ``Simulation`` without pictures in a temporary folder; reported are its
+phases (summary.json "timings": "collision", "contact" (the rest of the contact work),
+"solve", wall), t_unit (benchmarks/solid.py ``unit_solve`` of the scene's problem),
+solve_equivalents = wall / t_unit, contact_ratio = (collision + contact) / t_unit, and
+their growth exponents over the sizes.
+
+Usage: PYTHONPATH=. OMP_NUM_THREADS=1 python benchmarks/contact3d.py [--quick]
+       [--cells 15 20 26] [--pieces 4] [--repeat 2] [--scene NAME [--maxh H ...]]
+       [--json FILE [--force]]
+"""
+import argparse
+import inspect
+import json
+import math
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+import benchmark_json
+
+#: cells per edge of the default sizes: 20250, 48000 and 105456 tetrahedra
+DEFAULT_CELLS = [15, 20, 26]
+#: --quick: one small body (a few seconds)
+QUICK_CELLS = [8]
+#: the issue's target: contact work at most this share of one factorisation + solve at 100k
+TARGET_RATIO = 0.15
+#: hydrostatic strain of the glide conditions
+STRAIN = 1e-3
+#: overlap of two neighbouring blocks across their lip, in cells
+OVERLAP = 0.2
+#: --scene: maxh factors of the three sizes
+SCENE_FACTORS = (1.0, 0.7, 0.5)
+
+
+def compressed_body(cells, pieces):
+    """The fragmented cube as an ElasticProblem with glide conditions, and its arrays."""
+    from ngfracture.geometry.pieces import fragmented_box
+    from ngfracture.geometry.solid import solid_mesh
+    from ngfracture.mechanics.materials import LinearElastic
+    from ngfracture.mechanics.problem import ElasticProblem
+    arrays, _ = fragmented_box(cells, pieces)
+    prob = ElasticProblem(solid_mesh(arrays), LinearElastic(E=1.0, nu=0.25))
+    for c in "xyz":
+        prob.add_dirichlet(f"{c}min", 0.0, component=c)
+        prob.add_dirichlet(f"{c}max", -STRAIN, component=c)
+    return prob, arrays
+
+
+def contact_geometry(prob):
+    """The active set's geometry of the problem (as ContactSolver makes it in 3D)."""
+    from ngfracture.contact.active_set import Geometry
+    _, comp = prob.fragments()
+    nv, n = prob.mesh.nv, prob.fes.ndof // 3
+    fixed = prob.assemble_constraints().fixed_dofs
+    v, c = fixed % n, fixed // n
+    return Geometry(arrays=prob.arrays, fragment=comp[prob.arrays.tets[:, 0]], seams=None,
+                    fixed=(c * nv + v)[v < nv], holds=None)
+
+
+def expanded(arrays, fragment, cells, pieces):
+    """Every block expanded about its centroid: neighbours overlap by OVERLAP cells."""
+    X = arrays.points
+    vertex_fragment = np.zeros(len(X), dtype=np.int64)
+    vertex_fragment[arrays.tets.ravel()] = np.repeat(fragment, 4)
+    count = np.bincount(vertex_fragment)
+    centre = np.stack([np.bincount(vertex_fragment, weights=X[:, d]) / count for d in range(3)], axis=1)
+    delta = OVERLAP / cells * pieces          # block size 1 / pieces
+    return delta * (X - centre[vertex_fragment])
+
+
+def no_complementarity(rows, indices):
+    """The complementarity problem is a solve's (its cost is not contact work): not solved."""
+    return None
+
+
+def contact_rounds(geometry, U_predicted, U_solution, penetration_tol):
+    """The contact work of a two-round solve (module docstring): seconds per part and rows."""
+    from ngfracture.contact.active_set3d import ActiveSet3d
+    timings = {"collision": 0.0}
+    parts = dict.fromkeys(("rows", "choice", "settle"), 0.0)
+    active = ActiveSet3d(geometry, penetration_tol)
+    rounds = []
+    for rnd, u in ((1, U_predicted), (2, U_solution)):
+        t0 = time.perf_counter()
+        collision0 = timings["collision"]
+        candidates = active.update(u, timings)
+        t1 = time.perf_counter()
+        want, kept, other = active.primal_dual(candidates)
+        kept, settled = active.choose(candidates, want, kept, rnd, no_complementarity)
+        t2 = time.perf_counter()
+        if settled:
+            active.settle(candidates, other, u)
+        t3 = time.perf_counter()
+        parts["rows"] += (t1 - t0) - (timings["collision"] - collision0)
+        parts["choice"] += t2 - t1
+        parts["settle"] += t3 - t2
+        rounds.append(t3 - t0)
+        # every chosen row presses (a solve's multipliers; the solve itself is not timed)
+        active.record(candidates.keys, kept, -np.ones(len(kept)), 1.0)
+    return {"t_round1": rounds[0], "t_round2": rounds[1], "t_collision": timings["collision"],
+            **{f"t_{k}": v for k, v in parts.items()}, "settled": bool(settled),
+            "candidates": len(candidates.keys), "wanted": int(len(want)), "active_rows": int(len(kept))}
+
+
+def unit_solve(prob, repeat):
+    """Best of ``repeat`` seconds (wall and CPU) of one sparse Cholesky factorisation + solve
+    of the body, and the solver's name."""
+    import ngsolve
+    from ngfracture.linalg.factor import EliminatedFactor
+    from ngfracture.linalg.iterative import problem_inverse
+    rows = prob.assemble_constraints()
+    support = prob.support(rows)
+    prob.form.AssembleLinearization(prob.u.vec)
+    K = prob.form.mat
+    rhs = np.ones(K.height)
+    best, cpu, solver = math.inf, math.inf, None
+    before = ngsolve.GetNumThreads()
+    ngsolve.SetNumThreads(1)
+    try:
+        for _ in range(repeat):
+            t0, c0 = time.perf_counter(), time.process_time()
+            factor = EliminatedFactor(K, rows.fixed_dofs, support.pins, inverse=problem_inverse("auto", 3))
+            factor.factorise()
+            x = factor.solve(rhs)
+            best, cpu = min(best, time.perf_counter() - t0), min(cpu, time.process_time() - c0)
+            solver = factor.inverse
+            assert np.all(np.isfinite(x))
+            del factor
+    finally:
+        ngsolve.SetNumThreads(before)
+    return best, cpu, solver
+
+
+def run_case(cells, pieces, repeat):
+    """One size of the fragmented body: contact work, unit and ratios."""
+    prob, arrays = compressed_body(cells, pieces)
+    geometry = contact_geometry(prob)
+    U = expanded(arrays, geometry.fragment, cells, pieces)
+    t_before, cpu_before, solver = unit_solve(prob, repeat)
+    best = None
+    for _ in range(repeat):
+        solution = -STRAIN * arrays.points
+        c0 = time.process_time()
+        work = contact_rounds(geometry, solution + U, solution, 1e-10 * (1.0 / cells))
+        work["cpu_contact_work"] = time.process_time() - c0
+        work["contact_work"] = work["t_round1"] + work["t_round2"]
+        if best is None or work["cpu_contact_work"] < best["cpu_contact_work"]:
+            best = work
+    t_after, cpu_after, _ = unit_solve(prob, repeat)
+    t_unit, cpu_unit = 0.5 * (t_before + t_after), 0.5 * (cpu_before + cpu_after)
+    lips = int(np.count_nonzero(arrays.face_bc == arrays.bc_names.index("crack") + 1))
+    return {"cells": cells, "pieces": pieces, "tets": len(arrays.tets), "vertices": len(arrays.points),
+            "fragments": int(prob.fragments()[0]), "lip_faces": lips, "dofs": 3 * len(arrays.points), **best,
+            "t_unit": t_unit, "t_unit_before": t_before, "t_unit_after": t_after, "solver": solver,
+            "ratio": best["contact_work"] / t_unit, "ratio_per_round": best["contact_work"] / 2 / t_unit,
+            "cpu_t_unit": cpu_unit, "cpu_ratio": best["cpu_contact_work"] / cpu_unit}
+
+
+def exponents(cases, keys):
+    """Least-squares exponents p of value ~ tets^p (None with fewer than two sizes)."""
+    if len({c["tets"] for c in cases}) < 2:
+        return None
+    logn = np.log([c["tets"] for c in cases])
+    return {"tets": [c["tets"] for c in cases],
+            **{f"{k}_exponent": float(np.polyfit(logn, np.log([max(c[k], 1e-300) for c in cases]), 1)[0])
+               for k in keys}}
+
+
+def scene_sizes(name, maxh):
+    """The keyword arguments of every size of a registered scene: maxh values, or none."""
+    from ngfracture import scenes
+    if name not in scenes.SCENES:
+        raise ValueError(f"unknown scene {name!r}; registered: {', '.join(sorted(scenes.SCENES))}")
+    parameter = inspect.signature(scenes.SCENES[name]).parameters.get("maxh")
+    if parameter is None:
+        if maxh:
+            raise ValueError(f"scene {name!r} takes no maxh")
+        return [{}]
+    if maxh:
+        return [{"maxh": h} for h in maxh]
+    if not isinstance(parameter.default, (int, float)):
+        raise ValueError(f"scene {name!r} has no default maxh: give --maxh")
+    return [{"maxh": parameter.default * f} for f in SCENE_FACTORS]
+
+
+def run_scene(name, kwargs, repeat):
+    """One run of a registered scene: its contact phases, wall and unit."""
+    from ngfracture import Simulation, scenes
+    sys.path.insert(0, str(__import__("pathlib").Path(__file__).parent))
+    import solid
+    scene = scenes.SCENES[name](**kwargs)
+    t_before, solver = solid.unit_solve(scene, repeat=repeat)
+    with tempfile.TemporaryDirectory() as out:
+        result = Simulation(scene, out=out, pictures="none").run()
+    t_after, _ = solid.unit_solve(scene, repeat=repeat)
+    t_unit = 0.5 * (t_before + t_after)
+    timings = result.summary["timings"]
+    contact = timings["collision"] + timings["contact"]
+    return {"scene": name, **kwargs, "tets": scene.mesh.ne, "vertices": scene.mesh.nv, "reason": result.reason,
+            "steps": result.summary["n_steps"], "collision": timings["collision"], "contact": timings["contact"],
+            "solve": timings["solve"], "wall": timings["wall"], "t_unit": t_unit, "solver": solver,
+            "solve_equivalents": timings["wall"] / t_unit, "contact_ratio": contact / t_unit}
+
+
+def main(argv=None):
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--cells", nargs="+", type=int, default=None, help=f"cells per edge (default {DEFAULT_CELLS})")
+    p.add_argument("--pieces", type=int, default=4, help="blocks per edge (default 4: 64 fragments)")
+    p.add_argument("--repeat", type=int, default=2, help="best of this many (default 2)")
+    p.add_argument("--quick", action="store_true", help=f"one small body ({QUICK_CELLS[0]} cells per edge)")
+    p.add_argument("--scene", help="run this registered scene instead (at three --maxh if it takes maxh)")
+    p.add_argument("--maxh", nargs="+", type=float, default=None, help="the scene's sizes (with --scene)")
+    benchmark_json.add_options(p)
+    args = p.parse_args(argv)
+    if args.repeat < 1:
+        p.error("--repeat must be at least 1")
+    benchmark_json.refuse_existing(p, args)
+    if args.scene is not None:
+        try:
+            sizes = scene_sizes(args.scene, args.maxh)
+        except ValueError as exc:
+            p.error(str(exc))
+        cases = []
+        for kwargs in sizes:
+            cases.append(run_scene(args.scene, kwargs, args.repeat))
+            print(json.dumps(cases[-1]), file=sys.stderr, flush=True)
+        growth = exponents(cases, ("wall", "t_unit", "solve_equivalents", "contact_ratio"))
+        benchmark_json.write(args, {"scene": args.scene, "cases": cases, "growth": growth})
+        return 0
+    cells = args.cells or (QUICK_CELLS if args.quick else DEFAULT_CELLS)
+    cases = []
+    for n in cells:
+        cases.append(run_case(n, args.pieces, args.repeat))
+        print(json.dumps(cases[-1]), file=sys.stderr, flush=True)
+    growth = exponents(cases, ("contact_work", "t_unit", "ratio", "cpu_contact_work", "cpu_t_unit", "cpu_ratio"))
+    near = min(cases, key=lambda c: abs(math.log(c["tets"] / 1e5)))
+    target = {"target": TARGET_RATIO, "tets": near["tets"], "ratio": near["ratio"], "cpu_ratio": near["cpu_ratio"]}
+    benchmark_json.write(args, {"cases": cases, "growth": growth, "target_at_100k": target})
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
