@@ -39,7 +39,7 @@ from ..run.scene import Scene
 from .common import CORE_INNER, GLASS, HOLE, positive
 from .solids import FRONT_CONTROL
 
-__all__ = ["SPHERE_LOAD", "SPHERE_RADIUS", "SPHERE_FREE_RADIUS", "cored_sphere_mesh", "shells_exact",
+__all__ = ["SPHERE_LOAD", "SPHERE_RADIUS", "SPHERE_FREE_RADIUS", "SPHERE_CONTROL", "cored_sphere_mesh", "shells_exact",
            "sphere_first_crack", "sphere3d", "sphere3d_free"]
 
 #: the load parameter of the sphere scenes
@@ -51,6 +51,10 @@ SPHERE_FREE_RADIUS = 0.2
 #: the core's copies of the interface vertices are moved towards the centre by this fraction
 #: of their radius (module docstring: why the two surfaces are not bitwise twins)
 INTERFACE_GAP = 0.0
+#: the step control of the sphere scenes: the 3D fronts' spread passes, and a step is cut when its
+#: first pass splits more than 8 vertices (the 2D disk's number): the hole is stressed alike
+#: all round, and a step past the first crack would crack all of it at once
+SPHERE_CONTROL = {**FRONT_CONTROL, "max_new_cracks": 8}
 #: the outward faces of a positively oriented tetrahedron (0, 1, 2, 3)
 TET_FACES = np.array([[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]])
 
@@ -297,7 +301,7 @@ def sphere3d(maxh=0.25, fine=None, band=None, expansion=None, dx=None, core_stif
     strength, strength_parameters = scene_strength(mesh, ["glass"], c, weibull_m, weibull_scale, weibull_area, seed)
     return Scene(name=name, mesh=mesh, material={"glass": glass, "core": core}, critical={"glass": c},
                  apply_load=apply_load, load_max=expansion, dx=dx, contact_tol=1e-3 * fine, contact=True,
-                 radius=radius, load_description=SPHERE_LOAD, control=FRONT_CONTROL,
+                 radius=radius, load_description=SPHERE_LOAD, control=SPHERE_CONTROL,
                  fix_free_modes=True if confined else "all",
                  parameters={"maxh": maxh, "fine": fine, "band": band, "expansion": expansion, "dx": dx,
                              "critical": c, "confined": confined, "radius": radius, "first_crack_exact": x_c,
