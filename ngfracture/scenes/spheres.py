@@ -243,10 +243,8 @@ def sphere3d(maxh=0.25, fine=None, band=None, expansion=None, dx=None, core_stif
     shell (radii 0.125 to 0.25) is ``core_stiffness`` times as stiff and never cracks. The
     core's inner surface moves radially outward by x; frictionless contact passes the
     expansion on to the glass, whose outer surface is held (a rigid shell) when
-    ``confined``. Radial crack surfaces are to grow from the hole and stop inside the sphere;
-    at present the first cracked step fails the overlap invariant (docs/solid.md, "The
-    sphere scenes"). The interface sticks tangentially where the hole is uncracked
-    (:func:`stick_rows`).
+    ``confined``; the interface sticks tangentially (:func:`stick_rows`). Radial cracks are
+    to grow from the hole; the first cracked step fails (docs/solid.md, "The sphere scenes").
 
     Parameters
     ----------
