@@ -18,19 +18,24 @@ Candidates, each identified by its key ("f", slave, master vertices sorted):
     by rounding of a solve (1e-18 on the patch test's perimeter) and would be lost, but in
     the reference configuration touching is exact. A length threshold would instead add
     rows for vertices near but off a face, whose rows then fail the patch test;
-  * twin rows (:func:`~ngfracture.contact.rows3d.twin_rows`), for every vertex that has a
-    copy on another fragment at the bitwise-equal reference point: the corners of a common
-    face of two bodies meshed apart, and the coincident lips of cracks. They are the 3D
-    form of the 2D seam rows: the detection leaves closed seams out (their master face
-    would depend on rounding), and with a row identified by its key the candidate set of
-    a seam is the same in every round;
+  * twin rows (:func:`~ngfracture.contact.junctions3d.fragment_pair_rows`), for every vertex
+    that has a copy on another fragment at the bitwise-equal reference point: across the
+    matched faces of coincident lips one row per (copy, neighbouring fragment), one
+    direction per pair of fragments, so that a junction of several fragments gets a row
+    towards each face neighbour; the corners of a common face of two bodies meshed apart
+    (no matched face) get the rows of :func:`~ngfracture.contact.rows3d.fragment_twin_rows`.
+    They are the 3D form of the 2D seam rows: the detection leaves closed seams out (their
+    master face would depend on rounding), and with a row identified by its key the
+    candidate set of a seam is the same in every round;
   * lip rows (:func:`~ngfracture.contact.rows3d.lip_rows`), one per pair of copies on one
     fragment: the two lips of a crack that does not cut its fragment through;
 
 - *found* rows: the pairs the detection finds at the configuration of the last solve
   (touching or penetrating), in two passes (every boundary vertex of every fragment a
   slave: the pass that passes the patch test, rows3d's docstring). A found pair whose
-  vertex has a twin on the master fragment talks to it through its twin row only; a lip
+  vertex has a twin row to the master fragment (either copy the slave:
+  :func:`~ngfracture.contact.junctions3d.covered_pairs`) talks to it through that row only
+  (a diagonal neighbour at a junction has none, and its overlap is a found row); a lip
   vertex found in its own fragment, through the lip row of its pair of copies. A found
   row stays a candidate while it is active or found again, as in 2D.
 
@@ -45,8 +50,8 @@ import numpy as np
 
 from .active_set import ActiveSet, Candidates, refreshed
 from .collision3d import detect_penetrations_3d
-from .rows3d import (NodeToFaceRows, fragment_twin_rows, lip_rows, no_face_rows, node_to_face_rows,
-                     relinearise_node_to_face)
+from .junctions3d import covered_pairs, fragment_pair_rows
+from .rows3d import NodeToFaceRows, lip_rows, no_face_rows, node_to_face_rows, relinearise_node_to_face
 
 __all__ = ["ActiveSet3d", "fixed_rows_3d"]
 
@@ -82,7 +87,7 @@ def fixed_rows_3d(points, tets, faces, fragment):
     nv = len(points)
     touching = node_to_face_rows(points, faces, detect_penetrations_3d(points, tets, faces, fragment))
     vertex_fragment = _vertex_fragment(nv, tets, fragment)
-    rows = NodeToFaceRows.stack([touching, fragment_twin_rows(points, faces, vertex_fragment),
+    rows = NodeToFaceRows.stack([touching, fragment_pair_rows(points, faces, vertex_fragment),
                                  lip_rows(points, faces, vertex_fragment)])
     keys = rows.keys()
     first = sorted({k: i for i, k in reversed(list(enumerate(keys)))}.values())
@@ -117,6 +122,7 @@ class ActiveSet3d(ActiveSet):
         super().__init__(geometry, 0.0, penetration_tol, **options)
         self.n2s = no_face_rows(len(geometry.arrays.points))
         self.vertex_fragment = None
+        self.covered = set()                    # (vertex, fragment) pairs a fixed row covers
 
     def update(self, U, timings):
         """The candidate rows at X + U, the configuration of the last solve.
@@ -143,6 +149,7 @@ class ActiveSet3d(ActiveSet):
             self.seam_rows, self.seam_keys = fixed_rows_3d(a.points, a.tets, a.faces, self.geometry.fragment)
             timings["collision"] += time.perf_counter() - t0
             self.vertex_fragment = _vertex_fragment(len(a.points), a.tets, self.geometry.fragment)
+            self.covered = covered_pairs(a.points, self.seam_rows, self.vertex_fragment)
         elif self.moving:
             old = NodeToFaceRows.stack([self.seam_rows, self.n2s])
             relinearised = relinearise_node_to_face(old, a.points, U)
@@ -177,7 +184,7 @@ class ActiveSet3d(ActiveSet):
         twin = np.asarray(pen.twin, dtype=np.int64)
         keep = twin < 0
         if not keep.all():
-            covered = {(k[1], int(self.vertex_fragment[k[2]])) for k in self.seam_keys}
+            covered = self.covered
             own = pen.fragment == self.vertex_fragment[pen.vertex]
             keep |= ~own & np.array([(int(v), int(f)) not in covered
                                      for v, f in zip(pen.vertex.tolist(), pen.fragment.tolist())], dtype=bool)
