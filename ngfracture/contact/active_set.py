@@ -367,9 +367,10 @@ class ActiveSet:
         self.warm = set()        # a warm row that the solve releases is judged like any other
         want = np.flatnonzero(want)
         kept = self._independent(candidates.rows, want)
-        dependent = np.setdiff1d(want, kept)
-        other = np.setdiff1d(np.arange(len(candidates.keys)), dependent)
-        return want, kept, other
+        dependent = np.zeros(len(candidates.keys), dtype=bool)
+        dependent[want] = True
+        dependent[kept] = False
+        return want, kept, np.flatnonzero(~dependent)
 
     def choose(self, candidates, want, kept, round_number, complementarity):
         """The rows to impose next, and whether they are the set of the last solve.
@@ -399,11 +400,12 @@ class ActiveSet:
             True if they are the rows imposed in the last solve.
         """
         codes = self._codes(candidates.keys)
-        settled = self.solved and np.array_equal(np.unique(codes[kept]), self._mult_codes)
+        kept_codes = np.unique(codes[kept])
+        settled = self.solved and np.array_equal(kept_codes, self._mult_codes)
         if self.moving and not settled:
             self.last_penetration = np.inf     # the contraction is judged at one set only
         if not settled and (self.exact or round_number > self.pdas_rounds
-                            or np.unique(codes[kept]).tobytes() in self.imposed):
+                            or kept_codes.tobytes() in self.imposed):
             self.exact = True
             # candidates: the rows the update wants and every row imposed before
             tried = np.flatnonzero(np.isin(codes, self.tried))
@@ -413,9 +415,9 @@ class ActiveSet:
                 # would make the system singular
                 choice = self._independent(candidates.rows, closed)
                 if not np.array_equal(np.unique(codes[choice]), self._mult_codes):
-                    kept = choice
-        self.imposed.add(np.unique(codes[kept]).tobytes())
-        self.tried = np.union1d(self.tried, codes[kept])
+                    kept, kept_codes = choice, np.unique(codes[choice])
+        self.imposed.add(kept_codes.tobytes())
+        self.tried = np.union1d(self.tried, kept_codes)
         return kept, settled
 
     def settle(self, candidates, other, U):

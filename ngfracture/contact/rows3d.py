@@ -407,7 +407,7 @@ def lip_rows(points, faces, vertex_fragment):
 
 def _copy_pairs(X, F):
     """Every ordered pair (s, t) of boundary vertices at the bitwise-equal reference point, s == t included."""
-    on = np.unique(F)
+    on = np.flatnonzero(np.bincount(F.ravel(), minlength=len(X)))        # the boundary vertices, increasing
     P = X[on]
     order = np.lexsort((P[:, 2], P[:, 1], P[:, 0]))                     # equal points together, stable
     on, P = on[order], P[order]
