@@ -301,6 +301,35 @@ namespace ngfracture
 
     using Hit = std::tuple<int32_t,int32_t,int32_t>;   // vertex, fragment, tet
 
+    // The pairs (vertex, fragment) decided in a sweep: up to four fragments per vertex in
+    // place (filled in order), more in a hash set.
+    class Decided
+    {
+      static constexpr int32_t kFree = std::numeric_limits<int32_t>::min();
+      std::vector<std::array<int32_t,4>> slot_;
+      std::unordered_set<uint64_t> more_;
+      static uint64_t Key (int32_t v, int32_t F) { return (uint64_t(uint32_t(v)) << 32) | uint32_t(F); }
+    public:
+      explicit Decided (int64_t nv) : slot_(size_t(nv), { kFree, kFree, kFree, kFree }) { }
+      bool Has (int32_t v, int32_t F) const
+      {
+        const auto & s = slot_[v];
+        for (int i = 0; i < 4; i++)
+          {
+            if (s[i] == F) return true;
+            if (s[i] == kFree) return false;
+          }
+        return more_.count(Key(v, F)) > 0;
+      }
+      void Insert (int32_t v, int32_t F)        // (v, F) not in the set
+      {
+        auto & s = slot_[v];
+        for (int i = 0; i < 4; i++)
+          if (s[i] == kFree) { s[i] = F; return; }
+        more_.insert(Key(v, F));
+      }
+    };
+
     // The copies of every boundary vertex (bitwise-equal reference points), increasing.
     struct Copies
     {
@@ -341,16 +370,17 @@ namespace ngfracture
 
     // Every (boundary vertex, tetrahedron of another fragment) with the vertex in the
     // closed tetrahedron, and (lip vertex, tetrahedron of its own fragment not at the
-    // vertex): each tetrahedron's box swept over the vertex grid. A pair whose vertex sits
-    // on its twin of that fragment (a closed seam, or a closed lip) is no hit; the closed
-    // seams met in some closed tetrahedron are counted (their number), each tested until found.
-    // The tetrahedra are swept in increasing order, so a pair found in one is decided: its
-    // first hit is the smallest tetrahedron, and later tetrahedra of its fragment are not tested.
+    // vertex): each tetrahedron's box swept over the vertex grid. A pair found in a
+    // tetrahedron is decided and not tested again: a pair whose vertex sits on its twin of
+    // that fragment (a closed seam, or a closed lip) is no hit, only counted; any other is
+    // a hit in that tetrahedron, the smallest that holds it (the sweep goes in increasing
+    // order). The twin is looked up only for a pair found.
     std::vector<Hit> SweepTets (const TetMesh3 & m, const Derived & D, const Copies & copies, const HashGrid & g,
                                 Collision3Stats & st)
     {
       std::vector<Hit> hits;
-      std::unordered_set<uint64_t> closed, found;
+      Decided decided(m.nv);
+      int64_t closed = 0;
       for (int64_t t = 0; t < m.ne; t++)
         {
           const int32_t * T = m.tets + 4*t;
@@ -380,19 +410,19 @@ namespace ngfracture
                     const double * p = m.x + 3*v;
                     for (int d = 0; d < 3; d++)
                       if (p[d] < lo[d] || p[d] > hi[d]) return;
-                    int32_t twin = copies.Twin(D, v, F);
-                    bool seam = twin >= 0 && std::memcmp(p, m.x + 3*twin, 3 * sizeof(double)) == 0;
-                    uint64_t key = (uint64_t(uint32_t(v)) << 32) | uint32_t(F);
-                    if (seam ? closed.count(key) : found.count(key)) return;
+                    if (decided.Has(v, F)) return;
                     st.exact_tests++;
                     if (orientation == 2)
                       orientation = Orient3dSign(m.x + 3*T[0], m.x + 3*T[1], m.x + 3*T[2], m.x + 3*T[3]);
                     if (!InClosedTet(m.x, T, p, orientation)) return;
-                    if (seam) closed.insert(key);
-                    else { found.insert(key); hits.emplace_back(v, F, int32_t(t)); }
+                    decided.Insert(v, F);
+                    int32_t twin = copies.Twin(D, v, F);
+                    bool seam = twin >= 0 && std::memcmp(p, m.x + 3*twin, 3 * sizeof(double)) == 0;
+                    if (seam) closed++;
+                    else hits.emplace_back(v, F, int32_t(t));
                   });
         }
-      st.closed_seams = int64_t(closed.size());
+      st.closed_seams = closed;
       std::sort(hits.begin(), hits.end());
       return hits;
     }
