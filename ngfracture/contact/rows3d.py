@@ -143,6 +143,17 @@ def _gap_matrix(slave, master, bary, normal, nv):
     m = len(slave)
     w = np.concatenate([np.ones((m, 1)), -bary], axis=1)                  # weights of s, i, j, k
     verts = np.concatenate([slave[:, None], master], axis=1).astype(np.int64)
+    order = np.argsort(verts, axis=1, kind="stable")
+    vs = np.take_along_axis(verts, order, axis=1)
+    if not np.any(vs[:, 1:] == vs[:, :-1]) and 3 * nv < 2 ** 31 and 12 * m < 2 ** 31:
+        # four distinct vertices per row (no duplicate to sum): the CSR arrays directly,
+        # columns sorted within each row, as the conversion from coordinates makes them
+        ws = np.take_along_axis(w, order, axis=1)
+        cols = np.concatenate([vs + comp * nv for comp in range(3)], axis=1).ravel().astype(np.int32)
+        vals = np.concatenate([ws * normal[:, comp:comp + 1] for comp in range(3)], axis=1).ravel()
+        C = sp.csr_matrix((vals, cols, np.arange(0, 12 * m + 1, 12, dtype=np.int32)), shape=(m, 3 * nv))
+        C.eliminate_zeros()
+        return C
     rows = np.repeat(np.arange(m), 12)
     cols = np.concatenate([verts + comp * nv for comp in range(3)], axis=1).ravel()
     vals = np.concatenate([w * normal[:, comp:comp + 1] for comp in range(3)], axis=1).ravel()
@@ -396,7 +407,7 @@ def lip_rows(points, faces, vertex_fragment):
 
 def _copy_pairs(X, F):
     """Every ordered pair (s, t) of boundary vertices at the bitwise-equal reference point, s == t included."""
-    on = np.unique(F)
+    on = np.flatnonzero(np.bincount(F.ravel(), minlength=len(X)))        # the boundary vertices, increasing
     P = X[on]
     order = np.lexsort((P[:, 2], P[:, 1], P[:, 0]))                     # equal points together, stable
     on, P = on[order], P[order]
@@ -410,11 +421,14 @@ def _copy_pairs(X, F):
 def _rows_at_copies(X, F, s, t, per):
     """Rows of slaves s on the face at their copy t opposing s's normal most, one per value of ``per``."""
     nv = len(X)
+    if not len(s):
+        return no_face_rows(nv)
     p = X[F]
     area2 = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
     unit = area2 / np.linalg.norm(area2, axis=1)[:, None]
-    vnormal = np.zeros((nv, 3))
-    np.add.at(vnormal, F.ravel(), np.repeat(area2, 3, axis=0))
+    # the faces' area normals summed at their vertices, in face order (as np.add.at sums)
+    vnormal = np.stack([np.bincount(F.ravel(), weights=np.repeat(area2[:, d], 3), minlength=nv)
+                        for d in range(3)], axis=1)
     # candidate faces: every face at the copy
     inc = np.argsort(F.ravel(), kind="stable")
     start = np.searchsorted(F.ravel()[inc], t)
