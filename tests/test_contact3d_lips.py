@@ -28,6 +28,7 @@ are not cracked) left whole. Both lips are on one fragment, so only the lip rows
    once cracked) breaks in two with the steps, split vertices and crack faces of a run
    without, the displacements equal to 1e-8 (slow: two runs, about 20 s).
 """
+import dataclasses
 import math
 
 import numpy as np
@@ -275,7 +276,7 @@ def test_inclined_crack_slides_without_penetration():
 
 def bar_run(tmp_path, contact):
     """The smallest bar3d that breaks across its notch (benchmarks/solid.py --quick sizes)."""
-    scene = nf.scenes.bar3d(maxh=0.4, fine=0.1, radius=0.2, thickness=0.25)
+    scene = dataclasses.replace(nf.scenes.bar3d(maxh=0.4, fine=0.1, radius=0.2, thickness=0.25), contact=True)
     result = nf.Simulation(scene, out=tmp_path / contact, pictures="none", contact=contact).run()
     a = result.problem.arrays
     C = crack_faces(a)
