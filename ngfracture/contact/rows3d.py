@@ -61,6 +61,7 @@ from typing import ClassVar
 import numpy as np
 import scipy.sparse as sp
 
+from .junction3d import KINK, partner_faces, point_groups
 from .rows import RowTable
 
 __all__ = ["NodeToFaceRows", "no_face_rows", "node_to_face_rows", "twin_rows", "fragment_twin_rows", "lip_rows", "face_gap_rows",
@@ -302,7 +303,8 @@ def twin_rows(points, faces, slave):
         raise ValueError(f"slave must be a boolean mask of shape ({nv},), got {mask.dtype} {mask.shape}")
     s, t = _copy_pairs(X, F)
     pick = mask[s] & ~mask[t]
-    return _rows_at_copies(X, F, s[pick], t[pick], s[pick])
+    rows = _with_junction_rows(X, F, _rows_at_copies(X, F, s[pick], t[pick], s[pick]), s[pick], t[pick], False)
+    return rows.subset(np.lexsort((rows.face, rows.slave)))
 
 
 def fragment_twin_rows(points, faces, vertex_fragment):
@@ -342,8 +344,8 @@ def fragment_twin_rows(points, faces, vertex_fragment):
         raise ValueError(f"vertex_fragment must be integers of shape ({nv},), got {vf.dtype} {vf.shape}")
     s, t = _copy_pairs(X, F)
     pick = vf[s] != vf[t]
-    rows = _rows_at_copies(X, F, s[pick], t[pick], s[pick])
-    return rows.subset(np.lexsort((rows.slave, vf[rows.slave])))
+    rows = _with_junction_rows(X, F, _rows_at_copies(X, F, s[pick], t[pick], s[pick]), s[pick], t[pick], False)
+    return rows.subset(np.lexsort((rows.face, rows.slave, vf[rows.slave])))
 
 
 def lip_rows(points, faces, vertex_fragment):
@@ -391,16 +393,14 @@ def lip_rows(points, faces, vertex_fragment):
     s, t = _copy_pairs(X, F)
     pick = (frag[s] == frag[t]) & (s > t)
     s, t = s[pick], t[pick]
-    return _rows_at_copies(X, F, s, t, s * nv + t)
+    rows = _with_junction_rows(X, F, _rows_at_copies(X, F, s, t, s * nv + t), s, t, True)
+    copy = rows.master[np.arange(len(rows)), np.argmax(rows.bary, axis=1)] if len(rows) else rows.slave
+    return rows.subset(np.lexsort((rows.face, copy, rows.slave)))
 
 
 def _copy_pairs(X, F):
     """Every ordered pair (s, t) of boundary vertices at the bitwise-equal reference point, s == t included."""
-    on = np.unique(F)
-    P = X[on]
-    order = np.lexsort((P[:, 2], P[:, 1], P[:, 0]))                     # equal points together, stable
-    on, P = on[order], P[order]
-    group = np.cumsum(np.r_[False, np.any(P[1:] != P[:-1], axis=1)])
+    on, group = point_groups(X, F)
     first = np.searchsorted(group, group)                                  # start of each vertex's group
     size = np.searchsorted(group, group, side="right") - first
     who, other = _ranges(first, size)
@@ -434,6 +434,27 @@ def _rows_at_copies(X, F, s, t, per):
     master, normal = F[face], unit[face]
     g = _gap_offset(X, s, master, bary, normal)
     return NodeToFaceRows(slave=s, master=master, face=face, bary=bary, normal=normal, dist=g.copy(), g=g, nv=nv)
+
+
+def _with_junction_rows(X, F, rows, s, t, lips):
+    """``rows`` and rows on the partner faces of :func:`~ngfracture.contact.junction3d.partner_faces` it lacks."""
+    slave, face, k = partner_faces(X, F, s, t, all_pairs=lips)
+    bary = np.zeros((len(slave), 3))
+    bary[np.arange(len(slave)), k] = 1.0
+    p = X[F[face]]
+    area2 = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+    normal = area2 / np.linalg.norm(area2, axis=1)[:, None]
+    keep = ~np.isin(slave * len(F) + face, rows.slave * len(F) + rows.face)
+    if lips and len(rows):        # only faces at a kink against the pair's row (junction3d.KINK)
+        pair = rows.slave * len(X) + rows.master[np.arange(len(rows)), np.argmax(rows.bary, axis=1)]
+        want = slave * len(X) + F[face, k]
+        own = np.minimum(np.searchsorted(pair, want), len(rows) - 1)        # rows are sorted by pair
+        keep &= (pair[own] != want) | (1.0 - np.einsum("ij,ij->i", normal, rows.normal[own]) > KINK)
+    slave, face, bary, normal = slave[keep], face[keep], bary[keep], normal[keep]
+    g = _gap_offset(X, slave, F[face], bary, normal)
+    extra = NodeToFaceRows(slave=slave, master=F[face], face=face, bary=bary, normal=normal, dist=g.copy(), g=g,
+                           nv=len(X))
+    return NodeToFaceRows.stack([rows, extra])
 
 
 def _ranges(start, count):
