@@ -25,7 +25,9 @@ Candidates, each identified by its key ("f", slave, master vertices sorted):
     would depend on rounding), and with a row identified by its key the candidate set of
     a seam is the same in every round;
   * lip rows (:func:`~ngfracture.contact.rows3d.lip_rows`), one per pair of copies on one
-    fragment: the two lips of a crack that does not cut its fragment through;
+    fragment: the two lips of a crack that does not cut its fragment through; both kinds
+    with the junction rows (:mod:`~ngfracture.contact.junction3d`) where the surface at the
+    copy is not one plane;
 
 - *found* rows: the pairs the detection finds at the configuration of the last solve
   (touching or penetrating), in two passes (every boundary vertex of every fragment a

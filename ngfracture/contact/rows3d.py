@@ -44,6 +44,9 @@ Vertices whose copy on the other fragment sits at the same reference point (corn
 common face of two bodies meshed apart, closed seams of a crack) are left out by the
 detection; :func:`twin_rows` gives them a node-to-face row on a face at the twin. Rows of
 both passes at such a twin are the same row reversed, and the redundancy removal keeps one.
+Where the surface at the copy is not one plane (a point with three or more copies, a kinked
+crack lip) a slave also gets a row on every coincident face at the copy (junction rows,
+:mod:`ngfracture.contact.junction3d`).
 The tributary area of a node, by which a force is a pressure, is the consistent nodal area
 of the surface: the integral of its hat function, a third of the area of every face at
 the node (:func:`nodal_areas`).
@@ -273,6 +276,8 @@ def twin_rows(points, faces, slave):
     area-weighted sum of the normals of its own boundary faces), with the projection at t
     (barycentric 1 there): at a flat interface the interface's normal. Slaves whose faces at
     the twin all face along their normal (dot >= 0) get no row. Ties go to the smaller face.
+    At points with three or more copies, s > t also gets a row on every face at t coincident
+    with a face at s (:func:`~ngfracture.contact.junction3d.partner_faces`).
 
     Parameters
     ----------
@@ -287,7 +292,7 @@ def twin_rows(points, faces, slave):
     Returns
     -------
     NodeToFaceRows
-        Sorted by slave vertex; ``dist`` is the gap at the reference configuration (0).
+        Sorted by slave vertex, then face; ``dist`` is the gap at the reference configuration (0).
 
     Raises
     ------
@@ -328,7 +333,7 @@ def fragment_twin_rows(points, faces, vertex_fragment):
     Returns
     -------
     NodeToFaceRows
-        Sorted by the slave's fragment, then by slave vertex.
+        Sorted by the slave's fragment, then by slave vertex, then face.
 
     Raises
     ------
@@ -361,7 +366,9 @@ def lip_rows(points, faces, vertex_fragment):
     the same row only while the two faces stay parallel; once the lips deform their
     normals differ, the pair of rows is no longer dependent and imposed together they
     block the slip between the copies. At a junction of three or more copies every pair
-    has its row.
+    has its row. Where the crack surface is kinked, s also gets a row on every face at t
+    coincident with a face at s whose normal differs from the row's by more than
+    :data:`~ngfracture.contact.junction3d.KINK`.
 
     Parameters
     ----------
@@ -375,7 +382,7 @@ def lip_rows(points, faces, vertex_fragment):
     Returns
     -------
     NodeToFaceRows
-        Sorted by (slave, copy), the slave the higher-numbered copy; ``dist`` is the gap at
+        Sorted by (slave, copy, face), the slave the higher-numbered copy; ``dist`` is the gap at
         the reference configuration (0).
 
     Raises
