@@ -17,33 +17,60 @@ namespace ngfracture
 {
   namespace
   {
-    // A hashed uniform grid: items sorted by cell key, each occupied cell a range.
+    // A uniform grid: items sorted by cell key, each occupied cell a range. Up to
+    // kDenseCells cells the ranges are an array over all cells (a lookup is an index),
+    // beyond that a hash map of the occupied cells.
+    constexpr int64_t kDenseCells = int64_t(1) << 22;
     struct HashGrid
     {
       double origin[3], h;
       int64_t span;                                   // cells per axis that may be occupied
       std::vector<int32_t> items;
       std::unordered_map<uint64_t, std::pair<int32_t,int32_t>> range;
+      std::vector<int32_t> first;                     // dense: cell c holds items[first[c] .. first[c+1])
+
+      bool Dense () const { return span <= 161 && span * span * span <= kDenseCells; }
+      int64_t Linear (int64_t i, int64_t j, int64_t k) const { return (i * span + j) * span + k; }
 
       int64_t Cell (double v, int d) const { return int64_t(std::floor((v - origin[d]) / h)); }
       static uint64_t Key (int64_t i, int64_t j, int64_t k)
       { return (uint64_t(i) << 42) | (uint64_t(j) << 21) | uint64_t(k); }
       bool Valid (int64_t i) const { return i >= 0 && i < span; }
 
-      // items with closed boxes lo..hi (3 doubles each per item), in every cell they overlap
+      // items with closed boxes lo..hi (3 doubles each per item), in every cell they overlap;
+      // within a cell in increasing item order
       void Build (const std::vector<double> & lo, const std::vector<double> & hi)
       {
-        std::vector<std::pair<uint64_t,int32_t>> keyed;
         size_t n = lo.size() / 3;
-        for (size_t t = 0; t < n; t++)
+        range.clear();
+        first.clear();
+        auto cells = [&] (size_t t, auto && f)
           {
             int64_t a[3], b[3];
             for (int d = 0; d < 3; d++) { a[d] = Cell(lo[3*t+d], d); b[d] = Cell(hi[3*t+d], d); }
             for (int64_t i = a[0]; i <= b[0]; i++)
               for (int64_t j = a[1]; j <= b[1]; j++)
                 for (int64_t k = a[2]; k <= b[2]; k++)
-                  keyed.push_back({ Key(i, j, k), int32_t(t) });
+                  f(i, j, k);
+          };
+        if (Dense ())
+          {
+            // counting sort over all cells; cells outside the grid are never visited
+            first.assign(size_t(span * span * span) + 1, 0);
+            for (size_t t = 0; t < n; t++)
+              cells(t, [&] (int64_t i, int64_t j, int64_t k)
+                { if (Valid(i) && Valid(j) && Valid(k)) first[Linear(i, j, k) + 1]++; });
+            for (size_t c = 1; c < first.size(); c++) first[c] += first[c-1];
+            items.resize(first.back());
+            std::vector<int32_t> fill(first.begin(), first.end() - 1);
+            for (size_t t = 0; t < n; t++)
+              cells(t, [&] (int64_t i, int64_t j, int64_t k)
+                { if (Valid(i) && Valid(j) && Valid(k)) items[fill[Linear(i, j, k)]++] = int32_t(t); });
+            return;
           }
+        std::vector<std::pair<uint64_t,int32_t>> keyed;
+        for (size_t t = 0; t < n; t++)
+          cells(t, [&] (int64_t i, int64_t j, int64_t k) { keyed.push_back({ Key(i, j, k), int32_t(t) }); });
         std::sort(keyed.begin(), keyed.end());
         items.resize(keyed.size());
         range.reserve(keyed.size());
@@ -58,6 +85,12 @@ namespace ngfracture
       template <typename F> void Visit (int64_t i, int64_t j, int64_t k, F && f) const
       {
         if (!Valid(i) || !Valid(j) || !Valid(k)) return;
+        if (!first.empty())
+          {
+            int64_t c = Linear(i, j, k);
+            for (int32_t s = first[c]; s < first[c+1]; s++) f(items[s]);
+            return;
+          }
         auto it = range.find(Key(i, j, k));
         if (it == range.end()) return;
         for (int32_t s = it->second.first; s < it->second.second; s++) f(items[s]);
@@ -268,6 +301,35 @@ namespace ngfracture
 
     using Hit = std::tuple<int32_t,int32_t,int32_t>;   // vertex, fragment, tet
 
+    // The pairs (vertex, fragment) decided in a sweep: up to four fragments per vertex in
+    // place (filled in order), more in a hash set.
+    class Decided
+    {
+      static constexpr int32_t kFree = std::numeric_limits<int32_t>::min();
+      std::vector<std::array<int32_t,4>> slot_;
+      std::unordered_set<uint64_t> more_;
+      static uint64_t Key (int32_t v, int32_t F) { return (uint64_t(uint32_t(v)) << 32) | uint32_t(F); }
+    public:
+      explicit Decided (int64_t nv) : slot_(size_t(nv), { kFree, kFree, kFree, kFree }) { }
+      bool Has (int32_t v, int32_t F) const
+      {
+        const auto & s = slot_[v];
+        for (int i = 0; i < 4; i++)
+          {
+            if (s[i] == F) return true;
+            if (s[i] == kFree) return false;
+          }
+        return more_.count(Key(v, F)) > 0;
+      }
+      void Insert (int32_t v, int32_t F)        // (v, F) not in the set
+      {
+        auto & s = slot_[v];
+        for (int i = 0; i < 4; i++)
+          if (s[i] == kFree) { s[i] = F; return; }
+        more_.insert(Key(v, F));
+      }
+    };
+
     // The copies of every boundary vertex (bitwise-equal reference points), increasing.
     struct Copies
     {
@@ -308,14 +370,17 @@ namespace ngfracture
 
     // Every (boundary vertex, tetrahedron of another fragment) with the vertex in the
     // closed tetrahedron, and (lip vertex, tetrahedron of its own fragment not at the
-    // vertex): each tetrahedron's box swept over the vertex grid. A pair whose vertex sits
-    // on its twin of that fragment (a closed seam, or a closed lip) is no hit; the closed
-    // seams met in some closed tetrahedron are counted (their number), each tested until found.
+    // vertex): each tetrahedron's box swept over the vertex grid. A pair found in a
+    // tetrahedron is decided and not tested again: a pair whose vertex sits on its twin of
+    // that fragment (a closed seam, or a closed lip) is no hit, only counted; any other is
+    // a hit in that tetrahedron, the smallest that holds it (the sweep goes in increasing
+    // order). The twin is looked up only for a pair found.
     std::vector<Hit> SweepTets (const TetMesh3 & m, const Derived & D, const Copies & copies, const HashGrid & g,
                                 Collision3Stats & st)
     {
       std::vector<Hit> hits;
-      std::unordered_set<uint64_t> closed;
+      Decided decided(m.nv);
+      int64_t closed = 0;
       for (int64_t t = 0; t < m.ne; t++)
         {
           const int32_t * T = m.tets + 4*t;
@@ -345,19 +410,19 @@ namespace ngfracture
                     const double * p = m.x + 3*v;
                     for (int d = 0; d < 3; d++)
                       if (p[d] < lo[d] || p[d] > hi[d]) return;
-                    int32_t twin = copies.Twin(D, v, F);
-                    bool seam = twin >= 0 && std::memcmp(p, m.x + 3*twin, 3 * sizeof(double)) == 0;
-                    uint64_t key = (uint64_t(uint32_t(v)) << 32) | uint32_t(F);
-                    if (seam && closed.count(key)) return;
+                    if (decided.Has(v, F)) return;
                     st.exact_tests++;
                     if (orientation == 2)
                       orientation = Orient3dSign(m.x + 3*T[0], m.x + 3*T[1], m.x + 3*T[2], m.x + 3*T[3]);
                     if (!InClosedTet(m.x, T, p, orientation)) return;
-                    if (seam) closed.insert(key);
+                    decided.Insert(v, F);
+                    int32_t twin = copies.Twin(D, v, F);
+                    bool seam = twin >= 0 && std::memcmp(p, m.x + 3*twin, 3 * sizeof(double)) == 0;
+                    if (seam) closed++;
                     else hits.emplace_back(v, F, int32_t(t));
                   });
         }
-      st.closed_seams = int64_t(closed.size());
+      st.closed_seams = closed;
       std::sort(hits.begin(), hits.end());
       return hits;
     }
@@ -422,16 +487,33 @@ namespace ngfracture
           double d2 = Dist2(p, a, b, cc, bary, q);
           if (d2 < best || (d2 == best && f < bf)) { best = d2; bf = f; std::copy(bary, bary + 3, bary_out); }
         };
+      // the distance from p to cell i along axis d
+      auto axis_gap = [&] (int64_t i, int d)
+        {
+          double lo = fg.origin[d] + double(i) * fg.h;
+          return std::max({ lo - p[d], p[d] - (lo + fg.h), 0.0 });
+        };
       for (int64_t r = 0; r <= fg.span; r++)
         {
-          // the shell of cells at Chebyshev distance r, clipped to the grid
+          // the shell of cells at Chebyshev distance r, clipped to the grid; a cell farther
+          // from p than the best face holds no nearer face (a face's nearest point lies in a
+          // cell it is hashed to), so it is not visited (1e-6 h covers the rounding of the
+          // cell bounds, 1e-9 relative keeps the ties)
           for (int64_t i = std::max<int64_t>(c[0]-r, 0); i <= std::min(c[0]+r, fg.span-1); i++)
             for (int64_t j = std::max<int64_t>(c[1]-r, 0); j <= std::min(c[1]+r, fg.span-1); j++)
               {
                 bool side = std::abs(i-c[0]) == r || std::abs(j-c[1]) == r;
                 int64_t step = side || r == 0 ? 1 : 2*r;
+                double gij = axis_gap(i, 0) * axis_gap(i, 0) + axis_gap(j, 1) * axis_gap(j, 1);
                 for (int64_t k = c[2]-r; k <= c[2]+r; k += step)
-                  fg.Visit(i, j, k, consider);
+                  {
+                    if (bf >= 0)
+                      {
+                        double lb = std::sqrt(gij + axis_gap(k, 2) * axis_gap(k, 2)) - 1e-6 * fg.h;
+                        if (lb > 0 && lb * lb > best * (1.0 + 1e-9)) continue;
+                      }
+                    fg.Visit(i, j, k, consider);
+                  }
               }
           // faces not seen yet lie beyond distance r h, and beyond r h + wall (strictly:
           // no tie with a face not seen)

@@ -40,8 +40,17 @@ is solved again with those rows (an update). Where re-linearising every round st
 reducing the penetration at a settled set (rows sliding over a kink), the rows stay as they
 are from then on and the plain fixed point of updates decides, which fails with reason
 "penetration" when it does not contract.
+
+Keys as integers. The set operations of a round (which rows have multipliers, whether the
+chosen set is the last one or one imposed before, which rows were ever imposed) work on
+one int64 code per key: equal codes for equal keys within one active set. Keys given as a
+:class:`RowKeys` (the 3D candidates) carry their codes; for a plain list of tuples the
+active set numbers the keys in the order it meets them. The multipliers dictionary of
+tuples is made from the codes only when read (the solver reads it once, at convergence),
+so a round costs no Python work per row.
 """
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -51,7 +60,7 @@ from .redundancy import independent_rows
 from .rows import ContactConstraints, no_constraints, reachable, relinearise_node_to_segment, select_contacts
 from .seams import KINK_ANGLE, seam_constraints
 
-__all__ = ["Geometry", "Candidates", "ActiveSet", "max_penetration", "refreshed"]
+__all__ = ["Geometry", "Candidates", "RowKeys", "ActiveSet", "max_penetration", "refreshed"]
 
 
 @dataclass(frozen=True)
@@ -79,6 +88,48 @@ class Geometry:
     holds: object = None
 
 
+class RowKeys(Sequence):
+    """The keys of rows as int64 codes; the key tuples are made on first use.
+
+    Parameters
+    ----------
+    codes : numpy.ndarray of int
+        One code per row: equal codes for equal keys.
+    codec : object
+        Its ``decode(codes)`` gives the list of key tuples. Keys of one codec concatenate
+        (``+``) into keys of that codec.
+    """
+
+    def __init__(self, codes, codec):
+        self.codes = np.asarray(codes, dtype=np.int64)
+        self.codec = codec
+        self._tuples = None
+
+    def _list(self):
+        if self._tuples is None:
+            self._tuples = self.codec.decode(self.codes)
+        return self._tuples
+
+    def __len__(self):
+        return len(self.codes)
+
+    def __getitem__(self, i):
+        return self._list()[i]
+
+    def __iter__(self):
+        return iter(self._list())
+
+    def __add__(self, other):
+        if isinstance(other, RowKeys) and other.codec is self.codec:
+            return RowKeys(np.concatenate([self.codes, other.codes]), self.codec)
+        return self._list() + list(other)
+
+    def __eq__(self, other):
+        return isinstance(other, Sequence) and list(self) == list(other)
+
+    __hash__ = None
+
+
 @dataclass
 class Candidates:
     """The candidate rows of one round (made by :meth:`ActiveSet.update`).
@@ -87,9 +138,10 @@ class Candidates:
     ----------
     rows : ngfracture.contact.rows.ContactConstraints
         Seam rows first, then node-to-segment rows.
-    keys : list of tuple
+    keys : list of tuple or RowKeys
         The key of every row: ("s", lower twin, higher twin, kind) for seam rows,
-        ("n", slave, a, c) for node-to-segment rows.
+        ("n", slave, a, c) for node-to-segment rows (3D: ("f", slave, master vertices
+        sorted), as :class:`RowKeys`).
     gap : numpy.ndarray, shape (len(rows),)
         The linearised gaps C u + g at the configuration of the round.
     relinearised : ngfracture.contact.rows.ContactConstraints or None
@@ -201,14 +253,43 @@ class ActiveSet:
         self.seam_rows, self.seam_keys = None, []
         self.matched = None                     # vertices with a seam row
         self.n2s, self.n2s_keys = no_constraints(len(geometry.arrays.points)), []
-        self.multipliers = {}
-        self.imposed = set()                    # every set imposed so far
-        self.tried = set()                      # every row imposed so far
+        self._ids = {}                          # key -> code, for keys given as tuples
+        self._mult_codes = np.zeros(0, dtype=np.int64)   # codes of the last solve's rows, sorted
+        self._mult_values = np.zeros(0)                  # their multipliers
+        self._multipliers = {}                  # the dictionary, or (keys, kept, values) to make it from
+        self.imposed = set()                    # every set imposed so far (sorted codes as bytes)
+        self.tried = np.zeros(0, dtype=np.int64)         # codes of every row imposed so far, sorted
         self.exact = False                      # the complementarity problem chooses the set
         self.force_scale = 0.0                  # the largest force of any solve so far
         self.moving = True                      # rows re-linearised every round
         self.last_penetration = np.inf          # at the last re-linearisation of a settled set
         self.updates = 0
+
+    @property
+    def multipliers(self):
+        """Key -> multiplier of every row imposed in the last solve (dict, made when read)."""
+        if isinstance(self._multipliers, tuple):
+            keys, kept, values = self._multipliers
+            self._multipliers = {keys[i]: x for i, x in zip(kept.tolist(), values.tolist())}
+        return self._multipliers
+
+    def _key_codes(self, keys):
+        """The int64 code of every key given as a tuple: numbered in the order met."""
+        ids = self._ids
+        return np.fromiter((ids.setdefault(k, len(ids)) for k in keys), dtype=np.int64, count=len(keys))
+
+    def _codes(self, keys):
+        """The int64 code of every key (see the module docstring)."""
+        if isinstance(keys, RowKeys):
+            return keys.codes
+        return self._key_codes(keys)
+
+    def _has_multiplier(self, codes):
+        """Per code: whether its row has a multiplier, and the multiplier (0 where not)."""
+        if not len(self._mult_codes):
+            return np.zeros(len(codes), dtype=bool), np.zeros(len(codes))
+        at = np.minimum(np.searchsorted(self._mult_codes, codes), len(self._mult_codes) - 1)
+        return self._mult_codes[at] == codes, self._mult_values[at]
 
     def update(self, U, timings):
         """The candidate rows at X + U, the configuration of the last solve.
@@ -277,15 +358,19 @@ class ActiveSet:
             All rows but the wanted ones that depend on the kept ones: those whose
             penetration counts.
         """
-        lam, warm = self.multipliers, self.warm
-        want = np.array([(lam[k] <= 0.0) if k in lam else (g < -self.penetration_tol or k in warm)
-                         for k, g in zip(candidates.keys, candidates.gap)], dtype=bool)
+        codes = self._codes(candidates.keys)
+        has, lam = self._has_multiplier(codes)
+        enter = candidates.gap < -self.penetration_tol
+        if self.warm:
+            enter |= np.isin(codes, self._key_codes(list(self.warm)))
+        want = np.where(has, lam <= 0.0, enter)
         self.warm = set()        # a warm row that the solve releases is judged like any other
         want = np.flatnonzero(want)
         kept = self._independent(candidates.rows, want)
-        dependent = np.setdiff1d(want, kept)
-        other = np.setdiff1d(np.arange(len(candidates.keys)), dependent)
-        return want, kept, other
+        dependent = np.zeros(len(candidates.keys), dtype=bool)
+        dependent[want] = True
+        dependent[kept] = False
+        return want, kept, np.flatnonzero(~dependent)
 
     def choose(self, candidates, want, kept, round_number, complementarity):
         """The rows to impose next, and whether they are the set of the last solve.
@@ -314,24 +399,25 @@ class ActiveSet:
         settled : bool
             True if they are the rows imposed in the last solve.
         """
-        keys = candidates.keys
-        settled = self.solved and set(keys[i] for i in kept) == set(self.multipliers)
+        codes = self._codes(candidates.keys)
+        kept_codes = np.unique(codes[kept])
+        settled = self.solved and np.array_equal(kept_codes, self._mult_codes)
         if self.moving and not settled:
             self.last_penetration = np.inf     # the contraction is judged at one set only
         if not settled and (self.exact or round_number > self.pdas_rounds
-                            or frozenset(keys[i] for i in kept) in self.imposed):
+                            or kept_codes.tobytes() in self.imposed):
             self.exact = True
             # candidates: the rows the update wants and every row imposed before
-            tried = np.array([i for i, k in enumerate(keys) if k in self.tried], dtype=np.int64)
+            tried = np.flatnonzero(np.isin(codes, self.tried))
             closed = complementarity(candidates.rows, np.union1d(want, tried))
             if closed is not None:
                 # closed rows that depend on others hold with them; as equalities they
                 # would make the system singular
                 choice = self._independent(candidates.rows, closed)
-                if set(keys[i] for i in choice) != set(self.multipliers):
-                    kept = choice
-        self.imposed.add(frozenset(keys[i] for i in kept))
-        self.tried.update(keys[i] for i in kept)
+                if not np.array_equal(np.unique(codes[choice]), self._mult_codes):
+                    kept, kept_codes = choice, np.unique(codes[choice])
+        self.imposed.add(kept_codes.tobytes())
+        self.tried = np.union1d(self.tried, kept_codes)
         return kept, settled
 
     def settle(self, candidates, other, U):
@@ -386,7 +472,7 @@ class ActiveSet:
 
         Parameters
         ----------
-        keys : list of tuple
+        keys : list of tuple or RowKeys
             The keys of the candidates.
         kept : numpy.ndarray of int
             The rows imposed (indices into ``keys``).
@@ -402,7 +488,14 @@ class ActiveSet:
         """
         self.force_scale = max(self.force_scale, float(np.abs(multipliers).max(initial=0.0)), support_force)
         rounded = np.where(np.abs(multipliers) <= 1e-10 * self.force_scale, 0.0, multipliers)
-        self.multipliers = {keys[i]: x for i, x in zip(kept.tolist(), rounded.tolist())}
+        kept = np.asarray(kept, dtype=np.int64)
+        codes = self._codes(keys)[kept]
+        # a key met twice keeps its last multiplier, as a dictionary does
+        self._mult_codes, last = np.unique(codes[::-1], return_index=True)
+        self._mult_values = rounded[::-1][last]
+        self._multipliers = (keys, kept, rounded)
+        if not isinstance(keys, RowKeys):       # a list may change after the call
+            self._multipliers = self.multipliers
         self.solved = True
         return int(np.count_nonzero(rounded > 0))
 

@@ -18,21 +18,26 @@ Candidates, each identified by its key ("f", slave, master vertices sorted):
     by rounding of a solve (1e-18 on the patch test's perimeter) and would be lost, but in
     the reference configuration touching is exact. A length threshold would instead add
     rows for vertices near but off a face, whose rows then fail the patch test;
-  * twin rows (:func:`~ngfracture.contact.rows3d.twin_rows`), for every vertex that has a
-    copy on another fragment at the bitwise-equal reference point: the corners of a common
-    face of two bodies meshed apart, and the coincident lips of cracks. They are the 3D
-    form of the 2D seam rows: the detection leaves closed seams out (their master face
-    would depend on rounding), and with a row identified by its key the candidate set of
-    a seam is the same in every round;
+  * twin rows (:func:`~ngfracture.contact.junctions3d.fragment_pair_rows`), for every vertex
+    that has a copy on another fragment at the bitwise-equal reference point: across the
+    matched faces of coincident lips one row per (copy, neighbouring fragment), one
+    direction per pair of fragments, so that a junction of several fragments gets a row
+    towards each face neighbour; the corners of a common face of two bodies meshed apart
+    (no matched face) get the rows of :func:`~ngfracture.contact.rows3d.fragment_twin_rows`.
+    They are the 3D form of the 2D seam rows: the detection leaves closed seams out (their
+    master face would depend on rounding), and with a row identified by its key the
+    candidate set of a seam is the same in every round;
   * lip rows (:func:`~ngfracture.contact.rows3d.lip_rows`), one per pair of copies on one
     fragment: the two lips of a crack that does not cut its fragment through; both kinds
-    with the junction rows (:mod:`~ngfracture.contact.junction3d`) where the surface at the
+    with the partner-face rows (:mod:`~ngfracture.contact.kinks3d`) where the surface at the
     copy is not one plane;
 
 - *found* rows: the pairs the detection finds at the configuration of the last solve
   (touching or penetrating), in two passes (every boundary vertex of every fragment a
   slave: the pass that passes the patch test, rows3d's docstring). A found pair whose
-  vertex has a twin on the master fragment talks to it through its twin row only; a lip
+  vertex has a twin row to the master fragment (either copy the slave:
+  :func:`~ngfracture.contact.junctions3d.covered_pairs`) talks to it through that row only
+  (a diagonal neighbour at a junction has none, and its overlap is a found row); a lip
   vertex found in its own fragment, through the lip row of its pair of copies. A found
   row stays a candidate while it is active or found again, as in 2D.
 
@@ -40,17 +45,108 @@ Every round re-linearises all candidates at the configuration of the last solve
 (:func:`~ngfracture.contact.rows3d.relinearise_node_to_face`), and rows whose gap does not
 change by more than a hundredth of ``penetration_tol`` keep their old linearisation bit for
 bit (:func:`~ngfracture.contact.active_set.refreshed`), as in 2D.
+
+Keys as codes. A row's key ("f", slave, master vertices sorted) is held as the int64 code
+slave * n + i, with i the number of the master's vertex set among the distinct vertex sets
+of the boundary faces (:class:`FaceKeys`; a row's master is the vertices of its face, which
+the code checks). Codes are equal exactly where keys are, so the candidate bookkeeping
+(which found rows are new, which stay, which vertices a twin row covers) and the choice of
+the set (:class:`~ngfracture.contact.active_set.ActiveSet`) are array operations
+(``numpy.isin``, sorting), with the same results as with tuples; the tuples are made only
+where a caller reads them (:class:`~ngfracture.contact.active_set.RowKeys`).
 """
 import time
 
 import numpy as np
 
-from .active_set import ActiveSet, Candidates, refreshed
+from .active_set import ActiveSet, Candidates, RowKeys, refreshed
 from .collision3d import detect_penetrations_3d
-from .rows3d import (NodeToFaceRows, fragment_twin_rows, lip_rows, no_face_rows, node_to_face_rows,
-                     relinearise_node_to_face)
+from .junctions3d import covered_pairs, fragment_pair_rows
+from .rows3d import NodeToFaceRows, lip_rows, no_face_rows, node_to_face_rows, relinearise_node_to_face
 
-__all__ = ["ActiveSet3d", "fixed_rows_3d"]
+__all__ = ["ActiveSet3d", "FaceKeys", "fixed_rows_3d"]
+
+
+class FaceKeys:
+    """The int64 codes of node-to-face keys on one mesh (see the module docstring).
+
+    Parameters
+    ----------
+    faces : array_like of int, shape (nf, 3)
+        The mesh's boundary faces.
+
+    Raises
+    ------
+    ValueError
+        If ``faces`` is not of shape (nf, 3) with vertex numbers >= 0.
+    """
+
+    def __init__(self, faces):
+        F = np.asarray(faces)
+        if F.ndim != 2 or F.shape[1] != 3 or (F.size and (not np.issubdtype(F.dtype, np.integer) or F.min() < 0)):
+            raise ValueError(f"faces must be vertex numbers >= 0 of shape (nf, 3), got {F.dtype} {F.shape}")
+        S = np.sort(F.astype(np.int64), axis=1)
+        order = np.lexsort((S[:, 2], S[:, 1], S[:, 0]))
+        S = S[order]
+        first = np.r_[True, np.any(S[1:] != S[:-1], axis=1)] if len(S) else np.zeros(0, dtype=bool)
+        self.triples = S[first]                 # the distinct vertex sets, sorted
+        self.face_set = np.empty(len(S), dtype=np.int64)
+        self.face_set[order] = np.cumsum(first) - 1
+        self.n = max(len(self.triples), 1)
+        self._lookup = None
+
+    def codes(self, rows):
+        """The codes of the keys of some rows.
+
+        Parameters
+        ----------
+        rows : ngfracture.contact.rows3d.NodeToFaceRows
+            Rows of this mesh (their master the vertices of their face).
+
+        Returns
+        -------
+        numpy.ndarray of int64
+
+        Raises
+        ------
+        ValueError
+            If a row's master is not the vertex set of its face.
+        """
+        sets = self.face_set[np.asarray(rows.face, dtype=np.int64)]
+        if not np.array_equal(self.triples[sets], np.sort(rows.master, axis=1)):
+            raise ValueError("FaceKeys.codes: a row's master is not the vertex set of its face")
+        return np.asarray(rows.slave, dtype=np.int64) * self.n + sets
+
+    def codes_of(self, keys):
+        """The codes of keys given as tuples ("f", slave, a, b, c); -1 for a key of no face.
+
+        Parameters
+        ----------
+        keys : sequence of tuple
+
+        Returns
+        -------
+        numpy.ndarray of int64
+        """
+        if self._lookup is None:
+            self._lookup = {tuple(t): i for i, t in enumerate(self.triples.tolist())}
+        look = self._lookup
+        return np.fromiter(((k[1] * self.n + look[k[2:]]) if k[2:] in look else -1 for k in keys),
+                           dtype=np.int64, count=len(keys))
+
+    def decode(self, codes):
+        """The key tuples ("f", slave, master vertices sorted) of codes.
+
+        Parameters
+        ----------
+        codes : numpy.ndarray of int64
+
+        Returns
+        -------
+        list of tuple
+        """
+        slave, sets = np.divmod(np.asarray(codes, dtype=np.int64), self.n)
+        return [("f", s, a, b, c) for s, (a, b, c) in zip(slave.tolist(), self.triples[sets].tolist())]
 
 
 def fixed_rows_3d(points, tets, faces, fragment):
@@ -73,22 +169,34 @@ def fixed_rows_3d(points, tets, faces, fragment):
         The pairs touching in the reference configuration (sorted by vertex and fragment),
         then the twin rows of every fragment's vertices (fragment by fragment, by slave),
         then the lip rows (by slave and copy).
-    keys : list of tuple
-        Their keys, without repeats (a repeated key keeps its first row).
+    keys : RowKeys
+        Their keys (a sequence of tuples), without repeats (a repeated key keeps its
+        first row).
 
     Raises
     ------
     ValueError
         On inconsistent arrays (see :func:`detect_penetrations_3d`).
     """
+    return _fixed_rows(points, tets, faces, fragment, FaceKeys(faces))
+
+
+def _fixed_rows(points, tets, faces, fragment, codec):
+    """:func:`fixed_rows_3d` with the keys' codec given."""
     nv = len(points)
     touching = node_to_face_rows(points, faces, detect_penetrations_3d(points, tets, faces, fragment))
     vertex_fragment = _vertex_fragment(nv, tets, fragment)
-    rows = NodeToFaceRows.stack([touching, fragment_twin_rows(points, faces, vertex_fragment),
+    rows = NodeToFaceRows.stack([touching, fragment_pair_rows(points, faces, vertex_fragment),
                                  lip_rows(points, faces, vertex_fragment)])
-    keys = rows.keys()
-    first = sorted({k: i for i, k in reversed(list(enumerate(keys)))}.values())
-    return rows.subset(np.array(first, dtype=np.int64)), [keys[i] for i in first]
+    codes = codec.codes(rows)
+    first = np.sort(np.unique(codes, return_index=True)[1])
+    return rows.subset(first), RowKeys(codes[first], codec)
+
+
+def _pair_codes(pairs, nv):
+    """(vertex, fragment) pairs as int64 codes fragment * nv + vertex."""
+    pairs = np.array(list(pairs), dtype=np.int64).reshape(-1, 2)
+    return pairs[:, 1] * nv + pairs[:, 0]
 
 
 def _vertex_fragment(nv, tets, fragment):
@@ -119,6 +227,9 @@ class ActiveSet3d(ActiveSet):
         super().__init__(geometry, 0.0, penetration_tol, **options)
         self.n2s = no_face_rows(len(geometry.arrays.points))
         self.vertex_fragment = None
+        self.covered = np.zeros(0, dtype=np.int64)     # (vertex, fragment) a fixed row covers, as codes
+        self.codec = FaceKeys(geometry.arrays.faces)
+        self.n2s_keys = RowKeys(np.zeros(0, dtype=np.int64), self.codec)
 
     def update(self, U, timings):
         """The candidate rows at X + U, the configuration of the last solve.
@@ -142,33 +253,38 @@ class ActiveSet3d(ActiveSet):
         relinearised = None
         if self.seam_rows is None:
             t0 = time.perf_counter()
-            self.seam_rows, self.seam_keys = fixed_rows_3d(a.points, a.tets, a.faces, self.geometry.fragment)
+            self.seam_rows, self.seam_keys = _fixed_rows(a.points, a.tets, a.faces, self.geometry.fragment, self.codec)
             timings["collision"] += time.perf_counter() - t0
             self.vertex_fragment = _vertex_fragment(len(a.points), a.tets, self.geometry.fragment)
+            self.covered = _pair_codes(covered_pairs(a.points, self.seam_rows, self.vertex_fragment),
+                                       len(a.points))
         elif self.moving:
             old = NodeToFaceRows.stack([self.seam_rows, self.n2s])
             relinearised = relinearise_node_to_face(old, a.points, U)
             self.seam_rows, self.n2s = self._split(refreshed(old, relinearised, U, 0.01 * self.penetration_tol))
-        found, found_keys = self._node_to_face(U, timings)
-        known, found_set = set(self.n2s_keys) | set(self.seam_keys), set(found_keys)
-        retained = [i for i, k in enumerate(self.n2s_keys) if k in self.multipliers or k in found_set]
-        new = [i for i, k in enumerate(found_keys) if k not in known]
-        self.n2s = NodeToFaceRows.stack([self.n2s.subset(np.array(retained, dtype=np.int64)),
-                                         found.subset(np.array(new, dtype=np.int64))])
-        self.n2s_keys = [self.n2s_keys[i] for i in retained] + [found_keys[i] for i in new]
+        found, found_codes = self._node_to_face(U, timings)
+        n2s_codes = self.n2s_keys.codes
+        known = np.concatenate([n2s_codes, self.seam_keys.codes])
+        retained = np.flatnonzero(self._has_multiplier(n2s_codes)[0] | np.isin(n2s_codes, found_codes))
+        new = np.flatnonzero(~np.isin(found_codes, known))
+        self.n2s = NodeToFaceRows.stack([self.n2s.subset(retained), found.subset(new)])
+        self.n2s_keys = RowKeys(np.concatenate([n2s_codes[retained], found_codes[new]]), self.codec)
         rows = NodeToFaceRows.stack([self.seam_rows, self.n2s])
         if relinearised is not None:
             n_fixed = len(self.seam_keys)
-            relinearised = relinearised.subset(np.concatenate([np.arange(n_fixed),
-                                                               n_fixed + np.array(retained, dtype=np.int64)]))
+            relinearised = relinearised.subset(np.concatenate([np.arange(n_fixed), n_fixed + retained]))
         return Candidates(rows, self.seam_keys + self.n2s_keys, rows.C @ U.T.ravel() + rows.g, relinearised)
+
+    def _key_codes(self, keys):
+        """The codes of keys given as tuples (:meth:`FaceKeys.codes_of`)."""
+        return self.codec.codes_of(keys)
 
     def _fresh_rows(self, candidates, U):
         """The candidate rows re-linearised at X + U (all of them: settle's judgement)."""
         return relinearise_node_to_face(candidates.rows, self.geometry.arrays.points, U)
 
     def _node_to_face(self, U, timings):
-        """The pairs detected at X + U that no twin row covers, as rows with their keys."""
+        """The pairs detected at X + U that no twin row covers, as rows with their key codes."""
         a = self.geometry.arrays
         t0 = time.perf_counter()
         pen = detect_penetrations_3d(a.points, a.tets, a.faces, self.geometry.fragment, displacement=U)
@@ -179,9 +295,7 @@ class ActiveSet3d(ActiveSet):
         twin = np.asarray(pen.twin, dtype=np.int64)
         keep = twin < 0
         if not keep.all():
-            covered = {(k[1], int(self.vertex_fragment[k[2]])) for k in self.seam_keys}
             own = pen.fragment == self.vertex_fragment[pen.vertex]
-            keep |= ~own & np.array([(int(v), int(f)) not in covered
-                                     for v, f in zip(pen.vertex.tolist(), pen.fragment.tolist())], dtype=bool)
+            keep |= ~own & ~np.isin(np.asarray(pen.fragment, dtype=np.int64) * len(a.points) + pen.vertex, self.covered)
         rows = rows.subset(np.flatnonzero(keep))
-        return rows, rows.keys()
+        return rows, self.codec.codes(rows)

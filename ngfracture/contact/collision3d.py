@@ -41,6 +41,10 @@ the cells its bounding box overlaps (about 8 for h of the element size) and the 
 there of other fragments that pass the box test get the exact test. Memory and time are
 linear in the numbers of tetrahedra and boundary vertices for bounded cell occupancy
 (a few huge tetrahedra among small ones make them sweep many cells, correctly but slowly).
+Up to 2^22 cells the grid is an array of ranges over all cells, filled by a counting sort
+(a lookup is an index); beyond, a hash map of the occupied cells. The tetrahedra are
+swept in increasing order, so the first one holding a pair (vertex, fragment) is the
+smallest, and later tetrahedra of that fragment do not test the pair again.
 
 Master face. For each pair, in this order:
 
@@ -59,7 +63,11 @@ penetration; a vertex of a box pushed 1/4 into another one is pushed back along 
 overlap direction, not through side faces that are nearer but perpendicular to it. Faces
 are hashed into the same cells (every cell their box overlaps) and searched ring by ring
 of cells around v, until the best distance is at most r h after ring r (faces not seen
-are farther). Ties go to the smaller face number. The gap is -|x_v - p| with p the
+are farther). A cell farther from v than the best face so far is not searched: a face's
+nearest point lies in its box, so in a cell it is hashed to, and a nearer face is in a
+nearer cell (the bound is lowered by 1e-6 h for the rounding of the cell walls and
+compared with a relative margin of 1e-9, so ties are still seen). Ties go to the smaller
+face number. The gap is -|x_v - p| with p the
 nearest point (0 in case 1); p, its barycentric coordinates on the face and the face's
 unit normal are returned.
 

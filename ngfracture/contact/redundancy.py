@@ -132,9 +132,12 @@ def _reduced_rows(C, fixed, G, rtol):
         grow = gcol = np.zeros(0, dtype=np.int64)
         gval = np.zeros(0)
         p = 0
-    used, cols = np.unique(np.concatenate([col, gcol]), return_inverse=True)
-    col, gcol = cols[:len(col)], cols[len(col):]
-    n = len(used)
+    # the columns the rows touch, renumbered in increasing order (np.unique's numbering)
+    touched = np.zeros(ndof, dtype=bool)
+    touched[col] = touched[gcol] = True
+    number = np.cumsum(touched) - 1
+    col, gcol = number[col], number[gcol]
+    n = int(np.count_nonzero(touched))
     # components of the bipartite graph rows (C then G) -- dofs
     nodes = m + p + n
     graph = sp.csr_matrix((np.ones(len(col) + len(gcol), dtype=np.int8),

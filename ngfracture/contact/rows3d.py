@@ -45,8 +45,8 @@ common face of two bodies meshed apart, closed seams of a crack) are left out by
 detection; :func:`twin_rows` gives them a node-to-face row on a face at the twin. Rows of
 both passes at such a twin are the same row reversed, and the redundancy removal keeps one.
 Where the surface at the copy is not one plane (a point with three or more copies, a kinked
-crack lip) a slave also gets a row on every coincident face at the copy (junction rows,
-:mod:`ngfracture.contact.junction3d`).
+crack lip) a slave also gets a row on every coincident face at the copy (partner-face rows,
+:mod:`ngfracture.contact.kinks3d`).
 The tributary area of a node, by which a force is a pressure, is the consistent nodal area
 of the surface: the integral of its hat function, a third of the area of every face at
 the node (:func:`nodal_areas`).
@@ -64,7 +64,7 @@ from typing import ClassVar
 import numpy as np
 import scipy.sparse as sp
 
-from .junction3d import KINK, partner_faces, point_groups
+from .kinks3d import KINK, partner_faces, point_groups
 from .rows import RowTable
 
 __all__ = ["NodeToFaceRows", "no_face_rows", "node_to_face_rows", "twin_rows", "fragment_twin_rows", "lip_rows", "face_gap_rows",
@@ -147,6 +147,17 @@ def _gap_matrix(slave, master, bary, normal, nv):
     m = len(slave)
     w = np.concatenate([np.ones((m, 1)), -bary], axis=1)                  # weights of s, i, j, k
     verts = np.concatenate([slave[:, None], master], axis=1).astype(np.int64)
+    order = np.argsort(verts, axis=1, kind="stable")
+    vs = np.take_along_axis(verts, order, axis=1)
+    if not np.any(vs[:, 1:] == vs[:, :-1]) and 3 * nv < 2 ** 31 and 12 * m < 2 ** 31:
+        # four distinct vertices per row (no duplicate to sum): the CSR arrays directly,
+        # columns sorted within each row, as the conversion from coordinates makes them
+        ws = np.take_along_axis(w, order, axis=1)
+        cols = np.concatenate([vs + comp * nv for comp in range(3)], axis=1).ravel().astype(np.int32)
+        vals = np.concatenate([ws * normal[:, comp:comp + 1] for comp in range(3)], axis=1).ravel()
+        C = sp.csr_matrix((vals, cols, np.arange(0, 12 * m + 1, 12, dtype=np.int32)), shape=(m, 3 * nv))
+        C.eliminate_zeros()
+        return C
     rows = np.repeat(np.arange(m), 12)
     cols = np.concatenate([verts + comp * nv for comp in range(3)], axis=1).ravel()
     vals = np.concatenate([w * normal[:, comp:comp + 1] for comp in range(3)], axis=1).ravel()
@@ -277,7 +288,7 @@ def twin_rows(points, faces, slave):
     (barycentric 1 there): at a flat interface the interface's normal. Slaves whose faces at
     the twin all face along their normal (dot >= 0) get no row. Ties go to the smaller face.
     At points with three or more copies, s > t also gets a row on every face at t coincident
-    with a face at s (:func:`~ngfracture.contact.junction3d.partner_faces`).
+    with a face at s (:func:`~ngfracture.contact.kinks3d.partner_faces`).
 
     Parameters
     ----------
@@ -368,7 +379,7 @@ def lip_rows(points, faces, vertex_fragment):
     block the slip between the copies. At a junction of three or more copies every pair
     has its row. Where the crack surface is kinked, s also gets a row on every face at t
     coincident with a face at s whose normal differs from the row's by more than
-    :data:`~ngfracture.contact.junction3d.KINK`.
+    :data:`~ngfracture.contact.kinks3d.KINK`.
 
     Parameters
     ----------
@@ -417,11 +428,14 @@ def _copy_pairs(X, F):
 def _rows_at_copies(X, F, s, t, per):
     """Rows of slaves s on the face at their copy t opposing s's normal most, one per value of ``per``."""
     nv = len(X)
+    if not len(s):
+        return no_face_rows(nv)
     p = X[F]
     area2 = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
     unit = area2 / np.linalg.norm(area2, axis=1)[:, None]
-    vnormal = np.zeros((nv, 3))
-    np.add.at(vnormal, F.ravel(), np.repeat(area2, 3, axis=0))
+    # the faces' area normals summed at their vertices, in face order (as np.add.at sums)
+    vnormal = np.stack([np.bincount(F.ravel(), weights=np.repeat(area2[:, d], 3), minlength=nv)
+                        for d in range(3)], axis=1)
     # candidate faces: every face at the copy
     inc = np.argsort(F.ravel(), kind="stable")
     start = np.searchsorted(F.ravel()[inc], t)
@@ -444,7 +458,7 @@ def _rows_at_copies(X, F, s, t, per):
 
 
 def _with_junction_rows(X, F, rows, s, t, lips):
-    """``rows`` and rows on the partner faces of :func:`~ngfracture.contact.junction3d.partner_faces` it lacks."""
+    """``rows`` and rows on the partner faces of :func:`~ngfracture.contact.kinks3d.partner_faces` it lacks."""
     slave, face, k = partner_faces(X, F, s, t, all_pairs=lips)
     bary = np.zeros((len(slave), 3))
     bary[np.arange(len(slave)), k] = 1.0
@@ -452,7 +466,7 @@ def _with_junction_rows(X, F, rows, s, t, lips):
     area2 = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
     normal = area2 / np.linalg.norm(area2, axis=1)[:, None]
     keep = ~np.isin(slave * len(F) + face, rows.slave * len(F) + rows.face)
-    if lips and len(rows):        # only faces at a kink against the pair's row (junction3d.KINK)
+    if lips and len(rows):        # only faces at a kink against the pair's row (kinks3d.KINK)
         pair = rows.slave * len(X) + rows.master[np.arange(len(rows)), np.argmax(rows.bary, axis=1)]
         want = slave * len(X) + F[face, k]
         own = np.minimum(np.searchsorted(pair, want), len(rows) - 1)        # rows are sorted by pair

@@ -1,4 +1,4 @@
-"""Coincident faces at copies of a point: the master faces of the junction rows of 3D contact.
+"""Coincident faces at copies of a point: the master faces of the partner-face rows of 3D contact.
 
 Where the splitting made copies of a vertex, the faces around one copy t and those around
 another copy s come in coincident pairs: faces with their three vertices at the same three
@@ -6,7 +6,7 @@ reference points, the two sides of an interface or of a crack (a *partner* face 
 :mod:`ngfracture.contact.rows3d` holds a slave s against one face at t, the one most
 opposed to s's normal; where the surface at t is not one plane that is not enough, and
 :func:`partner_faces` gives every partner face at t, from which rows3d makes one row each
-(docs/contact.md, "Junction rows"):
+(docs/contact.md, "Crack lips in 3D", partner-face rows):
 
 - at points with three or more copies (a crack reaching an interface: the core's vertex and
   the two glass lip copies), for every pair of copies s > t;
@@ -48,7 +48,7 @@ def point_groups(points, faces):
     group : numpy.ndarray of int
         The number of each one's point, 0, 1, ... in that order.
     """
-    on = np.unique(faces)
+    on = np.flatnonzero(np.bincount(np.asarray(faces).ravel(), minlength=len(points)))   # increasing
     P = points[on]
     order = np.lexsort((P[:, 2], P[:, 1], P[:, 0]))                     # equal points together, stable
     on, P = on[order], P[order]

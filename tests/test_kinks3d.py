@@ -1,4 +1,4 @@
-"""Partner faces of the junction rows (ngfracture.contact.junction3d) and their rows (rows3d).
+"""Partner faces of the junction rows (ngfracture.contact.kinks3d) and their rows (rows3d).
 
 A point O with copies 0, 1, 2 (a crack reaching an interface: the core's vertex and two
 lip copies) and a point Q with copies 3, 4 (two copies only). Faces: [0, a, b] at copy 0
@@ -9,7 +9,7 @@ partner [4, c', a'] at Q.
 import numpy as np
 import pytest
 
-from ngfracture.contact.junction3d import partner_faces, point_groups
+from ngfracture.contact.kinks3d import partner_faces, point_groups
 from ngfracture.contact.rows3d import twin_rows
 
 

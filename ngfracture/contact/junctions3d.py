@@ -1,0 +1,195 @@
+"""Rows between the copies of a point on several fragments: one row per pair of fragments.
+
+Node splitting leaves coincident lips: every vertex on a lip has one copy per fragment at
+its point, bitwise equal, and the faces of two fragments' lips coincide (the same three
+points, opposite orientation): *matched faces*. Where several fragments meet (a line where
+two cut planes cross: 4 copies; a point where three cross: 8 copies) a copy touches every
+neighbouring fragment across its own lip, and the non-penetration of the copies needs a
+row towards each neighbour.
+
+:func:`fragment_pair_rows` gives, for every copy s on fragment F and every other fragment
+G that shares a matched face with F at s's point, one node-to-face row: slave s, master the
+copy t of s on G, on a matched face of G at t (projection at t, barycentric 1 there). Of
+the matched faces of G at t it takes the one whose unit normal is nearest to their
+area-weighted mean normal (the lip's normal between F and G at that point; ties: the
+smaller face), so the row's direction is that of the lip between the two fragments, not of
+s's vertex normal (which at a junction is diagonal, and would pick one neighbour at
+random). Only one direction per pair of fragments exists: the slave is on the
+higher-numbered fragment. The lips are matching meshes, so one pass transmits a uniform
+pressure exactly (as :func:`~ngfracture.contact.rows3d.lip_rows`); the reversed row on a
+face at s is the same row only while the two faces stay parallel, and as the lips deform
+the two directions become nearly, but not exactly, dependent (normals 1e-4 apart pass the
+redundancy removal's rank tolerance 1e-5), then they hold the copies against sliding
+and the imposed set has near-singular multipliers of both signs.
+
+Copies on two fragments without a matched face (the diagonal neighbours of a junction:
+they share only an edge or the point) get no row: the rows to the face neighbours bound
+their relative motion where the neighbours stay together, and a diagonal overlap that
+does occur is found by the detection (a vertex penetrating a fragment towards which it has
+no row is not left to any twin row, see
+:func:`~ngfracture.contact.active_set3d.ActiveSet3d`). Copies without any matched face (the
+corners of a common face of two bodies meshed apart with non-matching cells) keep the rows
+of :func:`~ngfracture.contact.rows3d.fragment_twin_rows` (both passes, on the face at the
+twin opposing the slave's vertex normal), which the patch test needs.
+"""
+import numpy as np
+
+from .rows3d import NodeToFaceRows, face_gap_rows, fragment_twin_rows
+
+__all__ = ["fragment_pair_rows", "covered_pairs"]
+
+
+def _point_ids(X, F):
+    """Per vertex the number of its reference point among the boundary vertices (-1 off the boundary)."""
+    on = np.unique(F)
+    P = X[on]
+    order = np.lexsort((P[:, 2], P[:, 1], P[:, 0]))
+    on, P = on[order], P[order]
+    group = np.cumsum(np.r_[False, np.any(P[1:] != P[:-1], axis=1)]) if len(on) else np.zeros(0, dtype=np.int64)
+    pid = np.full(len(X), -1, dtype=np.int64)
+    pid[on] = group
+    return pid
+
+
+def _matched_faces(F, pid, face_fragment):
+    """Ordered pairs (a, b) of faces on the same three points and on different fragments."""
+    K = np.sort(pid[F], axis=1)
+    order = np.lexsort((K[:, 2], K[:, 1], K[:, 0]))
+    Ks = K[order]
+    group = np.cumsum(np.r_[False, np.any(Ks[1:] != Ks[:-1], axis=1)]) if len(F) else np.zeros(0, dtype=np.int64)
+    first = np.searchsorted(group, group)
+    size = np.searchsorted(group, group, side="right") - first
+    who = np.repeat(np.arange(len(order)), size)
+    other = np.repeat(first, size) + (np.arange(len(who)) - np.repeat(np.cumsum(size) - size, size))
+    a, b = order[who], order[other]
+    keep = face_fragment[a] != face_fragment[b]
+    return a[keep], b[keep]
+
+
+def _checked(points, faces, vertex_fragment):
+    """The arrays as float coordinates, int faces and int fragments, or ValueError naming the bad one."""
+    X = np.asarray(points, dtype=np.float64)
+    if X.ndim != 2 or X.shape[1] != 3 or not np.isfinite(X).all():
+        raise ValueError(f"points must be finite numbers of shape (nv, 3), got shape {X.shape}")
+    nv = len(X)
+    F = np.asarray(faces)
+    if F.ndim != 2 or F.shape[1] != 3 or (F.size and not np.issubdtype(F.dtype, np.integer)):
+        raise ValueError(f"faces must be integers of shape (nf, 3), got {F.dtype} {F.shape}")
+    F = F.astype(np.int64)
+    if F.size and (F.min() < 0 or F.max() >= nv):
+        raise ValueError(f"faces hold vertex numbers outside [0, {nv})")
+    vf = np.asarray(vertex_fragment)
+    if vf.shape != (nv,) or (vf.size and not np.issubdtype(vf.dtype, np.integer)):
+        raise ValueError(f"vertex_fragment must be integers of shape ({nv},), got {vf.dtype} {vf.shape}")
+    return X, F, vf.astype(np.int64)
+
+
+def fragment_pair_rows(points, faces, vertex_fragment):
+    """Twin rows of fragmented bodies: one row per (copy, neighbouring fragment), one direction per pair.
+
+    See the module docstring for the rule and why.
+
+    Parameters
+    ----------
+    points : array_like, shape (nv, 3)
+        Reference coordinates (copies bitwise equal).
+    faces : array_like of int, shape (nf, 3)
+        Boundary faces, outward (the crack lips among them).
+    vertex_fragment : array_like of int, shape (nv,)
+        The fragment of every vertex.
+
+    Returns
+    -------
+    NodeToFaceRows
+        First the rows across matched faces, sorted by the slave's fragment, the slave and
+        the master's fragment; then the rows of
+        :func:`~ngfracture.contact.rows3d.fragment_twin_rows` whose slave lies on no matched
+        face, in their order. ``dist`` is the gap at the reference configuration.
+
+    Raises
+    ------
+    ValueError
+        On wrong shapes, non-finite coordinates or vertex numbers out of range.
+    """
+    X, F, vf = _checked(points, faces, vertex_fragment)
+    nv = len(X)
+    pid = _point_ids(X, F)
+    ff = vf[F[:, 0]] if len(F) else np.zeros(0, dtype=np.int64)
+    a, b = _matched_faces(F, pid, ff)
+    matched = np.zeros(nv, dtype=bool)
+    matched[F[a].ravel()] = True
+    fallback = fragment_twin_rows(X, F, vf)
+    fallback = fallback.subset(np.flatnonzero(~matched[fallback.slave]))
+    one_way = ff[a] > ff[b]
+    a, b = a[one_way], b[one_way]
+    if not len(a):
+        return fallback
+    # every corner k of master face b, with the slave: the copy of its point on face a
+    same = pid[F[b]][:, :, None] == pid[F[a]][:, None, :]              # [pair, k in b, j in a]
+    slave = F[a][np.arange(len(a))[:, None], same.argmax(axis=2)].ravel()
+    face = np.repeat(b, 3)
+    k = np.tile(np.arange(3), len(b))
+    p = X[F]
+    area2 = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+    unit = area2 / np.linalg.norm(area2, axis=1)[:, None]
+    group = np.lexsort((ff[face], slave))                                 # by (slave, master fragment)
+    slave, face, k = slave[group], face[group], k[group]
+    start = np.r_[True, (slave[1:] != slave[:-1]) | (ff[face][1:] != ff[face][:-1])]
+    owner = np.cumsum(start) - 1
+    mean = np.zeros((owner[-1] + 1, 3))
+    np.add.at(mean, owner, area2[face])
+    score = np.einsum("ij,ij->i", unit[face], mean[owner])
+    best = np.lexsort((face, -score, owner))
+    best = best[np.r_[True, owner[best][1:] != owner[best][:-1]]]
+    slave, face, k = slave[best], face[best], k[best]
+    order = np.lexsort((ff[face], slave, vf[slave]))
+    slave, face, k = slave[order], face[order], k[order]
+    bary = np.zeros((len(slave), 3))
+    bary[np.arange(len(slave)), k] = 1.0
+    master, normal = F[face], unit[face]
+    _, g = face_gap_rows(X, slave, master, bary, normal)
+    rows = NodeToFaceRows(slave=slave, master=master, face=face, bary=bary, normal=normal, dist=g.copy(), g=g, nv=nv)
+    return NodeToFaceRows.stack([rows, fallback]) if len(fallback) else rows
+
+
+def covered_pairs(points, rows, vertex_fragment):
+    """The (vertex, fragment) pairs whose contact a set of rows covers, both ways.
+
+    A row of slave s on a face of fragment G covers (s, G); where the master face has the
+    copy t of s (bitwise-equal reference point, on fragment F of s), it covers (t, F) as
+    well: the row is the non-penetration of the pair of copies, whichever is the slave.
+
+    Parameters
+    ----------
+    points : array_like, shape (nv, 3)
+        Reference coordinates.
+    rows : NodeToFaceRows
+        The rows.
+    vertex_fragment : array_like of int, shape (nv,)
+        The fragment of every vertex.
+
+    Returns
+    -------
+    set of tuple
+        (vertex, fragment) pairs of Python ints.
+
+    Raises
+    ------
+    ValueError
+        If the rows do not fit the arrays (vertex numbers out of range, wrong shapes).
+    """
+    X = np.asarray(points, dtype=np.float64)
+    vf = np.asarray(vertex_fragment)
+    if X.ndim != 2 or X.shape[1] != 3 or vf.shape != (len(X),) or rows.nv != len(X):
+        raise ValueError(f"covered_pairs: points {X.shape}, vertex_fragment {vf.shape} and rows of "
+                         f"{rows.nv} vertices do not fit")
+    if not len(rows):
+        return set()
+    s, m = np.asarray(rows.slave), np.asarray(rows.master)
+    out = set(zip(s.tolist(), vf[m[:, 0]].tolist()))
+    copy = np.all(X[m] == X[s][:, None, :], axis=2)                      # [row, corner]
+    has = copy.any(axis=1) & (vf[m[:, 0]] != vf[s])
+    t = m[np.flatnonzero(has), copy[has].argmax(axis=1)]
+    out.update(zip(t.tolist(), vf[s[has]].tolist()))
+    return out
+

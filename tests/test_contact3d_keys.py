@@ -1,0 +1,149 @@
+"""The fast paths of the 3D contact work give the results of the plain ones, exactly.
+
+Keys as int64 codes (``active_set3d.FaceKeys``, ``active_set.RowKeys``) against key tuples;
+the gap rows' CSR arrays against the conversion from coordinates; the detection's pairs,
+tetrahedra and master faces against a brute-force search over all pairs (exact orient3d,
+nearest face by distance to every face), on a fragmented cube whose blocks overlap.
+"""
+import numpy as np
+import scipy.sparse as sp
+
+from ngfracture.contact.active_set import Candidates, Geometry, RowKeys
+from ngfracture.contact.active_set3d import ActiveSet3d, FaceKeys, fixed_rows_3d
+from ngfracture.contact.collision3d import detect_penetrations_3d, orient3d
+from ngfracture.contact.rows3d import face_gap_rows, node_to_face_rows
+from ngfracture.geometry.pieces import fragmented_box
+
+CELLS, PIECES = 5, 2
+
+
+def _body(seed=0):
+    """The fragmented cube, and a displacement where every block overlaps its neighbours:
+    each block expanded about its centroid by 0.2 cells across every lip, plus noise."""
+    arrays, piece = fragmented_box(CELLS, PIECES)
+    X = arrays.points
+    vf = np.full(len(X), -1)
+    vf[arrays.tets.ravel()] = np.repeat(piece, 4)
+    centre = np.stack([np.bincount(vf, weights=X[:, d]) / np.bincount(vf) for d in range(3)], axis=1)
+    U = 0.2 / CELLS * PIECES * (X - centre[vf])
+    U += np.random.default_rng(seed).normal(scale=0.05 / CELLS, size=U.shape)
+    return arrays, piece, vf, U
+
+
+def _closest_distance(p, A, B, C):
+    """Distance from p to every triangle (A, B, C): the plane's foot if inside, else the nearest edge."""
+    n = np.cross(B - A, C - A)
+    n /= np.linalg.norm(n, axis=1)[:, None]
+    foot = p - np.einsum("ij,ij->i", p - A, n)[:, None] * n
+    inside = np.all([np.einsum("ij,ij->i", np.cross(Q - P, foot - P), n) >= 0
+                     for P, Q in ((A, B), (B, C), (C, A))], axis=0)
+    best = np.linalg.norm(p - foot, axis=1)
+    edges = []
+    for P, Q in ((A, B), (B, C), (C, A)):
+        e = Q - P
+        t = np.clip(np.einsum("ij,ij->i", p - P, e) / np.einsum("ij,ij->i", e, e), 0.0, 1.0)
+        edges.append(np.linalg.norm(p - (P + t[:, None] * e), axis=1))
+    return np.where(inside, best, np.min(edges, axis=0))
+
+
+def test_detection_equals_brute_force():
+    arrays, piece, vf, U = _body()
+    X, T, F = arrays.points, arrays.tets, arrays.faces
+    x = X + U
+    pen = detect_penetrations_3d(X, T, F, piece, displacement=U)
+    # brute force: every (boundary vertex, tetrahedron of another block), exactly
+    bv = np.unique(F)
+    v, t = np.repeat(bv, len(T)), np.tile(np.arange(len(T)), len(bv))
+    other = vf[v] != piece[t]
+    v, t = v[other], t[other]
+    corners = [x[T[t, k]] for k in range(4)]
+    s = orient3d(*corners).astype(int)
+    inside = s != 0
+    for k in range(4):
+        w = list(corners)
+        w[k] = x[v]
+        inside &= orient3d(*w) * s >= 0
+    v, t = v[inside], t[inside]
+    # closed seams: a copy on the block at the same reference and current point
+    key = {(tuple(X[u]), int(vf[u])): u for u in bv.tolist()}
+    twin = np.array([key.get((tuple(X[a]), int(piece[b])), -1) for a, b in zip(v.tolist(), t.tolist())])
+    closed = (twin >= 0) & np.all(x[v] == x[np.maximum(twin, 0)], axis=1)
+    v, t = v[~closed], t[~closed]
+    order = np.lexsort((t, piece[t], v))
+    v, t = v[order], t[order]
+    first = np.r_[True, (v[1:] != v[:-1]) | (piece[t][1:] != piece[t][:-1])]
+    assert len(pen) > 100
+    assert np.array_equal(pen.vertex, v[first]) and np.array_equal(pen.fragment, piece[t][first])
+    assert np.array_equal(pen.tet, t[first])
+    # master face: the nearest face of the block opposing the vertex's normal
+    area2 = np.cross(x[F[:, 1]] - x[F[:, 0]], x[F[:, 2]] - x[F[:, 0]])
+    vnormal = np.zeros((len(X), 3))
+    np.add.at(vnormal, F.ravel(), np.repeat(area2, 3, axis=0))
+    face_block = vf[F[:, 0]]
+    for i in range(len(pen)):
+        a, f = pen.vertex[i], pen.fragment[i]
+        cand = np.flatnonzero((face_block == f) & (area2 @ vnormal[a] < 0) & np.all(F != a, axis=1))
+        d = _closest_distance(x[a][None, :], x[F[cand, 0]], x[F[cand, 1]], x[F[cand, 2]])
+        assert pen.face[i] in cand
+        assert abs(-pen.gap[i] - d.min()) <= 1e-12 / CELLS
+        assert d[cand == pen.face[i]][0] <= d.min() + 1e-12 / CELLS
+
+
+def test_face_keys_are_the_key_tuples():
+    arrays, piece, vf, U = _body(1)
+    X, T, F = arrays.points, arrays.tets, arrays.faces
+    fixed, keys = fixed_rows_3d(X, T, F, piece)
+    found = node_to_face_rows(X, F, detect_penetrations_3d(X, T, F, piece, displacement=U))
+    codec = FaceKeys(F)
+    for rows in (fixed, found):
+        codes, tuples = codec.codes(rows), rows.keys()
+        assert codec.decode(codes) == tuples
+        assert np.array_equal(codec.codes_of(tuples), codes)
+        # equal codes exactly where the keys are equal
+        same_code = codes[:, None] == codes[None, :]
+        same_key = np.array([[a == b for b in tuples] for a in tuples[:300]])
+        assert np.array_equal(same_code[:300], same_key)
+    assert isinstance(keys, RowKeys) and list(keys) == fixed.keys() and len(set(keys)) == len(keys)
+    assert codec.codes_of([("f", 0, -1, -2, -3)])[0] == -1
+
+
+def test_gap_rows_are_the_coordinate_conversion():
+    arrays, piece, vf, U = _body(2)
+    X, F = arrays.points, arrays.faces
+    rows = node_to_face_rows(X, F, detect_penetrations_3d(X, arrays.tets, F, piece, displacement=U))
+    # the last row with its slave among its master's vertices: duplicates summed
+    slave = rows.slave.copy()
+    slave[-1] = rows.master[-1, 1]
+    for s in (rows.slave, slave):
+        C, _ = face_gap_rows(X, s, rows.master, rows.bary, rows.normal)
+        m, nv = len(s), len(X)
+        w = np.concatenate([np.ones((m, 1)), -rows.bary], axis=1)
+        verts = np.concatenate([s[:, None], rows.master], axis=1)
+        cols = np.concatenate([verts + c * nv for c in range(3)], axis=1).ravel()
+        vals = np.concatenate([w * rows.normal[:, c:c + 1] for c in range(3)], axis=1).ravel()
+        ref = sp.csr_matrix((vals, (np.repeat(np.arange(m), 12), cols)), shape=(m, 3 * nv))
+        ref.eliminate_zeros()
+        for name in ("indptr", "indices", "data"):
+            a, b = getattr(C, name), getattr(ref, name)
+            assert a.dtype == b.dtype and a.tobytes() == b.tobytes(), name
+
+
+def test_codes_choose_as_tuples():
+    """Two active sets fed the same candidates, one with RowKeys and one with key tuples."""
+    arrays, piece, vf, U = _body(3)
+    geometry = Geometry(arrays=arrays, fragment=piece, seams=None, fixed=np.zeros(0, dtype=np.int64))
+    coded, plain = ActiveSet3d(geometry, 1e-12), ActiveSet3d(geometry, 1e-12)
+    rng = np.random.default_rng(3)
+    for rnd, u in enumerate((U, 0.5 * U, np.zeros_like(U)), start=1):
+        cand = coded.update(u, {"collision": 0.0})
+        assert isinstance(cand.keys, RowKeys)
+        tuples = Candidates(cand.rows, list(cand.keys), cand.gap)
+        a, b = coded.primal_dual(cand), plain.primal_dual(tuples)
+        assert all(np.array_equal(p, q) for p, q in zip(a, b))
+        ka, sa = coded.choose(cand, a[0], a[1], rnd, lambda rows, idx: None)
+        kb, sb = plain.choose(tuples, b[0], b[1], rnd, lambda rows, idx: None)
+        assert np.array_equal(ka, kb) and sa == sb and (rnd > 1 or len(ka) > 100)
+        lam = np.where(rng.random(len(ka)) < 0.2, 1.0, -1.0)      # some rows released
+        assert coded.record(cand.keys, ka, lam, 1.0) == plain.record(tuples.keys, kb, lam, 1.0)
+        assert coded.multipliers == plain.multipliers and len(coded.multipliers) == len(ka)
+        assert np.array_equal(np.sort(coded.tried), np.sort(plain.tried)) and coded.imposed == plain.imposed
