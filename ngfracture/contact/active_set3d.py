@@ -20,7 +20,7 @@ Candidates, each identified by its key ("f", slave, master vertices sorted):
     rows for vertices near but off a face, whose rows then fail the patch test;
   * twin rows (:func:`~ngfracture.contact.junctions3d.fragment_pair_rows`), for every vertex
     that has a copy on another fragment at the bitwise-equal reference point: across the
-    matched faces of coincident lips one row per (copy, neighbouring fragment), one
+    matched faces of coincident lips one row per (copy, neighbouring copy), one
     direction per pair of fragments, so that a junction of several fragments gets a row
     towards each face neighbour; the corners of a common face of two bodies meshed apart
     (no matched face) get the rows of :func:`~ngfracture.contact.rows3d.fragment_twin_rows`.
@@ -28,7 +28,9 @@ Candidates, each identified by its key ("f", slave, master vertices sorted):
     master face would depend on rounding), and with a row identified by its key the
     candidate set of a seam is the same in every round;
   * lip rows (:func:`~ngfracture.contact.rows3d.lip_rows`), one per pair of copies on one
-    fragment: the two lips of a crack that does not cut its fragment through;
+    fragment: the two lips of a crack that does not cut its fragment through; both kinds
+    with the partner-face rows (:mod:`~ngfracture.contact.kinks3d`) where the surface at the
+    copy is not one plane;
 
 - *found* rows: the pairs the detection finds at the configuration of the last solve
   (touching or penetrating), in two passes (every boundary vertex of every fragment a

@@ -7,9 +7,14 @@ two cut planes cross: 4 copies; a point where three cross: 8 copies) a copy touc
 neighbouring fragment across its own lip, and the non-penetration of the copies needs a
 row towards each neighbour.
 
-:func:`fragment_pair_rows` gives, for every copy s on fragment F and every other fragment
-G that shares a matched face with F at s's point, one node-to-face row: slave s, master the
-copy t of s on G, on a matched face of G at t (projection at t, barycentric 1 there). Of
+:func:`fragment_pair_rows` gives, for every copy s on fragment F and every copy t of its
+point on another fragment G with a face matched to one of F's, one node-to-face row: slave
+s, master t, on a matched face of G at t (projection at t, barycentric 1 there). A
+fragment has one copy of a point unless a crack of its own reaches the point (the core's
+vertex at the mouth of a crack in the glass around it has a copy on each lip): then s has
+a row on each. At points of three or more copies, where the surface at t bends (matched
+faces whose normals differ from the chosen one's by more than
+:data:`~ngfracture.contact.kinks3d.KINK`), every such face gets its row as well. Of
 the matched faces of G at t it takes the one whose unit normal is nearest to their
 area-weighted mean normal (the lip's normal between F and G at that point; ties: the
 smaller face), so the row's direction is that of the lip between the two fragments, not of
@@ -34,6 +39,7 @@ twin opposing the slave's vertex normal), which the patch test needs.
 """
 import numpy as np
 
+from .kinks3d import KINK
 from .rows3d import NodeToFaceRows, face_gap_rows, fragment_twin_rows
 
 __all__ = ["fragment_pair_rows", "covered_pairs"]
@@ -85,7 +91,7 @@ def _checked(points, faces, vertex_fragment):
 
 
 def fragment_pair_rows(points, faces, vertex_fragment):
-    """Twin rows of fragmented bodies: one row per (copy, neighbouring fragment), one direction per pair.
+    """Twin rows of fragmented bodies: one row per (copy, neighbouring copy), one direction per pair.
 
     See the module docstring for the rule and why.
 
@@ -132,17 +138,27 @@ def fragment_pair_rows(points, faces, vertex_fragment):
     p = X[F]
     area2 = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
     unit = area2 / np.linalg.norm(area2, axis=1)[:, None]
-    group = np.lexsort((ff[face], slave))                                 # by (slave, master fragment)
-    slave, face, k = slave[group], face[group], k[group]
-    start = np.r_[True, (slave[1:] != slave[:-1]) | (ff[face][1:] != ff[face][:-1])]
+    copy = F[face, k]
+    group = np.lexsort((copy, slave))                                     # by (slave, master copy)
+    slave, face, k, copy = slave[group], face[group], k[group], copy[group]
+    start = np.r_[True, (slave[1:] != slave[:-1]) | (copy[1:] != copy[:-1])]
     owner = np.cumsum(start) - 1
     mean = np.zeros((owner[-1] + 1, 3))
     np.add.at(mean, owner, area2[face])
     score = np.einsum("ij,ij->i", unit[face], mean[owner])
     best = np.lexsort((face, -score, owner))
     best = best[np.r_[True, owner[best][1:] != owner[best][:-1]]]
-    slave, face, k = slave[best], face[best], k[best]
-    order = np.lexsort((ff[face], slave, vf[slave]))
+    # where three or more copies meet (a crack reaching an interface) and the surface at the
+    # master copy bends, every matched face there off the best one's plane gets its row too
+    copies = np.bincount(pid[pid >= 0])
+    chosen = np.empty(owner[-1] + 1, dtype=np.int64)
+    chosen[owner[best]] = face[best]
+    bend = 1.0 - np.einsum("ij,ij->i", unit[face], unit[chosen[owner]]) > KINK
+    keep = np.zeros(len(face), dtype=bool)
+    keep[best] = True
+    keep |= bend & (copies[pid[slave]] >= 3)
+    slave, face, k = slave[keep], face[keep], k[keep]
+    order = np.lexsort((face, ff[face], slave, vf[slave]))
     slave, face, k = slave[order], face[order], k[order]
     bary = np.zeros((len(slave), 3))
     bary[np.arange(len(slave)), k] = 1.0

@@ -44,6 +44,9 @@ Vertices whose copy on the other fragment sits at the same reference point (corn
 common face of two bodies meshed apart, closed seams of a crack) are left out by the
 detection; :func:`twin_rows` gives them a node-to-face row on a face at the twin. Rows of
 both passes at such a twin are the same row reversed, and the redundancy removal keeps one.
+Where the surface at the copy is not one plane (a point with three or more copies, a kinked
+crack lip) a slave also gets a row on every coincident face at the copy (partner-face rows,
+:mod:`ngfracture.contact.kinks3d`).
 The tributary area of a node, by which a force is a pressure, is the consistent nodal area
 of the surface: the integral of its hat function, a third of the area of every face at
 the node (:func:`nodal_areas`).
@@ -61,6 +64,7 @@ from typing import ClassVar
 import numpy as np
 import scipy.sparse as sp
 
+from .kinks3d import KINK, partner_faces, point_groups
 from .rows import RowTable
 
 __all__ = ["NodeToFaceRows", "no_face_rows", "node_to_face_rows", "twin_rows", "fragment_twin_rows", "lip_rows", "face_gap_rows",
@@ -283,6 +287,8 @@ def twin_rows(points, faces, slave):
     area-weighted sum of the normals of its own boundary faces), with the projection at t
     (barycentric 1 there): at a flat interface the interface's normal. Slaves whose faces at
     the twin all face along their normal (dot >= 0) get no row. Ties go to the smaller face.
+    At points with three or more copies, s > t also gets a row on every face at t coincident
+    with a face at s (:func:`~ngfracture.contact.kinks3d.partner_faces`).
 
     Parameters
     ----------
@@ -297,7 +303,7 @@ def twin_rows(points, faces, slave):
     Returns
     -------
     NodeToFaceRows
-        Sorted by slave vertex; ``dist`` is the gap at the reference configuration (0).
+        Sorted by slave vertex, then face; ``dist`` is the gap at the reference configuration (0).
 
     Raises
     ------
@@ -313,7 +319,8 @@ def twin_rows(points, faces, slave):
         raise ValueError(f"slave must be a boolean mask of shape ({nv},), got {mask.dtype} {mask.shape}")
     s, t = _copy_pairs(X, F)
     pick = mask[s] & ~mask[t]
-    return _rows_at_copies(X, F, s[pick], t[pick], s[pick])
+    rows = _with_junction_rows(X, F, _rows_at_copies(X, F, s[pick], t[pick], s[pick]), s[pick], t[pick], False)
+    return rows.subset(np.lexsort((rows.face, rows.slave)))
 
 
 def fragment_twin_rows(points, faces, vertex_fragment):
@@ -337,7 +344,7 @@ def fragment_twin_rows(points, faces, vertex_fragment):
     Returns
     -------
     NodeToFaceRows
-        Sorted by the slave's fragment, then by slave vertex.
+        Sorted by the slave's fragment, then by slave vertex, then face.
 
     Raises
     ------
@@ -353,8 +360,8 @@ def fragment_twin_rows(points, faces, vertex_fragment):
         raise ValueError(f"vertex_fragment must be integers of shape ({nv},), got {vf.dtype} {vf.shape}")
     s, t = _copy_pairs(X, F)
     pick = vf[s] != vf[t]
-    rows = _rows_at_copies(X, F, s[pick], t[pick], s[pick])
-    return rows.subset(np.lexsort((rows.slave, vf[rows.slave])))
+    rows = _with_junction_rows(X, F, _rows_at_copies(X, F, s[pick], t[pick], s[pick]), s[pick], t[pick], False)
+    return rows.subset(np.lexsort((rows.face, rows.slave, vf[rows.slave])))
 
 
 def lip_rows(points, faces, vertex_fragment):
@@ -370,7 +377,9 @@ def lip_rows(points, faces, vertex_fragment):
     the same row only while the two faces stay parallel; once the lips deform their
     normals differ, the pair of rows is no longer dependent and imposed together they
     block the slip between the copies. At a junction of three or more copies every pair
-    has its row.
+    has its row. Where the crack surface is kinked, s also gets a row on every face at t
+    coincident with a face at s whose normal differs from the row's by more than
+    :data:`~ngfracture.contact.kinks3d.KINK`.
 
     Parameters
     ----------
@@ -384,7 +393,7 @@ def lip_rows(points, faces, vertex_fragment):
     Returns
     -------
     NodeToFaceRows
-        Sorted by (slave, copy), the slave the higher-numbered copy; ``dist`` is the gap at
+        Sorted by (slave, copy, face), the slave the higher-numbered copy; ``dist`` is the gap at
         the reference configuration (0).
 
     Raises
@@ -402,16 +411,14 @@ def lip_rows(points, faces, vertex_fragment):
     s, t = _copy_pairs(X, F)
     pick = (frag[s] == frag[t]) & (s > t)
     s, t = s[pick], t[pick]
-    return _rows_at_copies(X, F, s, t, s * nv + t)
+    rows = _with_junction_rows(X, F, _rows_at_copies(X, F, s, t, s * nv + t), s, t, True)
+    copy = rows.master[np.arange(len(rows)), np.argmax(rows.bary, axis=1)] if len(rows) else rows.slave
+    return rows.subset(np.lexsort((rows.face, copy, rows.slave)))
 
 
 def _copy_pairs(X, F):
     """Every ordered pair (s, t) of boundary vertices at the bitwise-equal reference point, s == t included."""
-    on = np.flatnonzero(np.bincount(F.ravel(), minlength=len(X)))        # the boundary vertices, increasing
-    P = X[on]
-    order = np.lexsort((P[:, 2], P[:, 1], P[:, 0]))                     # equal points together, stable
-    on, P = on[order], P[order]
-    group = np.cumsum(np.r_[False, np.any(P[1:] != P[:-1], axis=1)])
+    on, group = point_groups(X, F)
     first = np.searchsorted(group, group)                                  # start of each vertex's group
     size = np.searchsorted(group, group, side="right") - first
     who, other = _ranges(first, size)
@@ -448,6 +455,27 @@ def _rows_at_copies(X, F, s, t, per):
     master, normal = F[face], unit[face]
     g = _gap_offset(X, s, master, bary, normal)
     return NodeToFaceRows(slave=s, master=master, face=face, bary=bary, normal=normal, dist=g.copy(), g=g, nv=nv)
+
+
+def _with_junction_rows(X, F, rows, s, t, lips):
+    """``rows`` and rows on the partner faces of :func:`~ngfracture.contact.kinks3d.partner_faces` it lacks."""
+    slave, face, k = partner_faces(X, F, s, t, all_pairs=lips)
+    bary = np.zeros((len(slave), 3))
+    bary[np.arange(len(slave)), k] = 1.0
+    p = X[F[face]]
+    area2 = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+    normal = area2 / np.linalg.norm(area2, axis=1)[:, None]
+    keep = ~np.isin(slave * len(F) + face, rows.slave * len(F) + rows.face)
+    if lips and len(rows):        # only faces at a kink against the pair's row (kinks3d.KINK)
+        pair = rows.slave * len(X) + rows.master[np.arange(len(rows)), np.argmax(rows.bary, axis=1)]
+        want = slave * len(X) + F[face, k]
+        own = np.minimum(np.searchsorted(pair, want), len(rows) - 1)        # rows are sorted by pair
+        keep &= (pair[own] != want) | (1.0 - np.einsum("ij,ij->i", normal, rows.normal[own]) > KINK)
+    slave, face, bary, normal = slave[keep], face[keep], bary[keep], normal[keep]
+    g = _gap_offset(X, slave, F[face], bary, normal)
+    extra = NodeToFaceRows(slave=slave, master=F[face], face=face, bary=bary, normal=normal, dist=g.copy(), g=g,
+                           nv=len(X))
+    return NodeToFaceRows.stack([rows, extra])
 
 
 def _ranges(start, count):
