@@ -193,12 +193,6 @@ def _fixed_rows(points, tets, faces, fragment, codec):
     return rows.subset(first), RowKeys(codes[first], codec)
 
 
-def _pair_codes(pairs, nv):
-    """(vertex, fragment) pairs as int64 codes fragment * nv + vertex."""
-    pairs = np.array(list(pairs), dtype=np.int64).reshape(-1, 2)
-    return pairs[:, 1] * nv + pairs[:, 0]
-
-
 def _vertex_fragment(nv, tets, fragment):
     """The fragment of every vertex (-1: in no tetrahedron)."""
     vertex_fragment = np.full(nv, -1, dtype=np.int64)
@@ -256,8 +250,7 @@ class ActiveSet3d(ActiveSet):
             self.seam_rows, self.seam_keys = _fixed_rows(a.points, a.tets, a.faces, self.geometry.fragment, self.codec)
             timings["collision"] += time.perf_counter() - t0
             self.vertex_fragment = _vertex_fragment(len(a.points), a.tets, self.geometry.fragment)
-            self.covered = _pair_codes(covered_pairs(a.points, self.seam_rows, self.vertex_fragment),
-                                       len(a.points))
+            self.covered = covered_pairs(a.points, self.seam_rows, self.vertex_fragment)
         elif self.moving:
             old = NodeToFaceRows.stack([self.seam_rows, self.n2s])
             relinearised = relinearise_node_to_face(old, a.points, U)

@@ -39,7 +39,7 @@ twin opposing the slave's vertex normal), which the patch test needs.
 """
 import numpy as np
 
-from .kinks3d import KINK
+from .kinks3d import KINK, point_groups
 from .rows3d import NodeToFaceRows, face_gap_rows, fragment_twin_rows
 
 __all__ = ["fragment_pair_rows", "covered_pairs"]
@@ -47,11 +47,7 @@ __all__ = ["fragment_pair_rows", "covered_pairs"]
 
 def _point_ids(X, F):
     """Per vertex the number of its reference point among the boundary vertices (-1 off the boundary)."""
-    on = np.unique(F)
-    P = X[on]
-    order = np.lexsort((P[:, 2], P[:, 1], P[:, 0]))
-    on, P = on[order], P[order]
-    group = np.cumsum(np.r_[False, np.any(P[1:] != P[:-1], axis=1)]) if len(on) else np.zeros(0, dtype=np.int64)
+    on, group = point_groups(X, F)
     pid = np.full(len(X), -1, dtype=np.int64)
     pid[on] = group
     return pid
@@ -186,8 +182,8 @@ def covered_pairs(points, rows, vertex_fragment):
 
     Returns
     -------
-    set of tuple
-        (vertex, fragment) pairs of Python ints.
+    numpy.ndarray of int64
+        The pairs as codes fragment * nv + vertex (nv = len(points)), sorted, unique.
 
     Raises
     ------
@@ -199,13 +195,11 @@ def covered_pairs(points, rows, vertex_fragment):
     if X.ndim != 2 or X.shape[1] != 3 or vf.shape != (len(X),) or rows.nv != len(X):
         raise ValueError(f"covered_pairs: points {X.shape}, vertex_fragment {vf.shape} and rows of "
                          f"{rows.nv} vertices do not fit")
-    if not len(rows):
-        return set()
-    s, m = np.asarray(rows.slave), np.asarray(rows.master)
-    out = set(zip(s.tolist(), vf[m[:, 0]].tolist()))
+    nv = len(X)
+    s, m = np.asarray(rows.slave, dtype=np.int64), np.asarray(rows.master, dtype=np.int64).reshape(-1, 3)
+    vf = vf.astype(np.int64)
     copy = np.all(X[m] == X[s][:, None, :], axis=2)                      # [row, corner]
     has = copy.any(axis=1) & (vf[m[:, 0]] != vf[s])
     t = m[np.flatnonzero(has), copy[has].argmax(axis=1)]
-    out.update(zip(t.tolist(), vf[s[has]].tolist()))
-    return out
+    return np.unique(np.r_[vf[m[:, 0]] * nv + s, vf[s[has]] * nv + t])
 
