@@ -351,13 +351,7 @@ def fragment_twin_rows(points, faces, vertex_fragment):
     ValueError
         On wrong shapes or vertex numbers out of range.
     """
-    X = _coordinates(points, "points")
-    nv = len(X)
-    F = np.asarray(faces)
-    F = _vertices(F, "faces", nv, (F.shape[0] if F.ndim == 2 else -1, 3))
-    vf = np.asarray(vertex_fragment)
-    if vf.shape != (nv,) or (vf.size and not np.issubdtype(vf.dtype, np.integer)):
-        raise ValueError(f"vertex_fragment must be integers of shape ({nv},), got {vf.dtype} {vf.shape}")
+    X, F, vf = _fragment_arrays(points, faces, vertex_fragment)
     s, t = _copy_pairs(X, F)
     pick = vf[s] != vf[t]
     rows = _with_junction_rows(X, F, _rows_at_copies(X, F, s[pick], t[pick], s[pick]), s[pick], t[pick], False)
@@ -401,19 +395,26 @@ def lip_rows(points, faces, vertex_fragment):
     ValueError
         On wrong shapes or vertex numbers out of range.
     """
-    X = _coordinates(points, "points")
+    X, F, frag = _fragment_arrays(points, faces, vertex_fragment)
     nv = len(X)
-    F = np.asarray(faces)
-    F = _vertices(F, "faces", nv, (F.shape[0] if F.ndim == 2 else -1, 3))
-    frag = np.asarray(vertex_fragment)
-    if frag.shape != (nv,) or not np.issubdtype(frag.dtype, np.integer):
-        raise ValueError(f"vertex_fragment must be integers of shape ({nv},), got {frag.dtype} {frag.shape}")
     s, t = _copy_pairs(X, F)
     pick = (frag[s] == frag[t]) & (s > t)
     s, t = s[pick], t[pick]
     rows = _with_junction_rows(X, F, _rows_at_copies(X, F, s, t, s * nv + t), s, t, True)
     copy = rows.master[np.arange(len(rows)), np.argmax(rows.bary, axis=1)] if len(rows) else rows.slave
     return rows.subset(np.lexsort((rows.face, copy, rows.slave)))
+
+
+def _fragment_arrays(points, faces, vertex_fragment):
+    """Coordinates, faces and the fragment of every vertex, checked (ValueError naming the bad one)."""
+    X = _coordinates(points, "points")
+    nv = len(X)
+    F = np.asarray(faces)
+    F = _vertices(F, "faces", nv, (F.shape[0] if F.ndim == 2 else -1, 3))
+    vf = np.asarray(vertex_fragment)
+    if vf.shape != (nv,) or (vf.size and not np.issubdtype(vf.dtype, np.integer)):
+        raise ValueError(f"vertex_fragment must be integers of shape ({nv},), got {vf.dtype} {vf.shape}")
+    return X, F, vf
 
 
 def _copy_pairs(X, F):
