@@ -40,7 +40,7 @@ twin opposing the slave's vertex normal), which the patch test needs.
 import numpy as np
 
 from .kinks3d import KINK, point_groups
-from .rows3d import NodeToFaceRows, face_gap_rows, fragment_twin_rows
+from .rows3d import NodeToFaceRows, face_gap_rows, fragment_twin_rows, no_face_rows
 
 __all__ = ["fragment_pair_rows", "covered_pairs"]
 
@@ -51,6 +51,20 @@ def _point_ids(X, F):
     pid = np.full(len(X), -1, dtype=np.int64)
     pid[on] = group
     return pid
+
+
+def _on_several_fragments(pid, vf):
+    """Per vertex: its reference point has copies on more than one fragment."""
+    on = np.flatnonzero(pid >= 0)
+    out = np.zeros(len(pid), dtype=bool)
+    if not len(on):
+        return out
+    low = np.full(pid.max() + 1, np.iinfo(np.int64).max)
+    high = np.full(pid.max() + 1, np.iinfo(np.int64).min)
+    np.minimum.at(low, pid[on], vf[on])
+    np.maximum.at(high, pid[on], vf[on])
+    out[on] = low[pid[on]] != high[pid[on]]
+    return out
 
 
 def _matched_faces(F, pid, face_fragment):
@@ -120,8 +134,10 @@ def fragment_pair_rows(points, faces, vertex_fragment):
     a, b = _matched_faces(F, pid, ff)
     matched = np.zeros(nv, dtype=bool)
     matched[F[a].ravel()] = True
-    fallback = fragment_twin_rows(X, F, vf)
-    fallback = fallback.subset(np.flatnonzero(~matched[fallback.slave]))
+    fallback = no_face_rows(nv)
+    if np.any(_on_several_fragments(pid, vf) & ~matched):      # else every fallback row is dropped
+        fallback = fragment_twin_rows(X, F, vf)
+        fallback = fallback.subset(np.flatnonzero(~matched[fallback.slave]))
     one_way = ff[a] > ff[b]
     a, b = a[one_way], b[one_way]
     if not len(a):

@@ -400,6 +400,8 @@ def lip_rows(points, faces, vertex_fragment):
     s, t = _copy_pairs(X, F)
     pick = (frag[s] == frag[t]) & (s > t)
     s, t = s[pick], t[pick]
+    if not len(s):              # no crack inside a fragment
+        return no_face_rows(nv)
     rows = _with_junction_rows(X, F, _rows_at_copies(X, F, s, t, s * nv + t), s, t, True)
     copy = rows.master[np.arange(len(rows)), np.argmax(rows.bary, axis=1)] if len(rows) else rows.slave
     return rows.subset(np.lexsort((rows.face, copy, rows.slave)))
