@@ -17,7 +17,7 @@ import scene_references  # noqa: E402
 def _check(name):
     import json
     stored = json.loads(scene_references.REFERENCE_FILE.read_text())[name]
-    found = scene_references.scene_fingerprint(name)
+    found = scene_references.reference_fingerprint(name)
     assert not scene_references.differences(stored, found), scene_references.differences(stored, found)
 
 
