@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <tuple>
@@ -185,19 +186,28 @@ namespace ngfracture
   {
     [[noreturn]] void Bad (const std::string & what) { throw std::invalid_argument("ngfracture.DetectPenetrations3d: " + what); }
 
-    // What the search needs besides the arrays: fragment per vertex and per face, the
-    // boundary vertices, their (area-weighted) outward normals, unit face normals.
-    struct Derived
+    // What the search needs besides the arrays and does not move: fragment per vertex and
+    // per face, the boundary vertices, the tetrahedra at every vertex (checked here), and
+    // (MakeTopology) the copies of every boundary vertex and the lip flags.
+    struct Topology
     {
       std::vector<int32_t> vfrag, ffrag, bverts;
-      std::vector<double> vnormal, fnormal;
       std::vector<uint8_t> lip;    // the vertex has a copy on its own fragment (a lip of a crack inside it)
+      std::vector<int64_t> start, at;     // the tetrahedra at vertex v: at[start[v] .. start[v+1])
+    };
+
+    // What the search needs at the current positions: the topology, the boundary vertices'
+    // (area-weighted) outward normals, unit face normals, the faces' boxes.
+    struct Derived
+    {
+      const std::vector<int32_t> & vfrag, & ffrag, & bverts;
+      const std::vector<uint8_t> & lip;
+      std::vector<double> vnormal, fnormal;
       std::vector<double> flo, fhi;       // boxes of the boundary faces (current positions)
     };
 
-    Derived Derive (const TetMesh3 & m)
+    void DeriveTopology (const TetMesh3 & m, Topology & D)
     {
-      Derived D;
       D.vfrag.assign(m.nv, -1);
       for (int64_t t = 0; t < m.ne; t++)
         for (int k = 0; k < 4; k++)
@@ -211,7 +221,8 @@ namespace ngfracture
           }
       // a face's fragment is its vertices' (fragments share no vertex); it must be a face
       // of a tetrahedron: one of the tetrahedra at its first vertex holds all three
-      std::vector<int64_t> start(m.nv + 1, 0), at;
+      std::vector<int64_t> & start = D.start, & at = D.at;
+      start.assign(m.nv + 1, 0);
       for (int64_t t = 0; t < m.ne; t++)
         for (int k = 0; k < 4; k++) start[m.tets[4*t+k] + 1]++;
       for (int64_t v = 0; v < m.nv; v++) start[v+1] += start[v];
@@ -237,25 +248,31 @@ namespace ngfracture
             }
         }
       std::vector<uint8_t> onb(m.nv, 0);
+      for (int64_t f = 0; f < m.nf; f++)
+        {
+          if (D.ffrag[f] < 0) Bad("faces[" + std::to_string(f) + "] is not a face of any tetrahedron");
+          for (int k = 0; k < 3; k++) onb[m.faces[3*f+k]] = 1;
+        }
+      D.bverts.clear();
+      for (int64_t v = 0; v < m.nv; v++)
+        if (onb[v]) D.bverts.push_back(int32_t(v));
+    }
+
+    // The normals of Derived at the current positions.
+    void DeriveNormals (const TetMesh3 & m, Derived & D)
+    {
       D.vnormal.assign(3*m.nv, 0.0);
       D.fnormal.assign(3*m.nf, 0.0);
       for (int64_t f = 0; f < m.nf; f++)
         {
-          if (D.ffrag[f] < 0) Bad("faces[" + std::to_string(f) + "] is not a face of any tetrahedron");
           const int32_t * F = m.faces + 3*f;
           double e0[3], e1[3], n[3];
           Sub(m.x + 3*F[1], m.x + 3*F[0], e0); Sub(m.x + 3*F[2], m.x + 3*F[0], e1); Cross(e0, e1, n);
           double len = std::sqrt(Dot(n, n));
           for (int d = 0; d < 3; d++) D.fnormal[3*f+d] = len > 0 ? n[d] / len : 0.0;
           for (int k = 0; k < 3; k++)
-            {
-              onb[F[k]] = 1;
-              for (int d = 0; d < 3; d++) D.vnormal[3*F[k]+d] += n[d];
-            }
+            for (int d = 0; d < 3; d++) D.vnormal[3*F[k]+d] += n[d];
         }
-      for (int64_t v = 0; v < m.nv; v++)
-        if (onb[v]) D.bverts.push_back(int32_t(v));
-      return D;
     }
 
     // The grid geometry: origin at the low corner of the boundary vertices, cell size the
@@ -337,17 +354,17 @@ namespace ngfracture
       std::vector<int64_t> start;          // group g: members[start[g] .. start[g+1])
       std::vector<int32_t> members;
 
-      // v's first copy on fragment F (-1: none)
-      int32_t Twin (const Derived & D, int32_t v, int32_t F) const
+      // v's first copy on fragment F (-1: none); vfrag the fragment of every vertex
+      int32_t Twin (const std::vector<int32_t> & vfrag, int32_t v, int32_t F) const
       {
         int32_t g = group[v];
         for (int64_t s = start[g]; s < start[g+1]; s++)
-          if (members[s] != v && D.vfrag[members[s]] == F) return members[s];
+          if (members[s] != v && vfrag[members[s]] == F) return members[s];
         return -1;
       }
     };
 
-    Copies MakeCopies (const TetMesh3 & m, const Derived & D)
+    Copies MakeCopies (const TetMesh3 & m, const Topology & D)
     {
       std::unordered_map<std::array<uint64_t,3>, int32_t, BitsHash> index;
       Copies c;
@@ -374,12 +391,12 @@ namespace ngfracture
     // tetrahedron is decided and not tested again: a pair whose vertex sits on its twin of
     // that fragment (a closed seam, or a closed lip) is no hit, only counted; any other is
     // a hit in that tetrahedron, the smallest that holds it (the sweep goes in increasing
-    // order). The twin is looked up only for a pair found.
+    // order). The twin is looked up only for a pair found. Pairs in ``decided`` are not
+    // tested (DecideClosedSeams).
     std::vector<Hit> SweepTets (const TetMesh3 & m, const Derived & D, const Copies & copies, const HashGrid & g,
-                                Collision3Stats & st)
+                                Decided & decided, Collision3Stats & st)
     {
       std::vector<Hit> hits;
-      Decided decided(m.nv);
       int64_t closed = 0;
       for (int64_t t = 0; t < m.ne; t++)
         {
@@ -416,7 +433,7 @@ namespace ngfracture
                       orientation = Orient3dSign(m.x + 3*T[0], m.x + 3*T[1], m.x + 3*T[2], m.x + 3*T[3]);
                     if (!InClosedTet(m.x, T, p, orientation)) return;
                     decided.Insert(v, F);
-                    int32_t twin = copies.Twin(D, v, F);
+                    int32_t twin = copies.Twin(D.vfrag, v, F);
                     bool seam = twin >= 0 && std::memcmp(p, m.x + 3*twin, 3 * sizeof(double)) == 0;
                     if (seam) closed++;
                     else hits.emplace_back(v, F, int32_t(t));
@@ -552,56 +569,145 @@ namespace ngfracture
 
   }
 
+  namespace
+  {
+    // The topology of a mesh, its copies and lip flags (all from the connectivity and the
+    // reference points).
+    void MakeTopology (const TetMesh3 & m, Topology & T, Copies & copies)
+    {
+      DeriveTopology(m, T);
+      copies = MakeCopies(m, T);
+      T.lip.assign(m.nv, 0);           // two copies of a point on one fragment: the lips of a crack inside it
+      for (size_t g = 0; g + 1 < copies.start.size(); g++)
+        for (int64_t i = copies.start[g]; i < copies.start[g+1]; i++)
+          for (int64_t j = i + 1; j < copies.start[g+1]; j++)
+            {
+              int32_t a = copies.members[i], b = copies.members[j];
+              if (T.vfrag[a] == T.vfrag[b]) T.lip[a] = T.lip[b] = 1;
+            }
+    }
+
+    // The closed seams, decided before the sweep: a pair (v, F) whose vertex sits at the
+    // current point of its twin on F (v's first copy there, Copies::Twin). The sweep finds
+    // such a pair in a tetrahedron of F at the twin (v is a corner of it, so in its closed
+    // volume and box), unless every tetrahedron there is flat, and counts it as a closed
+    // seam whichever tetrahedron it finds it in: here it is counted and decided without the
+    // exact tests of all the tetrahedra around it. Pairs whose twin has only flat
+    // tetrahedra are left to the sweep.
+    int64_t DecideClosedSeams (const TetMesh3 & m, const Topology & T, const Copies & copies, Decided & decided)
+    {
+      int64_t closed = 0;
+      for (int32_t v : T.bverts)
+        {
+          int32_t g = copies.group[v];
+          for (int64_t s = copies.start[g]; s < copies.start[g+1]; s++)
+            {
+              int32_t w = copies.members[s], F = T.vfrag[w];
+              if (w == v || copies.Twin(T.vfrag, v, F) != w) continue;      // first copy on F only
+              if (std::memcmp(m.x + 3*v, m.x + 3*w, 3 * sizeof(double)) != 0) continue;
+              bool solid = false;
+              for (int64_t a = T.start[w]; a < T.start[w+1] && !solid; a++)
+                {
+                  const int32_t * t = m.tets + 4*T.at[a];
+                  solid = t[0] != v && t[1] != v && t[2] != v && t[3] != v
+                    && Orient3dSign(m.x + 3*t[0], m.x + 3*t[1], m.x + 3*t[2], m.x + 3*t[3]) != 0;
+                }
+              if (!solid) continue;
+              decided.Insert(v, F);
+              closed++;
+            }
+        }
+      return closed;
+    }
+
+    std::vector<Penetration3> Detect (const TetMesh3 & m, const Topology & T, const Copies & copies,
+                                      Collision3Stats * stats)
+    {
+      Collision3Stats st;
+      Derived D { T.vfrag, T.ffrag, T.bverts, T.lip, {}, {}, {}, {} };
+      DeriveNormals(m, D);
+      st.boundary_vertices = int64_t(D.bverts.size());
+      std::vector<Penetration3> out;
+      if (D.bverts.empty() || m.ne == 0) { if (stats) *stats = st; return out; }
+      HashGrid vg;
+      SetupGrid(m, D, vg);
+      st.cell = vg.h;
+      std::vector<double> lo(3*D.bverts.size()), hi;
+      for (size_t s = 0; s < D.bverts.size(); s++)
+        std::copy(m.x + 3*D.bverts[s], m.x + 3*D.bverts[s] + 3, &lo[3*s]);
+      vg.Build(lo, lo);
+      for (auto & it : vg.items) it = D.bverts[it];        // grid items: vertex numbers
+      Decided decided(m.nv);
+      int64_t closed = DecideClosedSeams(m, T, copies, decided);
+      std::vector<Hit> hits = SweepTets(m, D, copies, vg, decided, st);
+      st.closed_seams += closed;
+      if (hits.empty()) { if (stats) *stats = st; return out; }
+
+      HashGrid fg = vg;                                    // same cells, boundary faces
+      lo.assign(3*m.nf, 0.0); hi.assign(3*m.nf, 0.0);
+      for (int64_t f = 0; f < m.nf; f++)
+        for (int d = 0; d < 3; d++)
+          {
+            double a = m.x[3*m.faces[3*f]+d], b = m.x[3*m.faces[3*f+1]+d], c = m.x[3*m.faces[3*f+2]+d];
+            lo[3*f+d] = std::min({a, b, c}); hi[3*f+d] = std::max({a, b, c});
+          }
+      fg.items.clear(); fg.range.clear();
+      fg.Build(lo, hi);
+      D.flo = std::move(lo); D.fhi = std::move(hi);
+
+      for (size_t s = 0; s < hits.size(); s++)
+        {
+          auto [v, F, t] = hits[s];
+          if (s > 0 && std::get<0>(hits[s-1]) == v && std::get<1>(hits[s-1]) == F) continue;
+          Penetration3 pen;
+          pen.vertex = v; pen.fragment = F; pen.tet = t;
+          pen.twin = copies.Twin(D.vfrag, v, F);             // closed seams were left out by the sweep
+          if (!MasterFace(m, D, fg, v, F, pen)) continue;
+          out.push_back(pen);
+        }
+      if (stats) *stats = st;
+      return out;
+    }
+  }
+
   std::vector<Penetration3> DetectPenetrations3 (const TetMesh3 & m, Collision3Stats * stats)
   {
-    Collision3Stats st;
-    Derived D = Derive(m);
-    st.boundary_vertices = int64_t(D.bverts.size());
-    std::vector<Penetration3> out;
-    if (D.bverts.empty() || m.ne == 0) { if (stats) *stats = st; return out; }
-    HashGrid vg;
-    SetupGrid(m, D, vg);
-    st.cell = vg.h;
-    std::vector<double> lo(3*D.bverts.size()), hi;
-    for (size_t s = 0; s < D.bverts.size(); s++)
-      std::copy(m.x + 3*D.bverts[s], m.x + 3*D.bverts[s] + 3, &lo[3*s]);
-    vg.Build(lo, lo);
-    for (auto & it : vg.items) it = D.bverts[it];        // grid items: vertex numbers
-    Copies copies = MakeCopies(m, D);
-    D.lip.assign(m.nv, 0);           // two copies of a point on one fragment: the lips of a crack inside it
-    for (size_t g = 0; g + 1 < copies.start.size(); g++)
-      for (int64_t i = copies.start[g]; i < copies.start[g+1]; i++)
-        for (int64_t j = i + 1; j < copies.start[g+1]; j++)
-          {
-            int32_t a = copies.members[i], b = copies.members[j];
-            if (D.vfrag[a] == D.vfrag[b]) D.lip[a] = D.lip[b] = 1;
-          }
-    std::vector<Hit> hits = SweepTets(m, D, copies, vg, st);
-    if (hits.empty()) { if (stats) *stats = st; return out; }
+    Topology T;
+    Copies copies;
+    MakeTopology(m, T, copies);
+    return Detect(m, T, copies, stats);
+  }
 
-    HashGrid fg = vg;                                    // same cells, boundary faces
-    lo.assign(3*m.nf, 0.0); hi.assign(3*m.nf, 0.0);
-    for (int64_t f = 0; f < m.nf; f++)
-      for (int d = 0; d < 3; d++)
-        {
-          double a = m.x[3*m.faces[3*f]+d], b = m.x[3*m.faces[3*f+1]+d], c = m.x[3*m.faces[3*f+2]+d];
-          lo[3*f+d] = std::min({a, b, c}); hi[3*f+d] = std::max({a, b, c});
-        }
-    fg.items.clear(); fg.range.clear();
-    fg.Build(lo, hi);
-    D.flo = std::move(lo); D.fhi = std::move(hi);
+  struct PenetrationDetector3::Impl
+  {
+    std::vector<double> X;
+    std::vector<int32_t> tets, faces, fragment;
+    int64_t nv, ne, nf;
+    Topology T;
+    Copies copies;
 
-    for (size_t s = 0; s < hits.size(); s++)
-      {
-        auto [v, F, t] = hits[s];
-        if (s > 0 && std::get<0>(hits[s-1]) == v && std::get<1>(hits[s-1]) == F) continue;
-        Penetration3 pen;
-        pen.vertex = v; pen.fragment = F; pen.tet = t;
-        pen.twin = copies.Twin(D, v, F);                   // closed seams were left out by the sweep
-        if (!MasterFace(m, D, fg, v, F, pen)) continue;
-        out.push_back(pen);
-      }
-    if (stats) *stats = st;
-    return out;
+    TetMesh3 Mesh (const double * x) const
+    { return TetMesh3 { X.data(), x, tets.data(), faces.data(), fragment.data(), nv, ne, nf }; }
+  };
+
+  PenetrationDetector3::PenetrationDetector3 (const TetMesh3 & m)
+    : impl_(std::make_unique<Impl>())
+  {
+    Impl & I = *impl_;
+    I.X.assign(m.X, m.X + 3*m.nv);
+    I.tets.assign(m.tets, m.tets + 4*m.ne);
+    I.faces.assign(m.faces, m.faces + 3*m.nf);
+    I.fragment.assign(m.fragment, m.fragment + m.ne);
+    I.nv = m.nv; I.ne = m.ne; I.nf = m.nf;
+    MakeTopology(I.Mesh(I.X.data()), I.T, I.copies);
+  }
+
+  PenetrationDetector3::~PenetrationDetector3 () = default;
+
+  int64_t PenetrationDetector3::NumVertices () const { return impl_->nv; }
+
+  std::vector<Penetration3> PenetrationDetector3::Detect (const double * x, Collision3Stats * stats) const
+  {
+    return ngfracture::Detect(impl_->Mesh(x), impl_->T, impl_->copies, stats);
   }
 }

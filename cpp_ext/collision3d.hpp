@@ -10,6 +10,7 @@
 // hashed grid of the boundary triangles, searched ring by ring around the vertex.
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 namespace ngfracture
@@ -50,6 +51,25 @@ namespace ngfracture
   // through), except closed seams (the vertex's twin on that fragment at the same current
   // point), sorted by (vertex, fragment). Throws std::invalid_argument on inconsistent input.
   std::vector<Penetration3> DetectPenetrations3 (const TetMesh3 & mesh, Collision3Stats * stats);
+
+  // DetectPenetrations3 for one mesh at many current positions: the work that depends on
+  // the connectivity and the reference points only (fragment of every vertex and face,
+  // boundary vertices, tetrahedra at every vertex, copies, lip flags) is done once, on a
+  // copy of the mesh's arrays, so it cannot go stale. Detect(x) returns what
+  // DetectPenetrations3 returns for the mesh at x, bit for bit.
+  class PenetrationDetector3
+  {
+  public:
+    explicit PenetrationDetector3 (const TetMesh3 & mesh);   // mesh.x is not used
+    ~PenetrationDetector3 ();
+    PenetrationDetector3 (const PenetrationDetector3 &) = delete;
+    PenetrationDetector3 & operator= (const PenetrationDetector3 &) = delete;
+    int64_t NumVertices () const;
+    std::vector<Penetration3> Detect (const double * x, Collision3Stats * stats) const;
+  private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+  };
 
   // Exact: p lies in the closed triangle (a, b, c) (coplanar and inside); false for a
   // degenerate triangle.

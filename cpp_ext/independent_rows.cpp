@@ -27,7 +27,163 @@ namespace ngfracture
     }
   }
 
+  namespace
+  {
+    // The vectors of the pivoted QR: values dense over the component's columns, each with
+    // its support, the sorted columns where it may be nonzero (a superset of its nonzeros).
+    // A dot product over the support of one factor adds the nonzero terms of the dense
+    // dot product in the same order, and skips terms that are exact zeros; adding a zero
+    // changes a sum at most in the sign of a zero. So every value below is bit for bit the
+    // one of IndependentRowsDense, at a cost proportional to the supports.
+    struct SupportQR
+    {
+      int64_t n;
+      std::vector<double> Q;                     // orthonormal basis, row by row (dense)
+      std::vector<std::vector<int32_t>> qsupp;   // support of every basis vector
+      std::vector<std::vector<int32_t>> colq;    // basis vectors whose support holds a column
+      std::vector<char> mark;                    // per basis vector: to visit in this pass
+      std::vector<int32_t> merged;
+
+      explicit SupportQR (int64_t n_) : n(n_), colq(n_) { }
+
+      static double Dot (const double * a, const std::vector<int32_t> & supp, const double * b)
+      {
+        double s = 0;
+        for (int32_t c : supp) s += a[c] * b[c];
+        return s;
+      }
+
+      // supp := supp | add (both sorted); the columns new to supp go to fresh.
+      void Merge (std::vector<int32_t> & supp, const std::vector<int32_t> & add,
+                  std::vector<int32_t> & fresh)
+      {
+        merged.clear();
+        size_t a = 0, b = 0;
+        while (a < supp.size() || b < add.size())
+          {
+            if (b == add.size() || (a < supp.size() && supp[a] < add[b])) merged.push_back(supp[a++]);
+            else if (a == supp.size() || add[b] < supp[a]) { fresh.push_back(add[b]); merged.push_back(add[b++]); }
+            else { merged.push_back(supp[a++]); b++; }
+          }
+        supp.swap(merged);
+      }
+
+      // v -= q_j (q_j . v) for every basis vector in order, twice: the dense
+      // Orthogonalise, visiting only the basis vectors that meet v's support.
+      void Orthogonalise (double * v, std::vector<int32_t> & supp)
+      {
+        int64_t nq = int64_t(qsupp.size());
+        std::vector<int32_t> fresh;
+        for (int pass = 0; pass < 2; pass++)
+          {
+            mark.assign(nq, 0);
+            for (int32_t c : supp)
+              for (int32_t j : colq[c]) mark[j] = 1;
+            for (int64_t j = 0; j < nq; j++)
+              {
+                if (!mark[j]) continue;
+                const double * q = &Q[j*n];
+                double alpha = -Dot(q, qsupp[j], v);
+                if (alpha == 0.0) continue;          // adds zeros only
+                for (int32_t c : qsupp[j]) v[c] += alpha * q[c];
+                fresh.clear();
+                Merge(supp, qsupp[j], fresh);
+                for (int32_t c : fresh)
+                  for (int32_t jj : colq[c]) mark[jj] = 1;   // later vectors meeting v now
+              }
+          }
+      }
+
+      // Append v / |v| (v orthogonalised, its norm r) to the basis.
+      void Append (const double * v, const std::vector<int32_t> & supp, double r)
+      {
+        int64_t j = int64_t(qsupp.size());
+        Q.resize((j + 1) * n, 0.0);
+        double * q = &Q[j*n];
+        for (int32_t c : supp) q[c] = v[c] / r;
+        qsupp.push_back(supp);
+        for (int32_t c : supp) colq[c].push_back(int32_t(j));
+      }
+    };
+
+    std::vector<int32_t> Support (const double * v, int64_t n)
+    {
+      std::vector<int32_t> supp;
+      for (int64_t c = 0; c < n; c++)
+        if (v[c] != 0.0) supp.push_back(int32_t(c));
+      return supp;
+    }
+  }
+
   std::vector<int32_t> IndependentRows (const double * A, int64_t k, int64_t n,
+                                        const double * G, int64_t p, double rtol)
+  {
+    SupportQR qr(n);
+    std::vector<double> v(n);
+    for (int64_t i = 0; i < p; i++)
+      {
+        std::copy(G + i*n, G + (i+1)*n, v.begin());
+        auto supp = Support(v.data(), n);
+        double n0 = std::sqrt(SupportQR::Dot(v.data(), supp, v.data()));
+        if (!(n0 > 0)) continue;
+        qr.Orthogonalise(v.data(), supp);
+        double r = std::sqrt(SupportQR::Dot(v.data(), supp, v.data()));
+        if (r > rtol * n0) qr.Append(v.data(), supp, r);
+      }
+    // Residuals of the rows of A with the Dirichlet span removed.
+    std::vector<double> R(A, A + k*n), norm0(k), res(k);
+    std::vector<std::vector<int32_t>> supp(k), colrows(n);
+    std::vector<char> active(k, 1);
+    for (int64_t i = 0; i < k; i++)
+      {
+        supp[i] = Support(&R[i*n], n);
+        norm0[i] = std::sqrt(SupportQR::Dot(&R[i*n], supp[i], &R[i*n]));
+        if (!(norm0[i] > 0)) { active[i] = 0; continue; }
+        qr.Orthogonalise(&R[i*n], supp[i]);
+        res[i] = std::sqrt(SupportQR::Dot(&R[i*n], supp[i], &R[i*n])) / norm0[i];
+        for (int32_t c : supp[i]) colrows[c].push_back(int32_t(i));
+      }
+    std::vector<int32_t> picked, touched, fresh;
+    std::vector<int64_t> stamp(k, -1);
+    while (true)
+      {
+        double best = 0;
+        for (int64_t i = 0; i < k; i++)
+          if (active[i]) best = std::max(best, res[i]);
+        if (!(best > rtol)) break;
+        int64_t j = -1;
+        for (int64_t i = 0; i < k && j < 0; i++)
+          if (active[i] && res[i] >= best * (1.0 - 1e-12)) j = i;
+        active[j] = 0;
+        picked.push_back(int32_t(j));
+        double * q = &R[j*n];
+        qr.Orthogonalise(q, supp[j]);               // re-orthogonalise the pivot
+        double r = std::sqrt(SupportQR::Dot(q, supp[j], q));
+        int64_t jq = int64_t(qr.qsupp.size());
+        qr.Append(q, supp[j], r);
+        const double * qq = &qr.Q[jq*n];
+        const auto & qs = qr.qsupp[jq];
+        // the active rows meeting q's support; the others change by zeros only
+        touched.clear();
+        for (int32_t c : qs)
+          for (int32_t i : colrows[c])
+            if (active[i] && stamp[i] != jq) { stamp[i] = jq; touched.push_back(i); }
+        for (int32_t i : touched)
+          {
+            double * ri = &R[int64_t(i)*n];
+            double alpha = -SupportQR::Dot(qq, qs, ri);
+            if (alpha == 0.0) continue;
+            for (int32_t c : qs) ri[c] += alpha * qq[c];
+            fresh.clear();
+            qr.Merge(supp[i], qs, fresh);
+            for (int32_t c : fresh) colrows[c].push_back(i);
+            res[i] = std::sqrt(SupportQR::Dot(ri, supp[i], ri)) / norm0[i];
+          }
+      }
+    return picked;
+  }
+
+  std::vector<int32_t> IndependentRowsDense (const double * A, int64_t k, int64_t n,
                                         const double * G, int64_t p, double rtol)
   {
     std::vector<double> Q;              // orthonormal basis, row by row
@@ -147,6 +303,86 @@ namespace ngfracture
     return kept;
   }
 
+  namespace
+  {
+    // True if every row of a component (unit-norm rows of C and G, columns numbered
+    // 0 .. nc-1 by colmap) is farther than rtol from the span of the others: then every
+    // QR, pivoted or not, keeps them all (|R_kk| >= sigma_min > rtol), and the QR is not
+    // needed. Shown by a Cholesky factorisation of the Gram matrix minus
+    // (rtol^2 + rounding) I in the rows' order, stored as an envelope (row i from its
+    // first neighbour): it succeeds when sigma_min^2 exceeds the shift. rounding bounds
+    // the backward error of forming and factorising the Gram matrix (4 k eps times its
+    // largest absolute row sum, as redundancy._clearly_independent); not tried where
+    // rtol^2 is within ten times it.
+    struct RowRef { const int64_t * indptr; const int32_t * indices; const double * data; int32_t row; };
+
+    bool ClearlyIndependent (const std::vector<RowRef> & rows, const std::vector<int32_t> & colmap,
+                             int64_t nc, double rtol)
+    {
+      int64_t k = int64_t(rows.size());
+      // rows meeting every local column, in order
+      std::vector<int64_t> cstart(nc + 1, 0);
+      auto entries = [&] (int64_t i, auto && f)
+      {
+        const RowRef & r = rows[i];
+        for (int64_t t = r.indptr[r.row]; t < r.indptr[r.row+1]; t++) f(colmap[r.indices[t]], r.data[t]);
+      };
+      for (int64_t i = 0; i < k; i++) entries(i, [&] (int32_t c, double) { cstart[c+1]++; });
+      for (int64_t c = 0; c < nc; c++) cstart[c+1] += cstart[c];
+      std::vector<int32_t> crow(cstart[nc]);
+      std::vector<double> cval(cstart[nc]);
+      {
+        std::vector<int64_t> fill(cstart.begin(), cstart.end() - 1);
+        for (int64_t i = 0; i < k; i++)
+          entries(i, [&] (int32_t c, double v) { crow[fill[c]] = int32_t(i); cval[fill[c]++] = v; });
+      }
+      // envelope of the lower triangle: row i holds columns first[i] .. i
+      std::vector<int64_t> first(k), start(k + 1, 0);
+      for (int64_t i = 0; i < k; i++)
+        {
+          first[i] = i;
+          entries(i, [&] (int32_t c, double) { first[i] = std::min<int64_t>(first[i], crow[cstart[c]]); });
+          start[i+1] = start[i] + (i - first[i] + 1);
+        }
+      std::vector<double> L(start[k], 0.0);
+      for (int64_t i = 0; i < k; i++)
+        entries(i, [&] (int32_t c, double v)
+          {
+            for (int64_t t = cstart[c]; t < cstart[c+1] && crow[t] <= i; t++)
+              L[start[i] + crow[t] - first[i]] += v * cval[t];
+          });
+      double rowsum = 0;
+      std::vector<double> absum(k, 0.0);
+      for (int64_t i = 0; i < k; i++)
+        for (int64_t j = first[i]; j <= i; j++)
+          {
+            double a = std::abs(L[start[i] + j - first[i]]);
+            absum[i] += a;
+            if (j < i) absum[j] += a;
+          }
+      for (int64_t i = 0; i < k; i++) rowsum = std::max(rowsum, absum[i]);
+      double rounding = 4.0 * double(k) * 2.220446049250313e-16 * rowsum;
+      if (rtol * rtol < 10.0 * rounding) return false;
+      double shift = rtol * rtol + rounding;
+      for (int64_t i = 0; i < k; i++)
+        {
+          double * li = &L[start[i] - first[i]];         // li[j] = L(i, j)
+          for (int64_t j = first[i]; j < i; j++)
+            {
+              const double * lj = &L[start[j] - first[j]];
+              double s = li[j];
+              for (int64_t t = std::max(first[i], first[j]); t < j; t++) s -= li[t] * lj[t];
+              li[j] = s / lj[j];
+            }
+          double d = li[i] - shift;
+          for (int64_t t = first[i]; t < i; t++) d -= li[t] * li[t];
+          if (!(d > 0)) return false;
+          li[i] = std::sqrt(d);
+        }
+      return true;
+    }
+  }
+
   std::vector<int32_t> IndependentRowsSparse (int64_t m, int64_t ndof,
                                               const int64_t * indptr, const int32_t * indices,
                                               const double * data, const int32_t * label,
@@ -154,7 +390,8 @@ namespace ngfracture
                                               int64_t p, const int64_t * gindptr,
                                               const int32_t * gindices, const double * gdata,
                                               const int32_t * glabel,
-                                              double rtol, int method, int64_t dense_limit)
+                                              double rtol, int method, int64_t dense_limit,
+                                              int64_t gram_min)
   {
     std::vector<int32_t> kept;
     if (m == 0) return kept;
@@ -194,6 +431,13 @@ namespace ngfracture
         int64_t nc = cols.size();
 
         bool banded = (method == 2 || (method == 0 && k > dense_limit)) && pg == 0;
+        auto members = [&] ()
+        {
+          std::vector<RowRef> refs;
+          for (size_t s = g0; s < g1; s++) refs.push_back({ gindptr, gindices, gdata, grows[s] });
+          for (size_t s = s0; s < s1; s++) refs.push_back({ indptr, indices, data, rows[s] });
+          return refs;
+        };
         if (k == 1 && pg == 0)
           {
             // A single row: independent iff it did not vanish.
@@ -222,6 +466,10 @@ namespace ngfracture
                 }
             for (int32_t j : IndependentColumnsBanded(tp.data(), ti.data(), tv.data(), nc, k, rtol))
               kept.push_back(rows[s0 + j]);
+          }
+        else if (k >= gram_min && ClearlyIndependent(members(), colmap, nc, rtol))
+          {
+            for (size_t s = s0; s < s1; s++) kept.push_back(rows[s]);
           }
         else
           {

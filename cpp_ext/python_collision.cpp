@@ -152,22 +152,23 @@ void ExportCollision (py::module & m)
         " and geometry (xi, nx, ny, dist, angle) per constraint.");
 
   m.def("IndependentRows",
-        [] (DArr A, DArr G, double rtol)
+        [] (DArr A, DArr G, double rtol, bool dense)
         {
           if (A.ndim() != 2 || G.ndim() != 2 || (G.shape(0) > 0 && G.shape(1) != A.shape(1)))
             throw py::value_error("ngfracture.IndependentRows: A (k, n) and G (p, n) expected");
           std::vector<int32_t> picked;
           {
             py::gil_scoped_release release;
-            picked = IndependentRows(A.data(), A.shape(0), A.shape(1),
-                                     G.data(), G.shape(0), rtol);
+            picked = (dense ? IndependentRowsDense : IndependentRows)(A.data(), A.shape(0), A.shape(1),
+                                                                      G.data(), G.shape(0), rtol);
           }
           py::array_t<int32_t> out(picked.size());
           std::copy(picked.begin(), picked.end(), out.mutable_data());
           return out;
         },
-        py::arg("A"), py::arg("G"), py::arg("rtol") = 1e-8,
-        "Rows of dense A independent of each other and of the rows of G (pivot order).");
+        py::arg("A"), py::arg("G"), py::arg("rtol") = 1e-8, py::arg("dense") = false,
+        "Rows of dense A independent of each other and of the rows of G (pivot order); "
+        "dense=True: the reference QR on dense vectors (same pivots, bit for bit).");
 
   m.def("IndependentColumnsBanded",
         [] (py::array_t<int64_t, py::array::c_style | py::array::forcecast> indptr,
@@ -198,7 +199,8 @@ void ExportCollision (py::module & m)
             IArr indices, DArr data, IArr label,
             py::array_t<int64_t, py::array::c_style | py::array::forcecast> position,
             py::array_t<int64_t, py::array::c_style | py::array::forcecast> gindptr,
-            IArr gindices, DArr gdata, IArr glabel, double rtol, int method, int64_t dense_limit)
+            IArr gindices, DArr gdata, IArr glabel, double rtol, int method, int64_t dense_limit,
+            int64_t gram_min)
         {
           int64_t m = indptr.shape(0) - 1, p = gindptr.shape(0) - 1;
           if (m < 0 || p < 0 || label.shape(0) != m || position.shape(0) != m
@@ -218,7 +220,7 @@ void ExportCollision (py::module & m)
             kept = IndependentRowsSparse(m, ndof, indptr.data(), indices.data(), data.data(),
                                          label.data(), position.data(), p, gindptr.data(),
                                          gindices.data(), gdata.data(), glabel.data(),
-                                         rtol, method, dense_limit);
+                                         rtol, method, dense_limit, gram_min);
           }
           py::array_t<int64_t> out(kept.size());
           std::copy(kept.begin(), kept.end(), out.mutable_data());
@@ -226,6 +228,6 @@ void ExportCollision (py::module & m)
         },
         py::arg("ndof"), py::arg("indptr"), py::arg("indices"), py::arg("data"), py::arg("label"),
         py::arg("position"), py::arg("gindptr"), py::arg("gindices"), py::arg("gdata"),
-        py::arg("glabel"), py::arg("rtol"), py::arg("method"), py::arg("dense_limit"),
+        py::arg("glabel"), py::arg("rtol"), py::arg("method"), py::arg("dense_limit"), py::arg("gram_min"),
         "Independent rows per connected component (see independent_rows.hpp).");
 }

@@ -19,10 +19,63 @@ namespace
     if (a.ndim() != ndim || (ndim == 2 && a.shape(1) != cols) || (rows >= 0 && a.shape(0) != rows))
       throw std::invalid_argument(std::string("ngfracture.") + fn + ": " + name + " has the wrong shape");
   }
+
+  // (ids (k, 5), geometry (k, 10), stats) of the penetrations, as DetectPenetrations3d returns them
+  py::tuple PenetrationTuple (const std::vector<Penetration3> & pen, const Collision3Stats & st)
+  {
+    std::vector<int32_t> ids;
+    std::vector<double> geo;
+    for (auto & p : pen)
+      {
+        ids.insert(ids.end(), { p.vertex, p.fragment, p.tet, p.face, p.twin });
+        geo.insert(geo.end(), p.proj, p.proj + 3);
+        geo.insert(geo.end(), p.bary, p.bary + 3);
+        geo.insert(geo.end(), p.normal, p.normal + 3);
+        geo.push_back(p.gap);
+      }
+    py::dict stats;
+    stats["cell"] = st.cell; stats["boundary_vertices"] = st.boundary_vertices;
+    stats["box_tests"] = st.box_tests; stats["exact_tests"] = st.exact_tests;
+    stats["closed_seams"] = st.closed_seams;
+    auto I = ToNumpy(ids, 5);
+    auto G = ToNumpy(geo, 10);
+    return py::make_tuple(I.reshape({ py::ssize_t(pen.size()), py::ssize_t(5) }),
+                          G.reshape({ py::ssize_t(pen.size()), py::ssize_t(10) }), stats);
+  }
 }
 
 void ExportCollision3d (py::module & m)
 {
+  py::class_<PenetrationDetector3>(m, "PenetrationDetector3d",
+                                   "DetectPenetrations3d for one mesh at many current positions: "
+                                   "the connectivity's work done once, on copies of the arrays.")
+    .def(py::init([] (DArr X, IArr tets, IArr faces, IArr fragment)
+                  {
+                    Check("PenetrationDetector3d", "points", X, 2, 3);
+                    Check("PenetrationDetector3d", "tets", tets, 2, 4);
+                    Check("PenetrationDetector3d", "faces", faces, 2, 3);
+                    Check("PenetrationDetector3d", "fragment", fragment, 1, 0, tets.shape(0));
+                    TetMesh3 mesh { X.data(), X.data(), tets.data(), faces.data(), fragment.data(),
+                                    X.shape(0), tets.shape(0), faces.shape(0) };
+                    py::gil_scoped_release release;
+                    return std::make_unique<PenetrationDetector3>(mesh);
+                  }),
+         py::arg("points"), py::arg("tets"), py::arg("faces"), py::arg("fragment"))
+    .def("detect",
+         [] (const PenetrationDetector3 & self, DArr x)
+         {
+           Check("PenetrationDetector3d.detect", "current", x, 2, 3, self.NumVertices());
+           std::vector<Penetration3> pen;
+           Collision3Stats st;
+           {
+             py::gil_scoped_release release;
+             pen = self.Detect(x.data(), &st);
+           }
+           return PenetrationTuple(pen, st);
+         },
+         py::arg("current"),
+         "(ids, geometry, stats) of DetectPenetrations3d at the current coordinates (nv, 3).");
+
   m.def("Orient3d",
         [] (DArr a, DArr b, DArr c, DArr d, bool exact_only)
         {
@@ -77,24 +130,7 @@ ValueError
             py::gil_scoped_release release;
             pen = DetectPenetrations3(mesh, &st);
           }
-          std::vector<int32_t> ids;
-          std::vector<double> geo;
-          for (auto & p : pen)
-            {
-              ids.insert(ids.end(), { p.vertex, p.fragment, p.tet, p.face, p.twin });
-              geo.insert(geo.end(), p.proj, p.proj + 3);
-              geo.insert(geo.end(), p.bary, p.bary + 3);
-              geo.insert(geo.end(), p.normal, p.normal + 3);
-              geo.push_back(p.gap);
-            }
-          py::dict stats;
-          stats["cell"] = st.cell; stats["boundary_vertices"] = st.boundary_vertices;
-          stats["box_tests"] = st.box_tests; stats["exact_tests"] = st.exact_tests;
-          stats["closed_seams"] = st.closed_seams;
-          auto I = ToNumpy(ids, 5);
-          auto G = ToNumpy(geo, 10);
-          return py::make_tuple(I.reshape({ py::ssize_t(pen.size()), py::ssize_t(5) }),
-                                G.reshape({ py::ssize_t(pen.size()), py::ssize_t(10) }), stats);
+          return PenetrationTuple(pen, st);
         },
         py::arg("points"), py::arg("current"), py::arg("tets"), py::arg("faces"), py::arg("fragment"),
         R"doc(Boundary vertices in the closed volume of another fragment, with their master faces.

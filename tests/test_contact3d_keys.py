@@ -6,11 +6,12 @@ tetrahedra and master faces against a brute-force search over all pairs (exact o
 nearest face by distance to every face), on a fragmented cube whose blocks overlap.
 """
 import numpy as np
+import pytest
 import scipy.sparse as sp
 
 from ngfracture.contact.active_set import Candidates, Geometry, RowKeys
 from ngfracture.contact.active_set3d import ActiveSet3d, FaceKeys, fixed_rows_3d
-from ngfracture.contact.collision3d import detect_penetrations_3d, orient3d
+from ngfracture.contact.collision3d import PenetrationDetector3d, detect_penetrations_3d, orient3d
 from ngfracture.contact.rows3d import face_gap_rows, node_to_face_rows
 from ngfracture.geometry.pieces import fragmented_box
 
@@ -46,9 +47,14 @@ def _closest_distance(p, A, B, C):
     return np.where(inside, best, np.min(edges, axis=0))
 
 
-def test_detection_equals_brute_force():
+@pytest.mark.parametrize("still", [False, True])
+def test_detection_equals_brute_force(still):
+    """With ``still`` half of the blocks do not move: their common lips stay closed, and the
+    closed seams the detection decides before its sweep must be the brute force's."""
     arrays, piece, vf, U = _body()
     X, T, F = arrays.points, arrays.tets, arrays.faces
+    if still:
+        U[vf >= 4] = 0.0
     x = X + U
     pen = detect_penetrations_3d(X, T, F, piece, displacement=U)
     # brute force: every (boundary vertex, tetrahedron of another block), exactly
@@ -68,6 +74,8 @@ def test_detection_equals_brute_force():
     key = {(tuple(X[u]), int(vf[u])): u for u in bv.tolist()}
     twin = np.array([key.get((tuple(X[a]), int(piece[b])), -1) for a, b in zip(v.tolist(), t.tolist())])
     closed = (twin >= 0) & np.all(x[v] == x[np.maximum(twin, 0)], axis=1)
+    assert pen.stats["closed_seams"] == len(np.unique(v[closed] * len(T) + piece[t[closed]]))
+    assert (pen.stats["closed_seams"] > 100) == still
     v, t = v[~closed], t[~closed]
     order = np.lexsort((t, piece[t], v))
     v, t = v[order], t[order]
@@ -87,6 +95,29 @@ def test_detection_equals_brute_force():
         assert pen.face[i] in cand
         assert abs(-pen.gap[i] - d.min()) <= 1e-12 / CELLS
         assert d[cand == pen.face[i]][0] <= d.min() + 1e-12 / CELLS
+
+
+def test_detector_is_the_detection():
+    """PenetrationDetector3d does the mesh's work once, on copies of its arrays: every
+    detection must equal detect_penetrations_3d's field by field, bit for bit (overlapping
+    blocks, half of them still with closed lips, the reference configuration), also after
+    the arrays it was made from are overwritten."""
+    arrays, piece, vf, U = _body()
+    X, T, F = arrays.points.copy(), arrays.tets.copy(), arrays.faces.copy()
+    half = np.where((vf >= 4)[:, None], 0.0, U)
+    detector = PenetrationDetector3d(X, T, F, piece)
+    X[:] = 0.0
+    T[:] = 0
+    fields = ("vertex", "fragment", "tet", "face", "twin", "projection", "bary", "normal", "gap")
+    for displacement in (U, half, None):
+        plain = detect_penetrations_3d(arrays.points, arrays.tets, arrays.faces, piece, displacement=displacement)
+        fast = detector.detect(displacement)
+        for k in fields:
+            assert np.array_equal(getattr(fast, k), getattr(plain, k)), k
+        assert fast.stats["closed_seams"] == plain.stats["closed_seams"]
+    assert len(detector.detect(U)) > 100 and detector.detect().stats["closed_seams"] > 100
+    with pytest.raises(ValueError, match="displacement"):
+        detector.detect(U[:-1])
 
 
 def test_face_keys_are_the_key_tuples():
@@ -147,3 +178,27 @@ def test_codes_choose_as_tuples():
         assert coded.record(cand.keys, ka, lam, 1.0) == plain.record(tuples.keys, kb, lam, 1.0)
         assert coded.multipliers == plain.multipliers and len(coded.multipliers) == len(ka)
         assert np.array_equal(np.sort(coded.tried), np.sort(plain.tried)) and coded.imposed == plain.imposed
+
+
+def test_redundancy_shortcuts_choose_the_plain_rows(monkeypatch):
+    """The candidate rows of overlapping blocks at their junctions (components of dependent
+    rows) and of the closed body (every row independent): the rows independent_rows keeps
+    with its Gram test per component must be those of the pivoted QR alone."""
+    from ngfracture.contact import redundancy
+    arrays, piece, vf, _ = _body()
+    X = arrays.points
+    centre = np.stack([np.bincount(vf, weights=X[:, d]) / np.bincount(vf) for d in range(3)], axis=1)
+    U = 0.2 / CELLS * PIECES * (X - centre[vf])          # the blocks overlap, without noise
+    geometry = Geometry(arrays=arrays, fragment=piece, seams=None, fixed=np.zeros(0, dtype=np.int64))
+    active = ActiveSet3d(geometry, 1e-12)
+    dropped = []
+    for u in (U, np.zeros_like(U)):
+        C = active.update(u, {"collision": 0.0}).rows.C
+        monkeypatch.setattr(redundancy, "_clearly_independent", lambda *args: False)
+        fast = redundancy.independent_rows(C, rtol=1e-5)
+        monkeypatch.setattr(redundancy, "GRAM_MIN_ROWS", 10 ** 9)
+        plain = redundancy.independent_rows(C, rtol=1e-5)
+        monkeypatch.undo()
+        assert np.array_equal(fast, plain)
+        dropped.append(C.shape[0] - len(plain))
+    assert dropped[0] > 10

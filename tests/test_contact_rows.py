@@ -212,6 +212,73 @@ def test_gram_shortcut_agrees_with_the_pivoted_qr(monkeypatch, distance):
         assert answered == [False] and len(qr) == m - 1
 
 
+def contact_like_rows(rng, nv, m):
+    """m unit rows of gaps along the axes on nv vertices (3 dofs each, component-major):
+    node-to-node rows (slave, one master) and node-to-face rows (slave, three masters with
+    barycentric weights), each within a window of 8 consecutive vertices, so that they form
+    cycles of the Fig. 5 kind."""
+    C = np.zeros((m, 3 * nv))
+    for i in range(m):
+        axis, centre = rng.integers(3), rng.integers(nv - 8)
+        v = centre + rng.choice(8, rng.choice([2, 4]), replace=False)
+        w = np.ones(1) if len(v) == 2 else rng.dirichlet(np.ones(3))
+        C[i, axis * nv + v] = np.concatenate([[1.0], -w])
+    return C / np.linalg.norm(C, axis=1)[:, None]
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_support_qr_is_the_dense_qr_bit_for_bit(seed):
+    """The pivoted QR works on the supports of its vectors (cpp_ext/independent_rows.cpp):
+    it must pick the rows the same QR on dense vectors picks, in the same order. Rows like
+    a 3D contact component, plus exact and negated duplicates and combinations of two rows
+    moved off by 0.5, 1 and 2 rtol; odd seeds with hold rows G (dense and a unit row)."""
+    rng = np.random.default_rng(seed)
+    nv, m, rtol = 30, 90, 1e-5
+    A = contact_like_rows(rng, nv, m)
+    i, j = rng.integers(0, m, (2, 12))
+    extra = [A[i[:4]], -A[j[:4]]]
+    for d, a, b in zip([0.5 * rtol, rtol, 2 * rtol] * 3, i[4:], j[4:]):
+        combo = (A[a] + A[b]) / np.linalg.norm(A[a] + A[b])
+        extra.append((combo + d * rng.normal(size=3 * nv) / np.sqrt(3 * nv))[None])
+    A = np.vstack([A] + extra)
+    A = A[rng.permutation(len(A))]
+    G = np.zeros((0, 3 * nv))
+    if seed % 2:
+        G = np.vstack([rng.normal(size=(2, 3 * nv)), np.eye(1, 3 * nv, 5)])
+    support = ngfracture._ngfracture.IndependentRows(A, G, rtol)
+    dense = ngfracture._ngfracture.IndependentRows(A, G, rtol, dense=True)
+    assert np.array_equal(support, dense)
+    assert len(support) < len(A) - 8            # the duplicates at least are dropped
+
+
+@pytest.mark.parametrize("distance", [None, 0.5e-5, 2e-5])
+def test_component_gram_test_agrees_with_the_qr(monkeypatch, distance):
+    """A component of at least redundancy.GRAM_MIN_ROWS rows is kept whole without the QR
+    where a Cholesky factorisation of its Gram matrix proves it clearly independent (C++);
+    the answer must be the QR's (GRAM_MIN_ROWS above any component: the plain computation).
+    Five components of 30 contact-like rows; with `distance` the last row of the first is a
+    combination of two others moved off by that much along a dof of its own (rtol = 1e-5):
+    at 0.5 rtol the QR drops it, so the test must have declined."""
+    rng = np.random.default_rng(7)
+    nv, rtol = 30, 1e-5
+    C = sp.block_diag([contact_like_rows(rng, nv, 30) for _ in range(5)]).toarray()
+    if distance is not None:
+        used = np.flatnonzero(np.any(C[:29] != 0, axis=0) | np.any(C[30:] != 0, axis=0))
+        free = np.setdiff1d(np.arange(C.shape[1]), used)[0]
+        combo = (C[0] + C[1]) / np.linalg.norm(C[0] + C[1])
+        C[29] = combo
+        C[29, free] = distance
+    monkeypatch.setattr(redundancy, "_clearly_independent", lambda *args: False)
+    fast = contact.independent_rows(sp.csr_matrix(C), rtol=rtol)
+    monkeypatch.setattr(redundancy, "GRAM_MIN_ROWS", 10 ** 9)
+    qr = contact.independent_rows(sp.csr_matrix(C), rtol=rtol)
+    assert np.array_equal(fast, qr)
+    if distance == 0.5e-5:
+        assert 29 not in qr.tolist()
+    if distance == 2e-5:
+        assert 29 in qr.tolist()
+
+
 # ------------------------------------------------------------------ redundancy
 @pytest.mark.parametrize("method", ["pivoted", "banded", "auto"])
 def test_2000_coincident_rows_rank_r_and_kkt(method):

@@ -60,7 +60,7 @@ import time
 import numpy as np
 
 from .active_set import ActiveSet, Candidates, RowKeys, refreshed
-from .collision3d import detect_penetrations_3d
+from .collision3d import PenetrationDetector3d
 from .junctions3d import covered_pairs, fragment_pair_rows
 from .rows3d import NodeToFaceRows, lip_rows, no_face_rows, node_to_face_rows, relinearise_node_to_face
 
@@ -176,15 +176,15 @@ def fixed_rows_3d(points, tets, faces, fragment):
     Raises
     ------
     ValueError
-        On inconsistent arrays (see :func:`detect_penetrations_3d`).
+        On inconsistent arrays (see :func:`~ngfracture.contact.collision3d.detect_penetrations_3d`).
     """
-    return _fixed_rows(points, tets, faces, fragment, FaceKeys(faces))
+    return _fixed_rows(points, tets, faces, fragment, FaceKeys(faces), PenetrationDetector3d(points, tets, faces, fragment))
 
 
-def _fixed_rows(points, tets, faces, fragment, codec):
-    """:func:`fixed_rows_3d` with the keys' codec given."""
+def _fixed_rows(points, tets, faces, fragment, codec, detector):
+    """:func:`fixed_rows_3d` with the keys' codec and the mesh's detector given."""
     nv = len(points)
-    touching = node_to_face_rows(points, faces, detect_penetrations_3d(points, tets, faces, fragment))
+    touching = node_to_face_rows(points, faces, detector.detect())
     vertex_fragment = _vertex_fragment(nv, tets, fragment)
     rows = NodeToFaceRows.stack([touching, fragment_pair_rows(points, faces, vertex_fragment),
                                  lip_rows(points, faces, vertex_fragment)])
@@ -224,6 +224,9 @@ class ActiveSet3d(ActiveSet):
         self.covered = np.zeros(0, dtype=np.int64)     # (vertex, fragment) a fixed row covers, as codes
         self.codec = FaceKeys(geometry.arrays.faces)
         self.n2s_keys = RowKeys(np.zeros(0, dtype=np.int64), self.codec)
+        a = geometry.arrays
+        # the detection's work on the mesh alone, done once for every detection of the solve
+        self.detector = PenetrationDetector3d(a.points, a.tets, a.faces, geometry.fragment)
 
     def update(self, U, timings):
         """The candidate rows at X + U, the configuration of the last solve.
@@ -247,7 +250,8 @@ class ActiveSet3d(ActiveSet):
         relinearised = None
         if self.seam_rows is None:
             t0 = time.perf_counter()
-            self.seam_rows, self.seam_keys = _fixed_rows(a.points, a.tets, a.faces, self.geometry.fragment, self.codec)
+            self.seam_rows, self.seam_keys = _fixed_rows(a.points, a.tets, a.faces, self.geometry.fragment, self.codec,
+                                                         self.detector)
             timings["collision"] += time.perf_counter() - t0
             self.vertex_fragment = _vertex_fragment(len(a.points), a.tets, self.geometry.fragment)
             self.covered = covered_pairs(a.points, self.seam_rows, self.vertex_fragment)
@@ -280,7 +284,7 @@ class ActiveSet3d(ActiveSet):
         """The pairs detected at X + U that no twin row covers, as rows with their key codes."""
         a = self.geometry.arrays
         t0 = time.perf_counter()
-        pen = detect_penetrations_3d(a.points, a.tets, a.faces, self.geometry.fragment, displacement=U)
+        pen = self.detector.detect(U)
         timings["collision"] += time.perf_counter() - t0
         rows = node_to_face_rows(a.points, a.faces, pen)
         # a vertex with a twin on the master fragment talks to it through its twin row; a

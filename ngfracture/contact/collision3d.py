@@ -86,7 +86,7 @@ import numpy as np
 
 from .. import _ngfracture as _ext
 
-__all__ = ["orient3d", "Penetrations3d", "detect_penetrations_3d"]
+__all__ = ["orient3d", "Penetrations3d", "detect_penetrations_3d", "PenetrationDetector3d"]
 
 
 def _points(p, name):
@@ -185,6 +185,37 @@ def _indices(a, name, cols, n):
     return np.ascontiguousarray(a, dtype=np.int32)
 
 
+def _mesh_arrays(points, tets, faces, fragment):
+    """The mesh's arrays as the C++ detection takes them, after the checks of
+    :func:`detect_penetrations_3d`."""
+    X = _points(points, "points")
+    T = _indices(tets, "tets", 4, len(X))
+    F = _indices(faces, "faces", 3, len(X))
+    frag = np.ascontiguousarray(fragment, dtype=np.int32)
+    if frag.shape != (len(T),):
+        raise ValueError(f"fragment must have shape ({len(T)},), got {frag.shape}")
+    return X, T, F, frag
+
+
+def _current(X, displacement):
+    """The current positions X + displacement (X itself without a displacement)."""
+    if displacement is None:
+        return X
+    U = _points(displacement, "displacement")
+    if U.shape != X.shape:
+        raise ValueError(f"displacement must have the shape of points {X.shape}, got {U.shape}")
+    return np.ascontiguousarray(X + U)
+
+
+def _penetrations(ids, geo, stats):
+    """Penetrations3d of the C++ detection's output."""
+    ids = np.asarray(ids, dtype=np.int64).reshape(-1, 5)
+    geo = np.asarray(geo, dtype=np.float64).reshape(-1, 10)
+    return Penetrations3d(vertex=ids[:, 0], fragment=ids[:, 1], tet=ids[:, 2], face=ids[:, 3],
+                          twin=ids[:, 4], projection=geo[:, 0:3], bary=geo[:, 3:6],
+                          normal=geo[:, 6:9], gap=geo[:, 9], stats=dict(stats))
+
+
 def detect_penetrations_3d(points, tets, faces, fragment, displacement=None):
     """Boundary vertices of each fragment in the closed volume of another, with master faces.
 
@@ -217,21 +248,52 @@ def detect_penetrations_3d(points, tets, faces, fragment, displacement=None):
         On wrong shapes, non-finite coordinates, vertex numbers out of range, a face that
         is no face of a tetrahedron, or a vertex in tetrahedra of two fragments.
     """
-    X = _points(points, "points")
-    x = X
-    if displacement is not None:
-        U = _points(displacement, "displacement")
-        if U.shape != X.shape:
-            raise ValueError(f"displacement must have the shape of points {X.shape}, got {U.shape}")
-        x = X + U
-    T = _indices(tets, "tets", 4, len(X))
-    F = _indices(faces, "faces", 3, len(X))
-    frag = np.ascontiguousarray(fragment, dtype=np.int32)
-    if frag.shape != (len(T),):
-        raise ValueError(f"fragment must have shape ({len(T)},), got {frag.shape}")
-    ids, geo, stats = _ext.DetectPenetrations3d(X, np.ascontiguousarray(x), T, F, frag)
-    ids = np.asarray(ids, dtype=np.int64).reshape(-1, 5)
-    geo = np.asarray(geo, dtype=np.float64).reshape(-1, 10)
-    return Penetrations3d(vertex=ids[:, 0], fragment=ids[:, 1], tet=ids[:, 2], face=ids[:, 3],
-                          twin=ids[:, 4], projection=geo[:, 0:3], bary=geo[:, 3:6],
-                          normal=geo[:, 6:9], gap=geo[:, 9], stats=dict(stats))
+    X, T, F, frag = _mesh_arrays(points, tets, faces, fragment)
+    return _penetrations(*_ext.DetectPenetrations3d(X, _current(X, displacement), T, F, frag))
+
+
+class PenetrationDetector3d:
+    """:func:`detect_penetrations_3d` for one mesh at many configurations.
+
+    What depends only on the mesh (the fragment of every vertex and face, the boundary
+    vertices, the tetrahedra at every vertex, the copies of every boundary vertex and the
+    lip flags) is computed once, in C++, on copies of the arrays given here: later changes
+    to those arrays do not reach it, so it cannot go stale. A contact solve makes one per
+    mesh (:class:`~ngfracture.contact.active_set3d.ActiveSet3d`) and detects with it in
+    every round. :meth:`detect` returns what :func:`detect_penetrations_3d` returns for the
+    same arrays, bit for bit.
+
+    Parameters
+    ----------
+    points, tets, faces, fragment
+        As for :func:`detect_penetrations_3d`.
+
+    Raises
+    ------
+    ValueError
+        As :func:`detect_penetrations_3d` does for the mesh's arrays.
+    """
+
+    def __init__(self, points, tets, faces, fragment):
+        X, T, F, frag = _mesh_arrays(points, tets, faces, fragment)
+        self._points = X.copy()
+        self._kernel = _ext.PenetrationDetector3d(X, T, F, frag)
+
+    def detect(self, displacement=None):
+        """The penetrations at points + displacement (:func:`detect_penetrations_3d`).
+
+        Parameters
+        ----------
+        displacement : array_like, shape (nv, 3), optional
+            Zero if omitted.
+
+        Returns
+        -------
+        Penetrations3d
+
+        Raises
+        ------
+        ValueError
+            On a displacement of the wrong shape or with non-finite entries.
+        """
+        return _penetrations(*self._kernel.detect(_current(self._points, displacement)))

@@ -6,7 +6,10 @@ on the Dirichlet rows; imposed together as equalities they make the KKT system s
 :func:`independent_rows` keeps a maximal independent subset by a column-pivoted QR
 (C++: ``cpp_ext/independent_rows.cpp``), split into the connected components of the rows'
 sparsity graph, and skips the QR where a Cholesky factorisation of the rows' Gram matrix
-proves them independent. Timings of both are in ``docs/contact.md``.
+proves them independent: for all rows at once (here), and per component (C++, components
+of at least :data:`GRAM_MIN_ROWS` rows). The QR works on the supports of its vectors, with
+the floating-point operations of the QR on dense vectors on their nonzeros, so it picks the
+same rows bit for bit. Timings are in ``docs/contact.md``.
 """
 import numpy as np
 import scipy.linalg as sla
@@ -15,7 +18,12 @@ from scipy.sparse.csgraph import connected_components, reverse_cuthill_mckee
 
 from .. import _ngfracture as _ext
 
-__all__ = ["independent_rows"]
+__all__ = ["independent_rows", "GRAM_MIN_ROWS"]
+
+#: components of at least this many rows, to be decided by the pivoted QR, are first tested
+#: by a Cholesky factorisation of their Gram matrix (C++), which keeps them all without the
+#: QR where it proves them clearly independent (:func:`independent_rows`)
+GRAM_MIN_ROWS = 8
 
 
 def independent_rows(C, fixed_dofs=None, G=None, rtol=1e-8, method="auto", dense_limit=256):
@@ -29,7 +37,13 @@ def independent_rows(C, fixed_dofs=None, G=None, rtol=1e-8, method="auto", dense
     rows' sparsity graph (rows sharing a dof, through C or G), each a dense QR restricted to
     its nonzero columns; single rows need no QR. Exact duplicates, the three-body
     node-to-node redundancy of the paper's Fig. 5 and rows implied by the Dirichlet rows
-    are all removed this way. Cost per component: O(k r n) for k rows, rank r, n columns.
+    are all removed this way. Cost per component: O(k r n) for k rows, rank r, n columns on
+    dense vectors; the QR visits only the supports of its vectors (the nonzeros of a
+    contact row and what the orthogonalisation fills in), with the same result bit for
+    bit. A component of at least ``GRAM_MIN_ROWS`` rows is first tested by an envelope
+    Cholesky factorisation of its Gram matrix, shifted as in the test for all rows below:
+    where that proves every row farther than rtol from the span of the others, the QR
+    would keep them all, and is skipped.
 
     Parameters
     ----------
@@ -168,7 +182,7 @@ def _pivoted_qr(Ca, Gn, lab_c, lab_g, rtol, method, dense_limit):
         Ca.shape[1], Ca.indptr.astype(np.int64), Ca.indices.astype(np.int32), Ca.data,
         lab_c.astype(np.int32), position, Gn.indptr.astype(np.int64),
         Gn.indices.astype(np.int32), Gn.data, lab_g.astype(np.int32), float(rtol), code,
-        int(dense_limit))
+        int(dense_limit), int(GRAM_MIN_ROWS))
 
 
 def _unit_rows(M):
