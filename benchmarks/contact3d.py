@@ -65,11 +65,19 @@ Every run is a ``Simulation`` without pictures in a temporary folder; reported a
 phases (summary.json "timings": "collision", "contact" (the rest of the contact work),
 "solve", wall), t_unit (benchmarks/solid.py ``unit_solve`` of the scene's problem),
 solve_equivalents = wall / t_unit, contact_ratio = (collision + contact) / t_unit, and
-their growth exponents over the sizes.
+their growth exponents over the sizes. ``--vary NAME --values V ...`` varies another size
+parameter instead of maxh (the sphere scenes' mesh is set by ``fine`` near the hole), with
+``--set NAME=VALUE`` fixing others; ``--steps N`` stops every run after N accepted steps,
+``--until-crack`` after its first cracked step (the run is left there, reason "first_crack",
+its wall the seconds to that step).
+Every case also reports its accepted steps' cumulative seconds (``step_seconds``) and split
+vertices, the first step that splits a vertex (``first_crack_step``), the seconds up to and
+including it (``seconds_to_first_crack``) and those over t_unit
+(``solve_equivalents_to_first_crack``, None without a crack), with its growth exponent.
 
 Usage: PYTHONPATH=. OMP_NUM_THREADS=1 python benchmarks/contact3d.py [--quick]
-       [--cells 15 20 26] [--pieces 4] [--repeat 2] [--scene NAME [--maxh H ...]]
-       [--json FILE [--force]]
+       [--cells 15 20 26] [--pieces 4] [--repeat 2] [--scene NAME [--maxh H ...]
+       [--vary NAME --values V ...] [--set NAME=VALUE ...] [--steps N] [--until-crack]] [--json FILE [--force]]
 """
 import argparse
 import inspect
@@ -234,40 +242,96 @@ def exponents(cases, keys):
                for k in keys}}
 
 
-def scene_sizes(name, maxh):
-    """The keyword arguments of every size of a registered scene: maxh values, or none."""
+def scene_sizes(name, maxh, vary="maxh", fixed=None):
+    """The keyword arguments of every size of a registered scene: values of the parameter
+    ``vary`` (``maxh``: the given ones, else the default times SCENE_FACTORS), each with the
+    ``fixed`` ones (a dict), or only those where the scene does not take ``vary``."""
     from ngfracture import scenes
     if name not in scenes.SCENES:
         raise ValueError(f"unknown scene {name!r}; registered: {', '.join(sorted(scenes.SCENES))}")
-    parameter = inspect.signature(scenes.SCENES[name]).parameters.get("maxh")
+    fixed = dict(fixed or {})
+    parameters = inspect.signature(scenes.SCENES[name]).parameters
+    for key in (*fixed, vary):
+        if key not in parameters and (key != vary or maxh):
+            raise ValueError(f"scene {name!r} takes no {key}")
+    if vary in fixed:
+        raise ValueError(f"--set {vary} and --vary {vary} exclude each other")
+    parameter = parameters.get(vary)
     if parameter is None:
-        if maxh:
-            raise ValueError(f"scene {name!r} takes no maxh")
-        return [{}]
+        return [fixed]
     if maxh:
-        return [{"maxh": h} for h in maxh]
-    if not isinstance(parameter.default, (int, float)):
-        raise ValueError(f"scene {name!r} has no default maxh: give --maxh")
-    return [{"maxh": parameter.default * f} for f in SCENE_FACTORS]
+        return [{**fixed, vary: h} for h in maxh]
+    if not isinstance(parameter.default, (int, float)) or isinstance(parameter.default, bool):
+        raise ValueError(f"scene {name!r} has no default {vary}: give the values")
+    return [{**fixed, vary: parameter.default * f} for f in SCENE_FACTORS]
 
 
-def run_scene(name, kwargs, repeat):
-    """One run of a registered scene: its contact phases, wall and unit."""
+def parsed_settings(items):
+    """``NAME=VALUE`` strings as a dict, the values read as JSON where they parse (numbers,
+    true/false, null), else kept as strings."""
+    out = {}
+    for item in items or ():
+        name, sep, value = item.partition("=")
+        if not sep or not name:
+            raise ValueError(f"--set needs NAME=VALUE, got {item!r}")
+        try:
+            out[name] = json.loads(value)
+        except json.JSONDecodeError:
+            out[name] = value
+    return out
+
+
+def first_crack(records):
+    """(step, cumulative seconds) of the first accepted step that split a vertex, from the
+    progress records of a run; (None, None) without one."""
+    for r in records:
+        if r["split_vertices"] > 0:
+            return r["step"], r["seconds"]
+    return None, None
+
+
+class FirstCrack(Exception):
+    """Raised by the progress callback of a run stopped at its first cracked step."""
+
+
+def run_scene(name, kwargs, repeat, steps=None, until_crack=False):
+    """One run of a registered scene (at most ``steps`` accepted steps, or up to and including
+    its first cracked step with ``until_crack``; reason "first_crack" then): its contact
+    phases, wall, unit and the time to its first cracked step."""
     from ngfracture import Simulation, scenes
+    from ngfracture.run.control import StepControl
     sys.path.insert(0, str(__import__("pathlib").Path(__file__).parent))
     import solid
     scene = scenes.SCENES[name](**kwargs)
     t_before, solver = solid.unit_solve(scene, repeat=repeat)
+    records = []
+
+    def progress(record):
+        records.append(record)
+        if until_crack and record["split_vertices"] > 0:
+            raise FirstCrack
+
+    control = StepControl(max_steps=steps) if steps is not None else None
     with tempfile.TemporaryDirectory() as out:
-        result = Simulation(scene, out=out, pictures="none").run()
+        simulation = Simulation(scene, control=control, out=out, pictures="none", progress=progress)
+        t0 = time.perf_counter()
+        try:
+            result = simulation.run()
+            reason, n_steps, wall = result.reason, result.summary["n_steps"], result.summary["timings"]["wall"]
+        except FirstCrack:
+            reason, n_steps, wall = "first_crack", records[-1]["step"], time.perf_counter() - t0
     t_after, _ = solid.unit_solve(scene, repeat=repeat)
     t_unit = 0.5 * (t_before + t_after)
-    timings = result.summary["timings"]
+    timings = simulation.timings
     contact = timings["collision"] + timings["contact"]
-    return {"scene": name, **kwargs, "tets": scene.mesh.ne, "vertices": scene.mesh.nv, "reason": result.reason,
-            "steps": result.summary["n_steps"], "collision": timings["collision"], "contact": timings["contact"],
-            "solve": timings["solve"], "wall": timings["wall"], "t_unit": t_unit, "solver": solver,
-            "solve_equivalents": timings["wall"] / t_unit, "contact_ratio": contact / t_unit}
+    crack_step, crack_seconds = first_crack(records)
+    return {"scene": name, **kwargs, "tets": scene.mesh.ne, "vertices": scene.mesh.nv, "reason": reason,
+            "steps": n_steps, "collision": timings["collision"], "contact": timings["contact"],
+            "solve": timings["solve"], "wall": wall, "t_unit": t_unit, "solver": solver,
+            "solve_equivalents": wall / t_unit, "contact_ratio": contact / t_unit,
+            "step_seconds": [r["seconds"] for r in records], "split_vertices": [r["split_vertices"] for r in records],
+            "first_crack_step": crack_step, "seconds_to_first_crack": crack_seconds,
+            "solve_equivalents_to_first_crack": None if crack_seconds is None else crack_seconds / t_unit}
 
 
 def main(argv=None):
@@ -277,22 +341,35 @@ def main(argv=None):
     p.add_argument("--repeat", type=int, default=2, help="best of this many (default 2)")
     p.add_argument("--quick", action="store_true", help=f"one small body ({QUICK_CELLS[0]} cells per edge)")
     p.add_argument("--scene", help="run this registered scene instead (at three --maxh if it takes maxh)")
-    p.add_argument("--maxh", nargs="+", type=float, default=None, help="the scene's sizes (with --scene)")
+    p.add_argument("--maxh", "--values", nargs="+", type=float, default=None, dest="maxh",
+                   help="the scene's sizes: values of --vary (with --scene)")
+    p.add_argument("--vary", default="maxh", help="the size parameter of the scene's cases (default maxh)")
+    p.add_argument("--set", action="append", default=None, metavar="NAME=VALUE",
+                   help="a scene parameter fixed in every case (repeatable)")
+    p.add_argument("--steps", type=int, default=None, help="stop every scene run after this many accepted steps")
+    p.add_argument("--until-crack", action="store_true",
+                   help="stop every scene run after its first step that splits a vertex")
     benchmark_json.add_options(p)
     args = p.parse_args(argv)
     if args.repeat < 1:
         p.error("--repeat must be at least 1")
+    if args.steps is not None and args.steps < 1:
+        p.error("--steps must be at least 1")
     benchmark_json.refuse_existing(p, args)
     if args.scene is not None:
         try:
-            sizes = scene_sizes(args.scene, args.maxh)
+            sizes = scene_sizes(args.scene, args.maxh, args.vary, parsed_settings(args.set))
         except ValueError as exc:
             p.error(str(exc))
         cases = []
         for kwargs in sizes:
-            cases.append(run_scene(args.scene, kwargs, args.repeat))
+            cases.append(run_scene(args.scene, kwargs, args.repeat, args.steps, args.until_crack))
             print(json.dumps(cases[-1]), file=sys.stderr, flush=True)
         growth = exponents(cases, ("wall", "t_unit", "solve_equivalents", "contact_ratio"))
+        cracked = [c for c in cases if c["first_crack_step"] is not None]
+        if growth is not None:
+            first = exponents(cracked, ("seconds_to_first_crack", "solve_equivalents_to_first_crack"))
+            growth.update({k: v for k, v in (first or {}).items() if k != "tets"})
         benchmark_json.write(args, {"scene": args.scene, "cases": cases, "growth": growth})
         return 0
     cells = args.cells or (QUICK_CELLS if args.quick else DEFAULT_CELLS)

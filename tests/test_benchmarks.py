@@ -101,3 +101,40 @@ def test_solid_benchmark_breaks_the_small_bar_and_reports_positive_ratios(tmp_pa
 def test_solid_benchmark_refuses_a_bad_size_before_any_run(tmp_path):
     r = run_benchmark("solid", "--sizes", "0.25/-1", "--json", str(tmp_path / "solid.json"))
     assert r.returncode == 2 and "a size is MAXH/FINE or FINE with numbers > 0" in r.stderr
+
+
+@pytest.mark.parametrize("args, message", [(["--set", "maxh"], "--set needs NAME=VALUE"),
+                                           (["--vary", "fine", "--set", "fine=0.1"], "exclude each other"),
+                                           (["--set", "width=1"], "scene 'sphere3d' takes no width"),
+                                           (["--steps", "0"], "--steps must be at least 1")])
+def test_contact3d_scene_options_refused_before_any_run(args, message, tmp_path):
+    target = tmp_path / "contact3d.json"
+    r = run_benchmark("contact3d", "--scene", "sphere3d", *args, "--json", str(target))
+    assert r.returncode == 2 and message in r.stderr, r.stderr
+    assert not target.exists()
+
+
+def test_contact3d_scene_sizes_vary_the_named_parameter():
+    sys.path.insert(0, str(ROOT / "benchmarks"))
+    import contact3d
+    sizes = contact3d.scene_sizes("sphere3d", [0.15, 0.1], "fine", contact3d.parsed_settings(["maxh=0.4"]))
+    assert sizes == [{"maxh": 0.4, "fine": 0.15}, {"maxh": 0.4, "fine": 0.1}]
+    # the default maxh times the factors, exactly
+    assert [s["maxh"] for s in contact3d.scene_sizes("sphere3d", None)] == [0.25 * f for f in contact3d.SCENE_FACTORS]
+    records = [{"step": 1, "split_vertices": 0, "seconds": 1.0}, {"step": 2, "split_vertices": 3, "seconds": 2.5},
+               {"step": 3, "split_vertices": 9, "seconds": 4.0}]
+    assert contact3d.first_crack(records) == (2, 2.5) and contact3d.first_crack(records[:1]) == (None, None)
+
+
+@pytest.mark.slow
+def test_contact3d_scene_run_stops_at_its_first_crack(tmp_path):
+    target = tmp_path / "contact3d.json"
+    r = run_benchmark("contact3d", "--scene", "sphere3d", "--vary", "fine", "--values", "0.15", "--set", "maxh=0.4",
+                      "--until-crack", "--repeat", "1", "--json", str(target))
+    assert r.returncode == 0, r.stderr
+    (case,) = json.loads(target.read_text())["cases"]
+    k = case["first_crack_step"]
+    assert case["reason"] == "first_crack" and case["steps"] == k == len(case["step_seconds"])
+    assert case["split_vertices"][:k - 1] == [0] * (k - 1) and case["split_vertices"][k - 1] > 0
+    assert case["seconds_to_first_crack"] == case["step_seconds"][-1] <= case["wall"]
+    assert case["solve_equivalents_to_first_crack"] == case["seconds_to_first_crack"] / case["t_unit"]
