@@ -26,12 +26,18 @@ partner-face rows and the self-contact detection hold the lips. E = 1, nu = 0.25
    exact clipping independently of the contact code (``ngfracture.output.overlap3d``), at
    most what node-to-face rows leave: the faces of lips that slid by s over each other
    while turning by an angle k apart cross by at most s sin k over the crack's area.
+3. The found rows at copies (``contact/copies3d.py``): the lower-numbered lip copies of the
+   plane x = 1/2 pushed by 1e-4 into the other lip are found 1e-4 deep on a face at their
+   copy, and become the rows of the higher copies (the fixed rows' direction) on the
+   coincident faces at the pushed vertices, projected there, reference normal, g = 0.
 """
 import math
 
 import numpy as np
 
 from ngfracture.contact.collision3d import detect_penetrations_3d
+from ngfracture.contact.copies3d import found_rows_at_copies
+from ngfracture.contact.rows3d import node_to_face_rows
 from ngfracture.contact.solver import ContactSolver
 from ngfracture.fracture.strain import vertex_displacement
 from ngfracture.geometry.internal_crack import open_internal_surface
@@ -162,3 +168,32 @@ def test_shear_slides_the_junction_without_penetration():
     assert np.all(result.multipliers <= 1e-8 * scale)
     assert depth <= SIZE_TOL
     assert overlap.volume <= bound
+
+
+def test_found_rows_at_copies_take_the_fixed_rows_direction():
+    """A lip vertex of the lower-numbered copy pushed into the other lip's wedge is found
+    with its master face at the copy; the row is the other copy's (the fixed rows' slave)
+    on the coincident face at the pushed vertex, projected there, with the face's reference
+    normal and g = 0 (contact/copies3d.py)."""
+    a = junction_cube()
+    X = a.points
+    _, point, count = np.unique(X, axis=0, return_inverse=True, return_counts=True)
+    point = point.ravel()
+    two = np.flatnonzero((count[point] == 2) & (X[:, 0] == 0.5))            # lip copies of the plane x = 1/2
+    low = two[np.array([np.count_nonzero(point[two] == point[v]) == 2 and v == two[point[two] == point[v]].min()
+                        for v in two])]
+    U = np.zeros_like(X)
+    U[low, 0] = 1e-4                                                        # into the copies' side x > 1/2
+    zero = np.zeros(len(a.tets), np.int64)
+    pen = detect_penetrations_3d(X, a.tets, a.faces, zero, U)
+    mine = np.isin(pen.vertex, low)
+    assert np.count_nonzero(mine) == len(low) and np.allclose(pen.gap[mine], -1e-4, rtol=1e-12, atol=0)
+    rows, at_copy = found_rows_at_copies(X, a.faces, node_to_face_rows(X, a.faces, pen), zero)
+    assert np.all(at_copy[mine])
+    r = rows.subset(np.flatnonzero(mine))
+    high = np.array([two[(point[two] == point[v]) & (two != v)][0] for v in pen.vertex[mine]])
+    assert np.array_equal(r.slave, high)                                    # the higher copy the slave
+    assert np.all(np.any(r.master == pen.vertex[mine][:, None], axis=1))   # on a face at the pushed vertex
+    assert np.array_equal(r.normal, np.tile([1.0, 0.0, 0.0], (len(r), 1))) and np.all(r.g == 0.0)
+    assert np.array_equal(np.sort(r.bary, axis=1), np.tile([0.0, 0.0, 1.0], (len(r), 1)))
+    assert np.allclose(r.C @ U.T.ravel() + r.g, -1e-4, rtol=1e-12, atol=0)

@@ -14,9 +14,10 @@ the core's inside moved by x, the outside held):
 * the first crack's load against the criterion applied to the exact solution, within
   the bound the faceted hole sets (a ray may dip below the tangent plane by the facets'
   tilt) widened by the measured displacement error at the hole;
-* a run: volume to the last bit, no inverted tetrahedron, no penetration after every
-  step, at least two crack surfaces from the hole, and the written steps' overlap between
-  fragments at most 1e-10 of the volume (slow).
+* runs, confined and free: volume to the last bit, no inverted tetrahedron, no penetration
+  after every step, and the written steps' overlap between fragments at most 1e-10 of the
+  volume; confined, at least two crack surfaces from the hole; free, at least three
+  fragments at the end (slow).
 """
 import math
 
@@ -32,7 +33,7 @@ from ngfracture.fracture.strain import principal, vertex_displacement
 from ngfracture.geometry.solid import tet_volumes, total_volume
 from ngfracture.mechanics.problem import ElasticProblem
 from ngfracture.run.invariants import OVERLAP_TOL, penetration_depth_3d
-from ngfracture.scenes import SCENES, cored_sphere_mesh, shells_exact, sphere3d, sphere_first_crack
+from ngfracture.scenes import SCENES, cored_sphere_mesh, shells_exact, sphere3d, sphere3d_free, sphere_first_crack
 from ngfracture.scenes.common import CORE_INNER, HOLE
 
 COARSE = dict(maxh=0.4, fine=0.15)
@@ -206,6 +207,15 @@ def test_run_confined(tmp_path):
     steps, result = run_with_checks(sphere3d(**COARSE), tmp_path)
     assert result.ok and result.reason == "load_max", result.message
     assert steps[-1][4] >= 2
+
+
+@pytest.mark.slow
+def test_run_free(tmp_path):
+    """sphere3d_free on the coarse mesh: the same invariants per step, and it falls apart
+    (the core and at least two glass pieces), as the 2D disintegration."""
+    steps, result = run_with_checks(sphere3d_free(**COARSE), tmp_path)
+    assert result.ok and result.reason in ("load_max", "broken"), result.message
+    assert steps[-1][5] >= 3
 
 
 def solid_arrays(scene):
