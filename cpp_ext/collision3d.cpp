@@ -444,20 +444,149 @@ namespace ngfracture
       return hits;
     }
 
+    // The boundary faces at every vertex (CSR: faces at[start[v] .. start[v+1]), increasing).
+    struct VertexFaces
+    {
+      std::vector<int64_t> start;
+      std::vector<int32_t> at;
+    };
+
+    VertexFaces MakeVertexFaces (const TetMesh3 & m)
+    {
+      VertexFaces vf;
+      vf.start.assign(m.nv + 1, 0);
+      for (int64_t i = 0; i < 3*m.nf; i++) vf.start[m.faces[i] + 1]++;
+      for (int64_t v = 0; v < m.nv; v++) vf.start[v+1] += vf.start[v];
+      vf.at.resize(vf.start[m.nv]);
+      std::vector<int64_t> fill(vf.start.begin(), vf.start.end() - 1);
+      for (int64_t f = 0; f < m.nf; f++)
+        for (int k = 0; k < 3; k++) vf.at[fill[m.faces[3*f+k]]++] = int32_t(f);
+      return vf;
+    }
+
+    // The partner faces of v on fragment F: the faces at a copy t of v on F (t != v) whose
+    // three points are those of a face at v (the other side of one of v's own faces: a
+    // crack lip or an interface), sorted. A partner face opposes one of v's own faces
+    // exactly, though not always v's averaged normal: where several cracks meet, a copy's
+    // wedge can be bounded by faces that the averaged normal of a neighbouring copy does
+    // not oppose, and v, in that wedge, is nearest to them.
+    std::vector<int32_t> PartnerFaces (const TetMesh3 & m, const Copies & copies, const Derived & D,
+                                       const VertexFaces & vfaces, int32_t v, int32_t F)
+    {
+      std::vector<int32_t> out;
+      const auto & grp = copies.group;
+      auto others = [&] (int32_t f, int32_t c, int32_t & a, int32_t & b)
+        {
+          const int32_t * T = m.faces + 3*f;
+          int k = T[0] == c ? 0 : (T[1] == c ? 1 : 2);
+          a = grp[T[(k+1)%3]]; b = grp[T[(k+2)%3]];
+          if (a > b) std::swap(a, b);
+        };
+      int32_t g = grp[v];
+      for (int64_t s = copies.start[g]; s < copies.start[g+1]; s++)
+        {
+          int32_t t = copies.members[s];
+          if (t == v || D.vfrag[t] != F) continue;
+          for (int64_t i = vfaces.start[t]; i < vfaces.start[t+1]; i++)
+            {
+              int32_t f = vfaces.at[i], a, b;
+              others(f, t, a, b);
+              for (int64_t j = vfaces.start[v]; j < vfaces.start[v+1]; j++)
+                {
+                  int32_t h = vfaces.at[j], c, d;
+                  others(h, v, c, d);
+                  if (a == c && b == d) { out.push_back(f); break; }
+                }
+            }
+        }
+      std::sort(out.begin(), out.end());
+      return out;
+    }
+
+    // The vertices of the tetrahedra at every vertex (CSR, with repeats; reference stars).
+    VertexFaces MakeVertexStars (const TetMesh3 & m)
+    {
+      VertexFaces st;
+      st.start.assign(m.nv + 1, 0);
+      for (int64_t i = 0; i < 4*m.ne; i++) st.start[m.tets[i] + 1] += 4;
+      for (int64_t v = 0; v < m.nv; v++) st.start[v+1] += st.start[v];
+      st.at.resize(st.start[m.nv]);
+      std::vector<int64_t> fill(st.start.begin(), st.start.end() - 1);
+      for (int64_t t = 0; t < m.ne; t++)
+        for (int k = 0; k < 4; k++)
+          for (int j = 0; j < 4; j++) st.at[fill[m.tets[4*t+k]]++] = m.tets[4*t+j];
+      return st;
+    }
+
+    // Every vertex w of the reference star of c on the side `sign` of the plane through X_c
+    // with normal n (sign * n . (X_w - X_c) >= -1e-9 |X_w - X_c|: the star's own face
+    // vertices lie on it up to rounding).
+    bool StarOnSide (const TetMesh3 & m, const VertexFaces & stars, int32_t c, const double * n, double sign)
+    {
+      for (int64_t i = stars.start[c]; i < stars.start[c+1]; i++)
+        {
+          double e[3];
+          Sub(m.X + 3*stars.at[i], m.X + 3*c, e);
+          if (sign * Dot(n, e) < -1e-9 * std::sqrt(Dot(e, e))) return false;
+        }
+      return true;
+    }
+
+    // v in the tetrahedron `tet` at its copy t: of the boundary faces of that tetrahedron
+    // at t whose plane has v's reference star on its outer side (faces v's wedge can have
+    // crossed into that tetrahedron: the lip between them, or where several cracks meet
+    // the lip of t towards a third copy that v slid past; not a face of t that v's wedge
+    // lies across, such as the side face that the edge of a lip pushed across a crack
+    // lies on), the one v is least deep behind at the current positions; -1 if none.
+    // `depth` gets max(0, -signed distance). Faces of t elsewhere are not candidates: t's
+    // wedge can be reflex, and v outside one of its planes may still be inside it.
+    int32_t SeparatingFace (const TetMesh3 & m, const VertexFaces & vfaces, const VertexFaces & stars,
+                            int32_t v, int32_t t, const int32_t * tet, double & depth)
+    {
+      int32_t best = -1;
+      double best_s = -std::numeric_limits<double>::infinity();
+      auto in_tet = [&] (int32_t w) { return tet[0] == w || tet[1] == w || tet[2] == w || tet[3] == w; };
+      for (int64_t i = vfaces.start[t]; i < vfaces.start[t+1]; i++)
+        {
+          int32_t f = vfaces.at[i];
+          const int32_t * T = m.faces + 3*f;
+          if (!in_tet(T[0]) || !in_tet(T[1]) || !in_tet(T[2])) continue;
+          double e0[3], e1[3], n[3];
+          Sub(m.X + 3*T[1], m.X + 3*T[0], e0); Sub(m.X + 3*T[2], m.X + 3*T[0], e1); Cross(e0, e1, n);
+          double len = std::sqrt(Dot(n, n));
+          if (!(len > 0)) continue;
+          for (int d = 0; d < 3; d++) n[d] /= len;
+          if (!StarOnSide(m, stars, v, n, 1.0)) continue;
+          Sub(m.x + 3*T[1], m.x + 3*T[0], e0); Sub(m.x + 3*T[2], m.x + 3*T[0], e1); Cross(e0, e1, n);
+          len = std::sqrt(Dot(n, n));
+          if (!(len > 0)) continue;
+          double r[3];
+          Sub(m.x + 3*v, m.x + 3*t, r);
+          double s = Dot(n, r) / len;
+          if (s > best_s || (s == best_s && f < best)) { best_s = s; best = f; }
+        }
+      depth = best >= 0 ? std::max(0.0, -best_s) : 0.0;
+      return best;
+    }
+
+    inline bool IsPartner (const std::vector<int32_t> & partners, int32_t f)
+    { return !partners.empty() && std::binary_search(partners.begin(), partners.end(), f); }
+
     // A face at v is never v's master (only possible on v's own fragment, self-contact).
     inline bool AtVertex (const int32_t * T, int32_t v) { return T[0] == v || T[1] == v || T[2] == v; }
 
     // Master face, step 1: a face of F that holds v exactly (closed triangle) and whose
     // normal does not point along v's (dot <= 0): v touches it, gap 0. Such a face is
     // in v's own cell. Returns the smallest such face number or -1.
-    int32_t TouchedFace (const TetMesh3 & m, const Derived & D, const HashGrid & fg, int32_t v, int32_t F)
+    int32_t TouchedFace (const TetMesh3 & m, const Derived & D, const HashGrid & fg, int32_t v, int32_t F,
+                         const std::vector<int32_t> & partners)
     {
       const double * p = m.x + 3*v;
       int32_t found = -1;
       fg.Visit(fg.Cell(p[0], 0), fg.Cell(p[1], 1), fg.Cell(p[2], 2), [&] (int32_t f)
         {
           if (D.ffrag[f] != F || (found >= 0 && f > found)) return;
-          if (!(Dot(&D.fnormal[3*f], &D.vnormal[3*v]) <= 0)) return;
+          if (!(Dot(&D.fnormal[3*f], &D.vnormal[3*v]) <= 0) && !IsPartner(partners, f)) return;
           const int32_t * T = m.faces + 3*f;
           if (AtVertex(T, v)) return;
           if (PointInClosedTriangle3(p, m.x + 3*T[0], m.x + 3*T[1], m.x + 3*T[2])) found = f;
@@ -468,7 +597,7 @@ namespace ngfracture
     // Step 2: the nearest face of F opposing v (normal dot < 0), or of any orientation if
     // none does, ring by ring of cells around v; ties to the smaller face number.
     int32_t NearestFace (const TetMesh3 & m, const Derived & D, const HashGrid & fg, int32_t v, int32_t F,
-                         bool opposing, double * bary_out)
+                         bool opposing, const std::vector<int32_t> & partners, double * bary_out)
     {
       const double * p = m.x + 3*v;
       int64_t c[3] = { fg.Cell(p[0], 0), fg.Cell(p[1], 1), fg.Cell(p[2], 2) };
@@ -486,7 +615,7 @@ namespace ngfracture
       auto consider = [&] (int32_t f)
         {
           if (D.ffrag[f] != F) return;
-          if (opposing && !(Dot(&D.fnormal[3*f], &D.vnormal[3*v]) < 0)) return;
+          if (opposing && !(Dot(&D.fnormal[3*f], &D.vnormal[3*v]) < 0) && !IsPartner(partners, f)) return;
           // a face whose box is farther than the best is not nearer (a margin for rounding
           // keeps the ties, which go to the smaller face number)
           double box2 = 0;
@@ -541,10 +670,10 @@ namespace ngfracture
     }
 
     bool MasterFace (const TetMesh3 & m, const Derived & D, const HashGrid & fg, int32_t v, int32_t F,
-                     Penetration3 & out)
+                     const std::vector<int32_t> & partners, Penetration3 & out)
     {
       const double * p = m.x + 3*v;
-      int32_t f = TouchedFace(m, D, fg, v, F);
+      int32_t f = TouchedFace(m, D, fg, v, F, partners);
       const int32_t * T = nullptr;
       if (f >= 0)
         {
@@ -555,8 +684,8 @@ namespace ngfracture
         }
       else
         {
-          f = NearestFace(m, D, fg, v, F, true, out.bary);
-          if (f < 0) f = NearestFace(m, D, fg, v, F, false, out.bary);
+          f = NearestFace(m, D, fg, v, F, true, partners, out.bary);
+          if (f < 0) f = NearestFace(m, D, fg, v, F, false, partners, out.bary);
           if (f < 0) return false;
           T = m.faces + 3*f;
           double d2 = Dist2(p, m.x + 3*T[0], m.x + 3*T[1], m.x + 3*T[2], out.bary, out.proj);
@@ -655,6 +784,7 @@ namespace ngfracture
       fg.Build(lo, hi);
       D.flo = std::move(lo); D.fhi = std::move(hi);
 
+      VertexFaces vfaces = MakeVertexFaces(m), stars = MakeVertexStars(m);
       for (size_t s = 0; s < hits.size(); s++)
         {
           auto [v, F, t] = hits[s];
@@ -662,7 +792,31 @@ namespace ngfracture
           Penetration3 pen;
           pen.vertex = v; pen.fragment = F; pen.tet = t;
           pen.twin = copies.Twin(D.vfrag, v, F);             // closed seams were left out by the sweep
-          if (!MasterFace(m, D, fg, v, F, pen)) continue;
+          // v in the star of a copy t (the holding tetrahedron is at t): the face at t
+          // it crossed, if there is one
+          int32_t t_copy = -1;
+          for (int k = 0; k < 4 && pen.twin >= 0; k++)
+            {
+              int32_t w = m.tets[4*t + k];
+              if (w != v && copies.group[w] == copies.group[v]) t_copy = w;
+            }
+          double depth = 0;
+          int32_t sep = t_copy >= 0 ? SeparatingFace(m, vfaces, stars, v, t_copy, m.tets + 4*t, depth) : -1;
+          if (sep >= 0)
+            {
+              const int32_t * T = m.faces + 3*sep;
+              ClosestPointOnTriangle3(m.x + 3*v, m.x + 3*T[0], m.x + 3*T[1], m.x + 3*T[2], pen.bary);
+              for (int d = 0; d < 3; d++)
+                pen.proj[d] = pen.bary[0]*m.x[3*T[0]+d] + pen.bary[1]*m.x[3*T[1]+d] + pen.bary[2]*m.x[3*T[2]+d];
+              pen.face = sep;
+              std::copy(&D.fnormal[3*sep], &D.fnormal[3*sep] + 3, pen.normal);
+              pen.gap = -depth;
+              out.push_back(pen);
+              continue;
+            }
+          std::vector<int32_t> partners;
+          if (pen.twin >= 0) partners = PartnerFaces(m, copies, D, vfaces, v, F);
+          if (!MasterFace(m, D, fg, v, F, partners, pen)) continue;
           out.push_back(pen);
         }
       if (stats) *stats = st;

@@ -2,8 +2,9 @@
 
 Keys as int64 codes (``active_set3d.FaceKeys``, ``active_set.RowKeys``) against key tuples;
 the gap rows' CSR arrays against the conversion from coordinates; the detection's pairs,
-tetrahedra and master faces against a brute-force search over all pairs (exact orient3d,
-nearest face by distance to every face), on a fragmented cube whose blocks overlap.
+tetrahedra and master faces against a brute-force search over all pairs (exact orient3d;
+the crossed face of the tetrahedron at a copy, or the nearest face by distance to every
+face), on a fragmented cube whose blocks overlap.
 """
 import numpy as np
 import pytest
@@ -83,18 +84,43 @@ def test_detection_equals_brute_force(still):
     assert len(pen) > 100
     assert np.array_equal(pen.vertex, v[first]) and np.array_equal(pen.fragment, piece[t][first])
     assert np.array_equal(pen.tet, t[first])
-    # master face: the nearest face of the block opposing the vertex's normal
+    # master face (collision3d's docstring): in a tetrahedron at a copy t of the vertex, the
+    # face of that tetrahedron at t with the vertex's reference star outside its plane that
+    # the vertex is least deep behind; else the nearest face of the block opposing the
+    # vertex's normal or coincident with one of its faces (partner faces)
     area2 = np.cross(x[F[:, 1]] - x[F[:, 0]], x[F[:, 2]] - x[F[:, 0]])
+    ref2 = np.cross(X[F[:, 1]] - X[F[:, 0]], X[F[:, 2]] - X[F[:, 0]])
     vnormal = np.zeros((len(X), 3))
     np.add.at(vnormal, F.ravel(), np.repeat(area2, 3, axis=0))
     face_block = vf[F[:, 0]]
+    points = [frozenset(map(tuple, X[f])) for f in F]
+    star = [np.unique(T[np.any(T == u, axis=1)]) for u in range(len(X))]
+    crossed = 0
     for i in range(len(pen)):
-        a, f = pen.vertex[i], pen.fragment[i]
-        cand = np.flatnonzero((face_block == f) & (area2 @ vnormal[a] < 0) & np.all(F != a, axis=1))
+        a, f, tet = pen.vertex[i], pen.fragment[i], T[pen.tet[i]]
+        t = [u for u in tet if u != a and np.array_equal(X[u], X[a])]
+        sep = []
+        if t:
+            at = np.flatnonzero(np.all(np.isin(F, tet), axis=1) & np.any(F == t[0], axis=1))
+            n = ref2[at] / np.linalg.norm(ref2[at], axis=1)[:, None]
+            e = X[star[a]] - X[a]
+            outside = np.all(n @ e.T >= -1e-9 * np.linalg.norm(e, axis=1), axis=1)
+            sep = at[outside]
+        if len(sep):
+            crossed += 1
+            signed = np.einsum("ij,j->i", area2[sep] / np.linalg.norm(area2[sep], axis=1)[:, None], x[a] - x[t[0]])
+            assert pen.face[i] == sep[np.lexsort((sep, -signed))[0]]
+            assert abs(pen.gap[i] + max(0.0, -signed.max())) <= 1e-12 / CELLS
+            continue
+        mine = {points[g] for g in np.flatnonzero(np.any(F == a, axis=1))}
+        partner = np.array([points[g] in mine and bool(np.any(np.all(X[F[g]] == X[a], axis=1)))
+                            for g in range(len(F))])
+        cand = np.flatnonzero((face_block == f) & ((area2 @ vnormal[a] < 0) | partner) & np.all(F != a, axis=1))
         d = _closest_distance(x[a][None, :], x[F[cand, 0]], x[F[cand, 1]], x[F[cand, 2]])
         assert pen.face[i] in cand
         assert abs(-pen.gap[i] - d.min()) <= 1e-12 / CELLS
         assert d[cand == pen.face[i]][0] <= d.min() + 1e-12 / CELLS
+    assert crossed > 0                         # both rules are exercised
 
 
 def test_detector_is_the_detection():

@@ -14,9 +14,10 @@ the core's inside moved by x, the outside held):
 * the first crack's load against the criterion applied to the exact solution, within
   the bound the faceted hole sets (a ray may dip below the tangent plane by the facets'
   tilt) widened by the measured displacement error at the hole;
-* a run: volume to the last bit, no inverted tetrahedron, no penetration after every
-  step, at least two crack surfaces from the hole, and the written steps' overlap between
-  fragments at most 1e-10 of the volume (slow).
+* runs, confined and free: volume to the last bit, no inverted tetrahedron, no penetration
+  after every step, and the written steps' overlap between fragments at most 1e-10 of the
+  volume; confined, at least two crack surfaces from the hole; free, at least three
+  fragments at the end (slow).
 """
 import math
 
@@ -32,7 +33,7 @@ from ngfracture.fracture.strain import principal, vertex_displacement
 from ngfracture.geometry.solid import tet_volumes, total_volume
 from ngfracture.mechanics.problem import ElasticProblem
 from ngfracture.run.invariants import OVERLAP_TOL, penetration_depth_3d
-from ngfracture.scenes import SCENES, cored_sphere_mesh, shells_exact, sphere3d, sphere_first_crack
+from ngfracture.scenes import SCENES, cored_sphere_mesh, shells_exact, sphere3d, sphere3d_free, sphere_first_crack
 from ngfracture.scenes.common import CORE_INNER, HOLE
 
 COARSE = dict(maxh=0.4, fine=0.15)
@@ -175,32 +176,49 @@ def crack_surfaces_from_hole(arrays):
     return len(set(comp[:n][np.abs(r - HOLE) < 1e-9]))
 
 
-@pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason="the coarse run cracks at x = 8.9e-4, 1.07e-3 and 1.11e-3 (29 split "
-                   "vertices), then at a hole vertex where three cracks meet (7 copies) a lip copy goes 1.0e-5 deep "
-                   "into its own fragment at x = 1.12e-3 (docs/solid.md, 'The sphere scenes')")
-def test_run_confined(tmp_path):
+def run_with_checks(scene, out):
+    """Run ``scene`` into ``out``; per accepted step (x, volume, smallest deformed tet volume,
+    deepest penetration, crack surfaces from the hole, fragments), and the result."""
     from ngfracture.run.simulation import Simulation
-    scene = sphere3d(**COARSE)
-    volume = total_volume(solid_arrays(scene).points, solid_arrays(scene).tets)
     steps = []
 
     def on_step(accepted):
         prob = accepted.problem
         a = prob.arrays
         U = vertex_displacement(prob.u)
-        steps.append((accepted.state.x, total_volume(a.points, a.tets),
-                      tet_volumes(a.points + U, a.tets).min(), penetration_depth_3d(prob),
-                      crack_surfaces_from_hole(a)))
+        steps.append((accepted.state.x, total_volume(a.points, a.tets), tet_volumes(a.points + U, a.tets).min(),
+                      penetration_depth_3d(prob), crack_surfaces_from_hole(a), prob.fragments()[0]))
 
-    result = Simulation(scene, out=tmp_path, pictures="none").run(on_step=on_step)
-    for s in steps:
-        print(s)
-    assert result.ok and result.reason == "load_max", result.message
-    for x, vol, vmin, depth, _ in steps:
+    result = Simulation(scene, out=out, pictures="none").run(on_step=on_step)
+    for step in steps:
+        print(step)
+    volume = total_volume(solid_arrays(scene).points, solid_arrays(scene).tets)
+    for x, vol, vmin, depth, _, _ in steps:
         assert vol == volume and vmin > 0 and depth <= OVERLAP_TOL * 2.0, (x, vol, vmin, depth)
+    check_run_overlap(out)                       # the written steps: overlap <= 1e-10 of the volume
+    return steps, result
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(strict=True, reason="the coarse run reaches x = 2.52e-3 of 3.56e-3 (36 steps, 219 split "
+                   "vertices, 333 s), then at x = 2.53e-3 a glass vertex of a piece being cut off goes 5.3e-5 deep "
+                   "into the copy it was split from, across a folded lip (docs/solid.md, 'The sphere scenes')")
+def test_run_confined(tmp_path):
+    steps, result = run_with_checks(sphere3d(**COARSE), tmp_path)
+    assert result.ok and result.reason == "load_max", result.message
     assert steps[-1][4] >= 2
-    check_run_overlap(tmp_path)                  # the written steps: overlap <= 1e-10 of the volume
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(strict=True, reason="the coarse free run reaches x = 1.95e-3 of 4.14e-3 (18 steps, 217 split "
+                   "vertices, the glass one piece), then its step at x = 1.96e-3 fails four times, the contact active "
+                   "set not settled in 20 rounds (docs/solid.md, 'The sphere scenes')")
+def test_run_free(tmp_path):
+    """sphere3d_free on the coarse mesh: the same invariants per step, and it falls apart
+    (the core and at least two glass pieces), as the 2D disintegration."""
+    steps, result = run_with_checks(sphere3d_free(**COARSE), tmp_path)
+    assert result.ok and result.reason in ("load_max", "broken"), result.message
+    assert steps[-1][5] >= 3
 
 
 def solid_arrays(scene):

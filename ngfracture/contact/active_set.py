@@ -78,8 +78,9 @@ class Geometry:
     fixed : numpy.ndarray of int
         Dofs fixed by Dirichlet conditions, in the layout of the rows (comp * nv + v).
     holds : scipy.sparse.csr_matrix or None
-        Rows holding the pieces on all their rigid modes, in that layout (None unless
-        ``fix_free_modes`` is "all"): contact rows dependent on them are dropped.
+        General rows kept in any case, in that layout: those holding the pieces on all
+        their rigid modes (``fix_free_modes`` "all") and the problem's own general rows
+        (None without either): contact rows dependent on them are dropped.
     """
     arrays: object
     fragment: np.ndarray

@@ -61,6 +61,7 @@ import numpy as np
 
 from .active_set import ActiveSet, Candidates, RowKeys, refreshed
 from .collision3d import PenetrationDetector3d
+from .copies3d import found_rows_at_copies
 from .junctions3d import covered_pairs, fragment_pair_rows
 from .rows3d import NodeToFaceRows, lip_rows, no_face_rows, node_to_face_rows, relinearise_node_to_face
 
@@ -286,11 +287,14 @@ class ActiveSet3d(ActiveSet):
         t0 = time.perf_counter()
         pen = self.detector.detect(U)
         timings["collision"] += time.perf_counter() - t0
-        rows = node_to_face_rows(a.points, a.faces, pen)
+        rows, at_copy = found_rows_at_copies(a.points, a.faces, node_to_face_rows(a.points, a.faces, pen),
+                                             self.vertex_fragment)
         # a vertex with a twin on the master fragment talks to it through its twin row; a
-        # lip vertex in its own fragment, through the lip row of its pair of copies
+        # lip vertex in its own fragment, through the lip row of its pair of copies; but
+        # one inside the wedge of a copy (master face at the copy) gets that face's row
+        # (copies3d: where several copies meet the fixed rows are not the whole condition)
         twin = np.asarray(pen.twin, dtype=np.int64)
-        keep = twin < 0
+        keep = (twin < 0) | (at_copy & (pen.gap < -self.penetration_tol))
         if not keep.all():
             own = pen.fragment == self.vertex_fragment[pen.vertex]
             keep |= ~own & ~np.isin(np.asarray(pen.fragment, dtype=np.int64) * len(a.points) + pen.vertex, self.covered)

@@ -46,15 +46,29 @@ Up to 2^22 cells the grid is an array of ranges over all cells, filled by a coun
 swept in increasing order, so the first one holding a pair (vertex, fragment) is the
 smallest, and later tetrahedra of that fragment do not test the pair again.
 
-Master face. For each pair, in this order:
+Master face. For a pair whose vertex lies in a tetrahedron at its copy t on F (a crack
+lip, or where several cracks meet): among the boundary faces of that tetrahedron at t,
+those whose plane has v's reference star (the vertices of v's tetrahedra) on its outer
+side, the one v is least deep behind (largest signed distance n . (x_v - x_t)); gap minus
+that depth (0 if v is not behind it), the projection the nearest point of the face. These
+are the faces v's wedge can have crossed: the lip between the two copies, or, where three
+or more copies meet, the lip of t towards a third copy that v slid past; not a face of t
+that v's wedge lies across (the side face that the edge of a lip pushed across the crack
+lies on). Else, in this order:
 
 1. touching: a boundary face of F that holds v exactly (closed triangle, exact
    predicates) and whose outward normal does not point along v's normal (dot <= 0; v's
-   normal is the area-weighted sum of the normals of its own boundary faces): gap 0
-   exactly, projection x_v itself;
+   normal is the area-weighted sum of the normals of its own boundary faces) or that is
+   a *partner* face (at a copy of v on F, on the three points of one of v's own faces):
+   gap 0 exactly, projection x_v itself;
 2. else the boundary face of F nearest to v (Euclidean distance to the closed triangle)
-   among those whose normal opposes v's (dot < 0);
+   among those whose normal opposes v's (dot < 0) and the partner faces;
 3. else the nearest face of F of any orientation.
+
+Where several cracks meet, a copy's wedge can be bounded by faces that the averaged normal
+of a neighbouring copy does not oppose: measured on the sphere scene, a lip copy within
+5e-16 of the crack face of a small three-face wedge it had slid onto was reported 1.0e-5
+deep, the distance to a face at another copy (docs/contact.md, "Points of several copies").
 
 The orientation filter is the 3D form of the 2D rule 3 (angle between master and slave):
 a vertex at the edge of a crack lip, pushed across the crack, lies exactly on the other

@@ -51,11 +51,8 @@ The tributary area of a node, by which a force is a pressure, is the consistent 
 of the surface: the integral of its hat function, a third of the area of every face at
 the node (:func:`nodal_areas`).
 
-The detection has no precision threshold: a node touching a face can be lost to rounding
-(nine perimeter nodes of the test's interface, moved out of the other block by 1e-18 in
-the prediction). Candidates are therefore gathered where touching is exact (the reference
-configuration of two blocks meshed apart) and joined by those found penetrating later,
-as the 2D active set keeps the rows it has found.
+Where the candidates come from (touching pairs of the reference configuration, fixed rows,
+found rows) is :mod:`ngfracture.contact.active_set3d`'s business.
 """
 from dataclasses import dataclass
 import functools
@@ -494,7 +491,10 @@ def relinearise_node_to_face(rows, points, displacement):
     The projection is onto the face's plane, its barycentrics clipped to the triangle
     (negative weights set to 0 and the rest rescaled to sum 1); the normal keeps its
     side. A master face squeezed below 1e-16 of its reference area keeps its previous
-    normal and barycentrics.
+    normal and barycentrics. A row projected at a copy of the slave (twin, lip and
+    partner-face rows; :func:`~ngfracture.contact.kinks3d.anchored_at_copies`) keeps its
+    projection there: the rows of one slave on several faces at a copy t then all vanish
+    where the copies meet (docs/contact.md, "Points of several copies").
 
     Parameters
     ----------
@@ -533,7 +533,9 @@ def relinearise_node_to_face(rows, points, displacement):
     n[degenerate] = rows.normal[degenerate]
     b = np.clip(b, 0.0, None)
     b /= np.where(b.sum(axis=1) > 0, b.sum(axis=1), 1.0)[:, None]
-    b[degenerate] = rows.bary[degenerate]
+    corner = rows.master[np.arange(len(rows)), np.argmax(rows.bary, axis=1)]
+    keep = degenerate | ((rows.bary.max(axis=1) == 1.0) & np.all(X[corner] == X[rows.slave], axis=1))
+    b[keep] = rows.bary[keep]
     dist = np.einsum("ij,ij->i", q - np.einsum("ij,ijk->ik", b, p), n)
     return NodeToFaceRows(rows.slave, rows.master, rows.face, b, n, dist,
                           _gap_offset(X, rows.slave, rows.master, b, n), nv=rows.nv)

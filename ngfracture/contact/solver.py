@@ -252,20 +252,27 @@ class ContactSolver:
         return geometry, fixed
 
     def _held_modes(self):
-        """With fix_free_modes "all", the rows that hold the pieces, in the P1 layout (else None).
+        """The general rows that contact rows must be independent of, in the P1 layout (or None).
 
-        Contact rows dependent on them would make the solve singular (a small piece with
-        more contact rows than deformation modes)."""
-        if self.options["fix_free_modes"] != "all":
-            return None
+        With fix_free_modes "all", the rows that hold the pieces; and the problem's own
+        general rows (the sphere scenes' stick rows). Contact rows dependent on them would
+        make the solve singular: a small piece with more contact rows than deformation
+        modes; at a point of three copies (a core vertex tied tangentially to one glass
+        copy, the other glass copy with a row on every partner face) six rows on the six
+        relative dofs of the copies whose normals leave one direction free."""
         prob = self.problem
         dim = prob.dim
-        modes = prob.support(prob.assemble_constraints()).modes.T.tocoo()
         nv, n = prob.mesh.nv, prob.fes.ndof // dim
-        v, c = modes.col % n, modes.col // n
-        keep = v < nv          # the modes live on the vertex dofs
-        return sp.csr_matrix((modes.data[keep], (modes.row[keep], (c * nv + v)[keep])),
-                             shape=(modes.shape[0], dim * nv))
+        blocks = []
+        if self.options["fix_free_modes"] == "all":
+            blocks.append(prob.support(prob.assemble_constraints()).modes.T.tocoo())
+        blocks += [sp.coo_matrix(C) for C, _, label in prob.constraints.rows if label != LABEL]
+        if not blocks:
+            return None
+        rows = sp.vstack(blocks).tocoo()
+        v, c = rows.col % n, rows.col // n
+        keep = v < nv          # the modes and the scenes' rows live on the vertex dofs
+        return sp.csr_matrix((rows.data[keep], (rows.row[keep], (c * nv + v)[keep])), shape=(rows.shape[0], dim * nv))
 
     def _active_set(self, geometry, warm):
         """The active set of a solve: ActiveSet on triangles, ActiveSet3d on tetrahedra."""

@@ -1,0 +1,117 @@
+"""Found rows between copies of a point: projected at the copy, one direction per pair.
+
+Where node splitting left several copies of a point (crack lips, the core's vertex at a
+crack's mouth on the sphere's hole), the fixed rows (:func:`~ngfracture.contact.rows3d.lip_rows`,
+:func:`~ngfracture.contact.junctions3d.fragment_pair_rows` and their partner-face rows) hold
+each copy against the faces at the other copies that are coincident with its own faces.
+Where three or more copies meet they are not the whole condition: a copy s may slide over
+a face at copy t that is coincident with a face of a third copy u (a lip sliding past the
+junction line of three cracks), or into the lip of t across the crack that opened between
+t and u (the core's vertex at a crack's mouth). Non-penetration there is a union of
+conditions (s outside t's wedge through one of its faces or another), which no fixed set
+of rows expresses; the detection finds where it fails: s inside a tetrahedron at t, its
+master the nearest face at t that opposes s's normal or is coincident with a face at s
+(:func:`~ngfracture.contact.collision3d.detect_penetrations_3d`).
+
+:func:`found_rows_at_copies` turns such detected rows into rows of the same form as the
+fixed ones, so that they neither conflict with them nor duplicate them reversed:
+
+- **projected at the copy**: a row of s on a face with a corner t at s's reference point
+  gets the barycentric 1 at t (g = 0): its gap n . (x_s - x_t) is the same as on any point
+  of the face's plane, and all rows of s on faces at t vanish where the copies meet
+  (:func:`~ngfracture.contact.rows3d.relinearise_node_to_face` keeps the projection there);
+- **the face's normal of the reference configuration**, as the fixed rows start: the
+  detection's configuration may be a prediction whose lips overlap and tilt by 1e-3, and
+  the gap of copies that meet does not change with the normal, so a row made there kept
+  the tilted normal (the re-linearisation keeps rows whose gap did not change), imposed
+  beside the fixed row of the pair with the face's true normal: two rows that block the
+  slip of the copies. The next round re-linearises a row whose gap the solve changed;
+- **one direction per pair**, the fixed rows' (the slave on the higher fragment, on one
+  fragment the higher vertex number): a row of the other direction, t found inside s's
+  wedge through face f at s, is the row of s on the face at t coincident with f (normals
+  opposite: n_f . (x_t - x_s) >= 0 is the same inequality), where there is one; rows of
+  both directions on nearly parallel faces, imposed together, block the slip of the copies
+  (docs/contact.md, "Crack lips in 3D").
+"""
+import numpy as np
+
+from .kinks3d import point_groups
+from .rows3d import NodeToFaceRows
+
+__all__ = ["found_rows_at_copies"]
+
+
+def _point_ids(X, F):
+    """Per vertex the number of its reference point among the boundary vertices (-1 elsewhere)."""
+    on, group = point_groups(X, F)
+    pid = np.full(len(X), -1, dtype=np.int64)
+    pid[on] = group
+    return pid
+
+
+def _partner_at(F, pid, face, vertex):
+    """For every (face, vertex): the face on the same three points with ``vertex`` as a corner, or -1."""
+    K = np.sort(pid[F], axis=1)
+    _, key = np.unique(K, axis=0, return_inverse=True)
+    key = key.ravel()
+    order = np.argsort(key, kind="stable")
+    start = np.searchsorted(key[order], key[face])
+    count = np.searchsorted(key[order], key[face], side="right") - start
+    out = np.full(len(face), -1, dtype=np.int64)
+    for shift in range(int(count.max(initial=0))):            # the faces on the same points: a few at most
+        slot = np.minimum(start + shift, len(order) - 1)
+        cand = order[slot]
+        hit = (shift < count) & (out < 0) & np.any(F[cand] == vertex[:, None], axis=1)
+        out[hit] = cand[hit]
+    return out
+
+
+def found_rows_at_copies(points, faces, rows, vertex_fragment):
+    """Detected rows on faces at a copy of the slave: projected there, in the fixed rows' direction.
+
+    Parameters
+    ----------
+    points : numpy.ndarray, shape (nv, 3)
+        Reference coordinates (copies bitwise equal).
+    faces : numpy.ndarray of int, shape (nf, 3)
+        Boundary faces, outward (the rows' faces are rows of it).
+    rows : NodeToFaceRows
+        Rows of detected pairs (:func:`~ngfracture.contact.rows3d.node_to_face_rows`).
+    vertex_fragment : numpy.ndarray of int, shape (nv,)
+        The fragment of every vertex.
+
+    Returns
+    -------
+    rows : NodeToFaceRows
+        The rows in their order; those at a copy projected there and, in the other
+        direction, replaced by the row of the copy on the coincident face at the slave
+        where it exists; their normal the face's in the reference configuration (``dist``
+        kept).
+    at_copy : numpy.ndarray of bool
+        Which rows are on a face at a copy of their slave.
+    """
+    if len(rows) == 0:
+        return rows, np.zeros(0, dtype=bool)
+    X, F = np.asarray(points), np.asarray(faces, dtype=np.int64)
+    vf = np.asarray(vertex_fragment, dtype=np.int64)
+    pid = _point_ids(X, F)
+    same = pid[rows.master] == pid[rows.slave][:, None]                  # [row, corner]
+    at_copy = same.any(axis=1) & (pid[rows.slave] >= 0)
+    slave, face, normal = rows.slave.copy(), rows.face.copy(), rows.normal.copy()
+    copy = rows.master[np.arange(len(rows)), same.argmax(axis=1)]
+    reverse = at_copy & ((vf[slave] < vf[copy]) | ((vf[slave] == vf[copy]) & (slave < copy)))
+    r = np.flatnonzero(reverse)
+    partner = _partner_at(F, pid, face[r], slave[r])
+    r, partner = r[partner >= 0], partner[partner >= 0]
+    slave[r], copy[r], face[r] = copy[r], slave[r], partner
+    master = F[face]
+    p = X[master[at_copy]]
+    area2 = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+    normal[at_copy] = area2 / np.linalg.norm(area2, axis=1)[:, None]
+    bary = rows.bary.copy()
+    bary[at_copy] = (master[at_copy] == copy[at_copy, None]).astype(np.float64)
+    g = rows.g.copy()
+    g[at_copy] = 0.0                                      # n . (X_s - X_t), the copies' points equal
+    out = NodeToFaceRows(slave=slave, master=master, face=face, bary=bary, normal=normal, dist=rows.dist.copy(),
+                         g=g, nv=rows.nv)
+    return out, at_copy
