@@ -198,7 +198,7 @@ class NewtonSolver:
         Solver of K^+ (INVERSES): "auto", "superlu", an NGSolve name (see
         linalg.kkt.ConstrainedSolver) or "amg"; chosen per factorisation by
         linalg.iterative.make_factor (3D "auto": sparse Cholesky within the memory budget,
-        "amg" above).
+        "amg" above; SuperLU for a full-Newton tangent with many general rows).
     divergence_factor : float
         An increment this many times larger than the first one means divergence.
     fix_free_modes : bool or "all"
