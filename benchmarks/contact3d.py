@@ -70,14 +70,19 @@ parameter instead of maxh (the sphere scenes' mesh is set by ``fine`` near the h
 ``--set NAME=VALUE`` fixing others; ``--steps N`` stops every run after N accepted steps,
 ``--until-crack`` after its first cracked step (the run is left there, reason "first_crack",
 its wall the seconds to that step).
-Every case also reports its accepted steps' cumulative seconds (``step_seconds``) and split
-vertices, the first step that splits a vertex (``first_crack_step``), the seconds up to and
+``--inverse NAME`` runs them with that direct solver (``StepControl.inverse``). Every case
+also reports, per accepted step and cumulative, its wall and CPU seconds (``step_seconds``,
+``step_cpu_seconds``) and the linear algebra's counts (``LinalgCounts``: ``step_factorisations``
+of K_ff, ``step_augmented`` augmented matrices, ``step_columns`` Schur columns solved,
+``step_schur_seconds``, ``step_factorise_seconds``; ``totals`` at the end, and one line per
+step on stderr as it is accepted), its split vertices, the first step that splits a vertex (``first_crack_step``), the seconds up to and
 including it (``seconds_to_first_crack``) and those over t_unit
 (``solve_equivalents_to_first_crack``, None without a crack), with its growth exponent.
 
 Usage: PYTHONPATH=. OMP_NUM_THREADS=1 python benchmarks/contact3d.py [--quick]
        [--cells 15 20 26] [--pieces 4] [--repeat 2] [--scene NAME [--maxh H ...]
-       [--vary NAME --values V ...] [--set NAME=VALUE ...] [--steps N] [--until-crack]] [--json FILE [--force]]
+       [--vary NAME --values V ...] [--set NAME=VALUE ...] [--steps N] [--until-crack] [--inverse NAME]]
+       [--json FILE [--force]]
 """
 import argparse
 import inspect
@@ -290,14 +295,95 @@ def first_crack(records):
     return None, None
 
 
+class LinalgCounts:
+    """Counts of the linear algebra of a run, by wrapping linalg.factor's methods while in use
+    (``with LinalgCounts() as counts``): ``factorisations`` (direct factorisations of K_ff),
+    ``augmented`` (augmented matrices factorised), ``columns`` (Schur columns K^+ c solved,
+    by column solves or sparse triangular solves), ``schur_seconds`` (seconds building
+    Schur columns), ``factorise_seconds``. The wrappers are removed on leaving."""
+
+    def __enter__(self):
+        from ngfracture.linalg import factor
+        self.factorisations = self.augmented = self.columns = 0
+        self.schur_seconds = self.factorise_seconds = 0.0
+        self._saved = [(factor.EliminatedFactor, "factorise"), (factor.EliminatedFactor, "augmented"),
+                       (factor.FactorBase, "columns_and_solve"), (factor.EliminatedFactor, "schur"),
+                       (factor, "reach_solves")]
+        self._saved = [(owner, name, getattr(owner, name)) for owner, name in self._saved]
+        counts = self
+        originals = {name: f for _, name, f in self._saved}
+
+        def factorise(fac):
+            t0, fresh = time.perf_counter(), not fac.factorised
+            originals["factorise"](fac)
+            counts.factorisations += fresh
+            counts.factorise_seconds += time.perf_counter() - t0
+
+        def augmented(fac, C):
+            cached = fac._augmented
+            out = originals["augmented"](fac, C)
+            counts.augmented += fac._augmented is not cached
+            return out
+
+        block = []          # the right-hand sides besides the rows of the columns_and_solve under way
+
+        def columns_and_solve(fac, C, B):
+            t0 = time.perf_counter()
+            block.append(B.shape[1])
+            try:
+                Z, X = originals["columns_and_solve"](fac, C, B)
+            finally:
+                block.pop()
+            counts.schur_seconds += time.perf_counter() - t0
+            return Z, X
+
+        def schur(fac, C):
+            t0 = time.perf_counter()
+            S = originals["schur"](fac, C)
+            counts.schur_seconds += time.perf_counter() - t0
+            return S
+
+        def reach_solves(lu, arrays, index, C):
+            counts.columns += C.shape[0]
+            return originals["reach_solves"](lu, arrays, index, C)
+
+        solve = factor.EliminatedFactor.solve
+
+        def counted_solve(fac, B):
+            if block:
+                counts.columns += B.shape[1] - block[-1]
+                block[-1] = B.shape[1]      # a further solve (the residual check) adds nothing
+            return solve(fac, B)
+
+        self._saved.append((factor.EliminatedFactor, "solve", solve))
+        for owner, name, f in [(factor.EliminatedFactor, "factorise", factorise),
+                               (factor.EliminatedFactor, "augmented", augmented),
+                               (factor.FactorBase, "columns_and_solve", columns_and_solve),
+                               (factor.EliminatedFactor, "schur", schur), (factor, "reach_solves", reach_solves),
+                               (factor.EliminatedFactor, "solve", counted_solve)]:
+            setattr(owner, name, f)
+        return self
+
+    def __exit__(self, *exc):
+        for owner, name, f in self._saved:
+            setattr(owner, name, f)
+        return False
+
+    def snapshot(self):
+        """The counts so far, a dict."""
+        return {"factorisations": self.factorisations, "augmented": self.augmented, "columns": self.columns,
+                "schur_seconds": self.schur_seconds, "factorise_seconds": self.factorise_seconds}
+
+
 class FirstCrack(Exception):
     """Raised by the progress callback of a run stopped at its first cracked step."""
 
 
-def run_scene(name, kwargs, repeat, steps=None, until_crack=False):
+def run_scene(name, kwargs, repeat, steps=None, until_crack=False, inverse=None):
     """One run of a registered scene (at most ``steps`` accepted steps, or up to and including
-    its first cracked step with ``until_crack``; reason "first_crack" then): its contact
-    phases, wall, unit and the time to its first cracked step."""
+    its first cracked step with ``until_crack``; reason "first_crack" then; with the step
+    control's ``inverse`` if given): its contact phases, wall, unit, the time to its first
+    cracked step and the linear algebra's counts (:class:`LinalgCounts`) per step."""
     from ngfracture import Simulation, scenes
     from ngfracture.run.control import StepControl
     sys.path.insert(0, str(__import__("pathlib").Path(__file__).parent))
@@ -307,14 +393,19 @@ def run_scene(name, kwargs, repeat, steps=None, until_crack=False):
     records = []
 
     def progress(record):
-        records.append(record)
+        records.append({**record, **counts.snapshot(), "cpu_seconds": time.process_time() - cpu0})
+        print(json.dumps({k: records[-1][k] for k in ("step", "seconds", "cpu_seconds", "split_vertices",
+                                                      *counts.snapshot())}), file=sys.stderr, flush=True)
         if until_crack and record["split_vertices"] > 0:
             raise FirstCrack
 
-    control = StepControl(max_steps=steps) if steps is not None else None
-    with tempfile.TemporaryDirectory() as out:
+    options = {"max_steps": steps} if steps is not None else {}
+    if inverse is not None:
+        options["inverse"] = inverse
+    control = StepControl(**options) if options else None
+    with tempfile.TemporaryDirectory() as out, LinalgCounts() as counts:
         simulation = Simulation(scene, control=control, out=out, pictures="none", progress=progress)
-        t0 = time.perf_counter()
+        t0, cpu0 = time.perf_counter(), time.process_time()
         try:
             result = simulation.run()
             reason, n_steps, wall = result.reason, result.summary["n_steps"], result.summary["timings"]["wall"]
@@ -330,7 +421,8 @@ def run_scene(name, kwargs, repeat, steps=None, until_crack=False):
             "solve": timings["solve"], "wall": wall, "t_unit": t_unit, "solver": solver,
             "solve_equivalents": wall / t_unit, "contact_ratio": contact / t_unit,
             "step_seconds": [r["seconds"] for r in records], "split_vertices": [r["split_vertices"] for r in records],
-            "first_crack_step": crack_step, "seconds_to_first_crack": crack_seconds,
+            **{f"step_{key}": [r[key] for r in records] for key in (*counts.snapshot(), "cpu_seconds")},
+            "totals": counts.snapshot(), "first_crack_step": crack_step, "seconds_to_first_crack": crack_seconds,
             "solve_equivalents_to_first_crack": None if crack_seconds is None else crack_seconds / t_unit}
 
 
@@ -349,6 +441,7 @@ def main(argv=None):
     p.add_argument("--steps", type=int, default=None, help="stop every scene run after this many accepted steps")
     p.add_argument("--until-crack", action="store_true",
                    help="stop every scene run after its first step that splits a vertex")
+    p.add_argument("--inverse", default=None, help="the scene runs' direct solver (StepControl.inverse)")
     benchmark_json.add_options(p)
     args = p.parse_args(argv)
     if args.repeat < 1:
@@ -363,7 +456,7 @@ def main(argv=None):
             p.error(str(exc))
         cases = []
         for kwargs in sizes:
-            cases.append(run_scene(args.scene, kwargs, args.repeat, args.steps, args.until_crack))
+            cases.append(run_scene(args.scene, kwargs, args.repeat, args.steps, args.until_crack, args.inverse))
             print(json.dumps(cases[-1]), file=sys.stderr, flush=True)
         growth = exponents(cases, ("wall", "t_unit", "solve_equivalents", "contact_ratio"))
         cracked = [c for c in cases if c["first_crack_step"] is not None]

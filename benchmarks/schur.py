@@ -9,7 +9,17 @@ factorisation, best of three. Reported per case: dofs, rows, seconds of each, th
 and the largest difference of the two S relative to its largest entry. The factorisation
 itself is the same for both and not counted.
 
-Usage: python benchmarks/schur.py [--factors 1 2 4 8 16] [--json FILE [--force]]
+``--sphere FINE ...``: the sphere scene (``scenes.sphere3d(maxh, fine)``, ``--maxh``, default
+the scene's) with its stick rows (the general rows of its first solve): one factorisation
+of the tangent and its Schur complement each way a 3D solve can take it, fresh every time,
+best of three: "cholesky" (NGSolve's sparse Cholesky, then the columns K^+ C^T and C Z),
+"superlu" (SuperLU, then the sparse triangular solves of ``EliminatedFactor.schur``),
+"augmented" (SuperLU of the augmented matrix, ``EliminatedFactor.augmented``; no S).
+Reported per case: tets, factorised dofs, rows, each one's factorisation and Schur
+seconds, their sums and the ratios to "cholesky".
+
+Usage: python benchmarks/schur.py [--factors 1 2 4 8 16] [--sphere FINE ... [--maxh H]]
+       [--json FILE [--force]]
 """
 import argparse
 import time
@@ -60,12 +70,55 @@ def case(factor, repeat=3):
             "relative_difference": float(np.abs(S["sparse"] - S["columns"]).max() / np.abs(S["columns"]).max())}
 
 
+def sphere_case(fine, maxh=None, repeat=3):
+    """The three ways of a 3D factorisation with the sphere's stick rows (module docstring)."""
+    from ngfracture.linalg.sparse import reproducible_threads
+    kwargs = {"fine": fine} if maxh is None else {"fine": fine, "maxh": maxh}
+    scene = scenes.sphere3d(**kwargs)
+    prob = ElasticProblem(scene.mesh, scene.material)
+    scene.apply_load(prob, scene.dx)
+    rows = prob.assemble_constraints()
+    support = prob.support(rows)
+    K, C = prob.tangent(), rows.C
+    out = {"fine": fine, "tets": scene.mesh.ne, "rows": C.shape[0]}
+    for name in ("cholesky", "superlu", "augmented"):
+        best = (np.inf, np.inf)
+        for _ in range(repeat):
+            f = factor_module.EliminatedFactor(K, rows.fixed_dofs, support.pins,
+                                               inverse="sparsecholesky" if name == "cholesky" else "superlu")
+            t0 = time.perf_counter()
+            if name == "augmented":
+                f.augmented(C)
+                t1 = time.perf_counter()
+            else:
+                with reproducible_threads():
+                    f.factorise()
+                t1 = time.perf_counter()
+                S = C @ f.columns(C) if name == "cholesky" else f.schur(C)
+                assert np.all(np.isfinite(S))
+            t2 = time.perf_counter()
+            best = min(best, (t1 - t0, t2 - t1), key=sum)
+        out.update({f"{name}_factorise_s": best[0], f"{name}_schur_s": best[1], f"{name}_s": sum(best)})
+        out["dofs"] = int(np.count_nonzero(f.factor_free))
+    for name in ("superlu", "augmented"):
+        out[f"{name}_over_cholesky"] = out[f"{name}_s"] / out["cholesky_s"]
+    print(out, flush=True)
+    return out
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--factors", nargs="+", type=float, default=[1, 2, 4, 8, 16])
+    parser.add_argument("--sphere", nargs="+", type=float, default=None, metavar="FINE",
+                        help="the sphere scene at these values of fine instead (3D ways)")
+    parser.add_argument("--maxh", type=float, default=None, help="the sphere's maxh (with --sphere)")
     benchmark_json.add_options(parser)
     args = parser.parse_args(argv)
     benchmark_json.refuse_existing(parser, args)
+    if args.sphere:
+        cases = [sphere_case(fine, args.maxh) for fine in args.sphere]
+        benchmark_json.write(args, {"sphere_cases": cases})
+        return
     cases = [case(f) for f in args.factors]
     benchmark_json.write(args, {"cases": cases, "sparse_schur_min_dofs": factor_module.SPARSE_SCHUR_MIN_DOFS})
 

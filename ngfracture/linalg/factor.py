@@ -16,6 +16,7 @@ import ngsolve as ng
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from .kept import KeptColumns, row_keys
 from .sparse import reproducible_threads, to_ngsolve, to_scipy
 from .triangular import factor_arrays, reach_solves, sparse_columns, supernodal_solver
 
@@ -57,8 +58,12 @@ class FactorBase:
     pinned), ``inverse``, ``linear_solver``, and defines ``solve(B)`` and ``sparse_schur``.
     """
 
+    #: True if a block solve gives every column bit for bit as that column solved alone
+    #: (then every column met is kept, :meth:`columns_and_solve`)
+    columns_independent = False
+
     def __init__(self):
-        self._columns = {}        # row key -> K^+ row^T, for the rows of the last Schur complement
+        self._columns = KeptColumns()     # K^+ c of the rows met (columns_and_solve)
         self._checked = False     # the first solve checks its residual (check_solution)
 
     def check_solution(self, B, X):
@@ -153,10 +158,12 @@ class FactorBase:
         return Rt_sparse, A
 
     def columns(self, C):
-        """Z = K^+ C^T (ndof, m); rows met in the last call are not solved again.
+        """Z = K^+ C^T (ndof, m); rows met before are not solved again.
 
-        A row is recognised by its stored column indices and values (bitwise); the cache
-        keeps only the rows of the latest call.
+        A row is recognised by its stored column indices and values (bitwise). Where the
+        solves are column by column (:attr:`columns_independent`) every row met is kept
+        (linalg.kept: up to ``KEPT_COLUMNS_BYTES``): a kept column is bit for bit the one a
+        solve would give. Otherwise only the rows of the latest call are kept.
 
         Parameters
         ----------
@@ -197,19 +204,14 @@ class FactorBase:
             From :meth:`solve`.
         """
         C = sp.csr_matrix(C)
-        keys = [C.indices[s:e].tobytes() + C.data[s:e].tobytes() for s, e in zip(C.indptr[:-1], C.indptr[1:])]
+        keys = row_keys(C)
         Z = np.zeros((self.ndof, len(keys)))
-        new = []
-        for i, key in enumerate(keys):
-            if key in self._columns:
-                Z[:, i] = self._columns[key]
-            else:
-                new.append(i)
+        new = self._columns.fill(keys, Z)
         X = B
         if new or B.shape[1]:
             solved = self.solve(np.hstack([C[new].T.toarray(), B]))
             Z[:, new], X = solved[:, :len(new)], solved[:, len(new):]
-        self._columns = {key: Z[:, i] for i, key in enumerate(keys)}
+        self._columns.keep(keys, Z, self.columns_independent)
         return Z, X
 
     @property
@@ -220,18 +222,11 @@ class FactorBase:
                 and np.count_nonzero(self.free) <= AUGMENTED_MAX_DOFS)
 
     def keeps_columns(self, m):
-        """False if the Schur complement of ``m`` general rows is made by :meth:`schur`,
-        keeping no columns K^+ C^T: ``sparse_schur`` and m >= ``SPARSE_SCHUR_MIN_ROWS``.
-
-        Parameters
-        ----------
-        m : int
-
-        Returns
-        -------
-        bool
-        """
+        """False (bool) if the Schur complement of ``m`` (int) general rows is made by
+        :meth:`schur`, keeping no columns K^+ C^T: ``sparse_schur`` and m >=
+        ``SPARSE_SCHUR_MIN_ROWS``."""
         return not (self.sparse_schur and m >= SPARSE_SCHUR_MIN_ROWS)
+
 
 class EliminatedFactor(FactorBase):
     """K^+: the stiffness without fixed dofs and pins, factorised once, for many solves.
@@ -239,9 +234,8 @@ class EliminatedFactor(FactorBase):
     Kept between the constrained solves of one load (contact rounds, modified Newton).
     The direct factorisation of K_ff is made at first need (:meth:`factorise`): a solver on
     the augmented path factorises K with its rows instead (:meth:`augmented`, which keeps
-    the factorisation of the last rows). For the Schur path it remembers K^+ c for the
-    rows c of the last Schur complement, so rows kept from one round to the next cost no
-    solve.
+    the factorisation of the last rows). For the Schur path it keeps K^+ c of the rows
+    c met (:meth:`columns`): rows kept from one round to the next cost no solve.
 
     Parameters
     ----------
@@ -310,12 +304,11 @@ class EliminatedFactor(FactorBase):
         self.seconds = time.perf_counter() - t0
 
     def without_caches(self):
-        """The same factorisation, with none of the results kept from its solves.
+        """The same factorisation, with only the kept columns of column-by-column solves.
 
-        It solves as a factor made afresh of the same matrix would, bit for bit: which rows
-        a block solve meets decides the block's rounding, so a factorisation carried to
-        another load step (mechanics.tangent.SavedTangent.kept) starts with no kept columns, as the
-        one a resumed run makes again.
+        It solves as a factor made afresh of the same matrix would, bit for bit, so that a
+        factorisation carried to another load step (mechanics.tangent.SavedTangent.kept)
+        solves as the one a resumed run makes again (:attr:`columns_independent`).
 
         Returns
         -------
@@ -323,9 +316,16 @@ class EliminatedFactor(FactorBase):
             Sharing the matrix and its factorisation (both read only).
         """
         other = copy.copy(self)
-        other._columns, other._reach, other._augmented, other._checked = {}, {}, None, False
+        other._columns = self._columns.copy() if self.columns_independent else KeptColumns()
+        other._reach, other._augmented, other._checked = {}, None, False
         other.__dict__.pop("_modes", None)
         return other
+
+    @property
+    def columns_independent(self):
+        """True unless SuperLU factorised K_ff, whose supernodal block solves round a column
+        differently in another block (NGSolve's do not; GMRES solves column by column)."""
+        return self.linear_solver == "gmres" or self.inverse != "superlu"
 
     @property
     def factorised(self):
@@ -573,7 +573,7 @@ class EliminatedFactor(FactorBase):
         self.factorise()
         t0 = time.perf_counter()
         C = sp.csr_matrix(C)
-        keys = [C.indices[s:e].tobytes() + C.data[s:e].tobytes() for s, e in zip(C.indptr[:-1], C.indptr[1:])]
+        keys = row_keys(C)
         new = [i for i, key in enumerate(keys) if key not in self._reach]
         n = self._lu.shape[0]
         if new:

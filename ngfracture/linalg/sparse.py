@@ -104,6 +104,17 @@ def single_threaded_blas():
         yield
 
 
+#: the thread count a TaskManager starts with, read at the first reproducible_threads
+_ngsolve_threads = None
+
+
+def forget_thread_count():
+    """Let the next :func:`reproducible_threads` read the thread count again (after a
+    ``ngsolve.SetNumThreads`` outside a TaskManager)."""
+    global _ngsolve_threads
+    _ngsolve_threads = None
+
+
 @contextlib.contextmanager
 def reproducible_threads():
     """One NGSolve thread while factorising, for results that repeat to the last bit.
@@ -115,18 +126,26 @@ def reproducible_threads():
     "Threads"). Must be entered outside a TaskManager context (its thread count is fixed
     when it starts).
 
+    Outside a TaskManager ``ngsolve.GetNumThreads()`` is 1 whatever ``SetNumThreads`` set;
+    the count a TaskManager starts with, the one to restore, is read inside one at the first
+    call and kept for the process: starting a TaskManager costs about 5 ms, 3 s over the
+    400 factorisations of a sphere run (docs/solvers.md, "Threads"). A program that
+    changes the count with ``ngsolve.SetNumThreads`` after that first call must call
+    :func:`forget_thread_count` for it to be restored.
+
     Yields
     ------
     None
         The body of the ``with`` block runs with ``ngsolve.SetNumThreads(1)``; the previous
         thread count is restored on leaving it, also when it raises.
     """
+    global _ngsolve_threads
     before = ng.GetNumThreads()
     if before == 1:
-        # outside a TaskManager GetNumThreads() is 1 whatever SetNumThreads set: the count
-        # a TaskManager starts with, which is what to restore, is read inside one (0.4 ms)
-        with ng.TaskManager():
-            before = ng.GetNumThreads()
+        if _ngsolve_threads is None:
+            with ng.TaskManager():
+                _ngsolve_threads = ng.GetNumThreads()
+        before = _ngsolve_threads
     ng.SetNumThreads(1)
     try:
         yield
