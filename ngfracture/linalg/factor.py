@@ -158,12 +158,7 @@ class FactorBase:
         return Rt_sparse, A
 
     def columns(self, C):
-        """Z = K^+ C^T (ndof, m); rows met before are not solved again.
-
-        A row is recognised by its stored column indices and values (bitwise). Where the
-        solves are column by column (:attr:`columns_independent`) every row met is kept
-        (linalg.kept: up to ``KEPT_COLUMNS_BYTES``): a kept column is bit for bit the one a
-        solve would give. Otherwise only the rows of the latest call are kept.
+        """Z = K^+ C^T (ndof, m); rows met before (bitwise) are not solved again (linalg.kept).
 
         Parameters
         ----------
@@ -173,12 +168,8 @@ class FactorBase:
         Returns
         -------
         numpy.ndarray, shape (ndof, m)
-            Column i is K^+ C_i^T, zero at fixed dofs and pins.
-
-        Raises
-        ------
-        SingularSystem
-            From :meth:`solve`, if the rows not cached need a solve and it fails.
+            Column i is K^+ C_i^T, zero at fixed dofs and pins. Raises SingularSystem as
+            :meth:`solve`.
         """
         return self.columns_and_solve(C, np.zeros((self.ndof, 0)))[0]
 
@@ -222,9 +213,17 @@ class FactorBase:
                 and np.count_nonzero(self.free) <= AUGMENTED_MAX_DOFS)
 
     def keeps_columns(self, m):
-        """False (bool) if the Schur complement of ``m`` (int) general rows is made by
-        :meth:`schur`, keeping no columns K^+ C^T: ``sparse_schur`` and m >=
-        ``SPARSE_SCHUR_MIN_ROWS``."""
+        """Whether a Schur complement keeps the columns K^+ C^T (else :meth:`schur` makes it).
+
+        Parameters
+        ----------
+        m : int
+            The number of general rows.
+
+        Returns
+        -------
+        bool
+            False where ``sparse_schur`` and m >= ``SPARSE_SCHUR_MIN_ROWS``."""
         return not (self.sparse_schur and m >= SPARSE_SCHUR_MIN_ROWS)
 
 

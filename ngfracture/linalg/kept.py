@@ -26,13 +26,24 @@ def row_keys(C):
 
 
 class KeptColumns:
-    """Columns by row key, for one factorisation."""
+    """Columns by row key, for one factorisation.
+
+    Parameters
+    ----------
+    items : dict of bytes -> numpy.ndarray, optional
+        Columns to start with (shared, not copied).
+    """
 
     def __init__(self, items=None):
         self._items = {} if items is None else dict(items)
 
     def copy(self):
-        """Another KeptColumns with the same columns (shared, read only)."""
+        """Another KeptColumns with the same columns (shared, read only).
+
+        Returns
+        -------
+        KeptColumns
+        """
         return KeptColumns(self._items)
 
     def fill(self, keys, Z):
