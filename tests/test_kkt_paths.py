@@ -199,6 +199,28 @@ def test_default_path_by_size_and_the_complementarity_path_is_schur(contact_stat
         ConstrainedSolver(K, rows.fixed_dofs, rows.C, modes=support.modes, pins=support.pins, path="qr")
 
 
+def test_a_singular_augmented_matrix_falls_back_to_the_schur_path_and_says_so(contact_state, monkeypatch):
+    """The augmented LU of rows that hold a mechanism only at rounding level can be singular
+    where the Schur path (pins, coarse problem) solves: "auto" falls back and records it,
+    an explicit "augmented" raises."""
+    prob, rows, support, _ = contact_state
+    K = prob.tangent()
+
+    def singular(self, C):
+        raise factor_module.SingularSystem("augmented matrix: pivot ratio 8.67e-16")
+    monkeypatch.setattr(factor_module.EliminatedFactor, "augmented", singular)
+    kkt = ConstrainedSolver(K, rows.fixed_dofs, rows.C, modes=support.modes, pins=support.pins)
+    assert kkt.path == "schur" and "pivot ratio 8.67e-16" in kkt.fallback
+    r, du_fixed, h = random_kkt_load(prob.fes.ndof, rows, seed=5)
+    du, lam = kkt.solve(r, du_fixed, h)
+    du_ref, lam_ref = whole_kkt_solution(to_scipy(K), rows, r, du_fixed, h)
+    assert_equal_to_whole_kkt(du, lam, du_ref, lam_ref, kkt_forward_tolerance(to_scipy(K), rows))
+    with pytest.raises(factor_module.SingularSystem, match="8.67e-16"):
+        ConstrainedSolver(K, rows.fixed_dofs, rows.C, modes=support.modes, pins=support.pins, path="augmented")
+    assert ConstrainedSolver(K, rows.fixed_dofs, rows.C, inverse="sparsecholesky", modes=support.modes,
+                             pins=support.pins).fallback is None
+
+
 def test_a_cracking_run_takes_the_same_path_with_the_sparse_schur_complement(monkeypatch):
     """The coarse plate run to broken through, every Schur complement from the sparse
     triangular solves (forced below its size threshold) against the kept columns: the same

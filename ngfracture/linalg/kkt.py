@@ -102,6 +102,9 @@ class ConstrainedSolver:
     ----------
     path : str
         The path chosen ("augmented" or "schur").
+    fallback : str or None
+        Why the path "auto" chose left the augmented matrix for the Schur complement (its
+        factorisation was singular), else None.
 
     Raises
     ------
@@ -139,9 +142,17 @@ class ConstrainedSolver:
         self.path = _chosen_path(path, factor, self.m, dependent_rows)
         self._checked = False     # the augmented path checks the residual of its first solve
         self._first = None        # (q, K^+ q) of the first solve, solved with the columns
+        self.fallback = None      # why the augmented path chosen by "auto" gave way to the Schur path
         if self.path == "augmented":
-            self._augmented = factor.augmented(self.C)
-            return
+            try:
+                self._augmented = factor.augmented(self.C)
+                return
+            except SingularSystem as err:
+                if path != "auto":
+                    raise
+                # rows that hold a mechanism only at rounding level (a shattered body):
+                # the Schur path's pins and coarse problem resolve what the LU's pivots cannot
+                self.path, self.fallback = "schur", f"augmented matrix singular ({err}); Schur complement instead"
         factor.factorise()        # here, outside a TaskManager (see EliminatedFactor.factorise)
         if self.m:
             self._R, A = factor.corrected_modes(self._R)

@@ -418,6 +418,8 @@ class NewtonSolver:
                     kkt, factor = self._linear_system(rows, support, given, (r, du_fixed), status.timings)
                     if given is None:
                         status.factorisations.append(factor.choice)
+                    if kkt.fallback:
+                        status.notes.append(f"iteration {k}: {kkt.fallback}")
                 with _Timer(status.timings, "solve"), prob.threads():
                     du, status.multipliers = kkt.solve(r, du_fixed, h)
             except SingularSystem as err:
