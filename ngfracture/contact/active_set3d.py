@@ -61,7 +61,7 @@ import numpy as np
 
 from .active_set import ActiveSet, Candidates, RowKeys, refreshed
 from .collision3d import PenetrationDetector3d
-from .copies3d import found_rows_at_copies
+from .copies3d import folded_rows_at_copies, found_rows_at_copies
 from .junctions3d import covered_pairs, fragment_pair_rows
 from .rows3d import NodeToFaceRows, lip_rows, no_face_rows, node_to_face_rows, relinearise_node_to_face
 
@@ -298,5 +298,15 @@ class ActiveSet3d(ActiveSet):
         if not keep.all():
             own = pen.fragment == self.vertex_fragment[pen.vertex]
             keep |= ~own & ~np.isin(np.asarray(pen.fragment, dtype=np.int64) * len(a.points) + pen.vertex, self.covered)
+        deep = np.flatnonzero(keep & at_copy & (pen.gap < -self.penetration_tol))
         rows = rows.subset(np.flatnonzero(keep))
-        return rows, self.codec.codes(rows)
+        codes = self.codec.codes(rows)
+        if len(deep):
+            # and, where the lip at the copy is folded, a row on every coincident face there
+            folded = folded_rows_at_copies(a.points, a.faces, rows, np.isin(np.flatnonzero(keep), deep))
+            folded_codes = self.codec.codes(folded)
+            first = np.sort(np.unique(folded_codes, return_index=True)[1])
+            first = first[~np.isin(folded_codes[first], codes)]
+            rows = NodeToFaceRows.stack([rows, folded.subset(first)])
+            codes = np.concatenate([codes, folded_codes[first]])
+        return rows, codes
