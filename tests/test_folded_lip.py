@@ -20,7 +20,8 @@ off its plane. Checked, with rows C d + g >= 0 (g = 0, the copies coincide):
   ray d = (1, 0, 0) that the one fixed row let through (s's side slides along one slope
   past the fold and reaches across t; the coarse sphere's failure at x = 2.533e-3); no row
   on the face coplanar with the found one (nearly parallel rows block the slip);
-* flat (a = 0): nothing is added.
+* flat (a = 0): nothing is added; nor where the copies are tied by the scene's rows
+  (``tied``) or are lips of one fragment (the fixed kink rows have those faces).
 """
 import numpy as np
 
@@ -66,7 +67,7 @@ def test_folded_lip_rows_are_the_exact_condition():
     fixed = fragment_pair_rows(points, faces, fragment)
     assert np.count_nonzero(fixed.slave == 5) == 1                         # one fixed row at two copies
     found = found_row(points, faces, 5, 0)                                 # s on the right slope [O, R, Q1]
-    folded = folded_rows_at_copies(points, faces, found, np.array([True]))
+    folded = folded_rows_at_copies(points, faces, found, np.array([True]), fragment)
     assert folded.slave.tolist() == [5, 5] and folded.face.tolist() == [1, 2]    # the left slope; not 3
     assert np.all(folded.g == 0.0) and np.all(folded.bary[:, 0] == 1.0)
     rows = NodeToFaceRows.stack([found, folded])
@@ -83,6 +84,23 @@ def test_folded_lip_rows_are_the_exact_condition():
 
 def test_flat_lip_adds_nothing():
     points, faces, fragment = roof(0.0)
-    folded = folded_rows_at_copies(points, faces, found_row(points, faces, 5, 0), np.array([True]))
+    folded = folded_rows_at_copies(points, faces, found_row(points, faces, 5, 0), np.array([True]), fragment)
     assert len(folded) == 0
-    assert len(folded_rows_at_copies(points, faces, found_row(points, faces, 5, 0), np.array([False]))) == 0
+    points, faces, fragment = roof(1.0)
+    found = found_row(points, faces, 5, 0)
+    assert len(folded_rows_at_copies(points, faces, found, np.array([False]), fragment)) == 0
+    # copies tied by the scene's own rows (the sphere's stick rows) keep their one row
+    assert len(folded_rows_at_copies(points, faces, found, np.array([True]), fragment, tied=np.array([0 * 10 + 5]))) == 0
+    # lips of one fragment have their kink rows among the fixed rows
+    assert len(folded_rows_at_copies(points, faces, found, np.array([True]), np.zeros(10, dtype=np.int64))) == 0
+
+
+def test_tied_pairs_of_two_vertex_rows_only():
+    from scipy.sparse import csr_matrix
+    from ngfracture.contact.active_set3d import tied_pairs
+    nv = 4
+    # a stick-like row on vertices 3 and 1 (components x and y), a mode row on 0, 1, 2
+    H = csr_matrix(([1.0, -1.0, 1.0, 1.0, 1.0, 1.0], ([0, 0, 0, 1, 1, 1], [3, nv + 1, 2 * nv + 3, 0, 1, 2])),
+                   shape=(2, 3 * nv))
+    assert tied_pairs(H, nv).tolist() == [1 * nv + 3]
+    assert len(tied_pairs(None, nv)) == 0

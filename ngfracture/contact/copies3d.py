@@ -130,8 +130,14 @@ def found_rows_at_copies(points, faces, rows, vertex_fragment):
     return out, at_copy
 
 
-def folded_rows_at_copies(points, faces, rows, pick):
+def folded_rows_at_copies(points, faces, rows, pick, vertex_fragment, tied=None):
     """Rows of the picked found rows' slaves on the faces at their copy where the lip there bends.
+
+    Only pairs of copies on different fragments at points of two copies are completed:
+    elsewhere the fixed rows have every such face (lips: the kink rows; three or more
+    copies: the partner-face rows), and pairs whose relative motion the scene's own rows
+    tie (``tied``: the sphere's stick rows) keep their one row, the others being dependent
+    on those rows (the sphere's faceted interface).
 
     Parameters
     ----------
@@ -143,6 +149,10 @@ def folded_rows_at_copies(points, faces, rows, pick):
         Rows of :func:`found_rows_at_copies`.
     pick : numpy.ndarray of bool, shape (len(rows),)
         The rows to complete: rows at a copy of their slave (barycentric 1 there).
+    vertex_fragment : numpy.ndarray of int, shape (nv,)
+        The fragment of every vertex.
+    tied : numpy.ndarray of int or None
+        Pairs of vertices tied by other rows, as codes min * nv + max (sorted).
 
     Returns
     -------
@@ -156,9 +166,16 @@ def folded_rows_at_copies(points, faces, rows, pick):
     """
     X, F = np.asarray(points), np.asarray(faces, dtype=np.int64)
     nv = rows.nv
-    r = np.flatnonzero(pick)
-    s = rows.slave[r]
-    t = rows.master[r, np.argmax(rows.bary[r], axis=1)]
+    vf = np.asarray(vertex_fragment, dtype=np.int64)
+    pid = _point_ids(X, F)
+    s = rows.slave
+    t = rows.master[np.arange(len(rows)), np.argmax(rows.bary, axis=1)]
+    two = np.bincount(pid[pid >= 0], minlength=1)[np.maximum(pid[s], 0)] == 2
+    ok = np.asarray(pick, dtype=bool) & two & (pid[s] >= 0) & (vf[s] != vf[t])
+    if tied is not None and len(tied):
+        ok &= ~np.isin(np.minimum(s, t) * nv + np.maximum(s, t), tied)
+    r = np.flatnonzero(ok)
+    s, t = s[r], t[r]
     code = s * nv + t
     pair = np.unique(code)
     slave, face, corner = partner_faces(X, F, pair // nv, pair % nv, all_pairs=True, one_way=False)
