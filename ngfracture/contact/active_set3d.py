@@ -58,10 +58,11 @@ where a caller reads them (:class:`~ngfracture.contact.active_set.RowKeys`).
 import time
 
 import numpy as np
+import scipy.sparse as sp
 
 from .active_set import ActiveSet, Candidates, RowKeys, refreshed
 from .collision3d import PenetrationDetector3d
-from .copies3d import found_rows_at_copies
+from .copies3d import folded_rows_at_copies, found_rows_at_copies
 from .junctions3d import covered_pairs, fragment_pair_rows
 from .rows3d import NodeToFaceRows, lip_rows, no_face_rows, node_to_face_rows, relinearise_node_to_face
 
@@ -194,6 +195,35 @@ def _fixed_rows(points, tets, faces, fragment, codec, detector):
     return rows.subset(first), RowKeys(codes[first], codec)
 
 
+def tied_pairs(holds, nv):
+    """The pairs of vertices that one row of ``holds`` (P1 layout, comp * nv + v) ties together.
+
+    Parameters
+    ----------
+    holds : scipy.sparse.spmatrix or None
+        General rows (the scene's own, the holds of free pieces).
+    nv : int
+        Number of vertices.
+
+    Returns
+    -------
+    numpy.ndarray of int64
+        Codes min * nv + max of the pairs of distinct vertices in one row, sorted, unique;
+        rows on more than two vertices (the holds of a piece's rigid modes) tie none.
+    """
+    if holds is None or holds.shape[0] == 0:
+        return np.zeros(0, dtype=np.int64)
+    H = sp.csr_matrix(holds)
+    H.eliminate_zeros()
+    row = np.repeat(np.arange(H.shape[0]), np.diff(H.indptr))
+    v = np.unique(row * nv + H.indices % nv)                  # (row, vertex), each once
+    row, v = v // nv, v % nv
+    count = np.bincount(row, minlength=H.shape[0])
+    two = count[row] == 2
+    row, v = row[two], v[two]
+    return np.unique(v[0::2] * nv + v[1::2])                  # sorted within a row: min first
+
+
 def _vertex_fragment(nv, tets, fragment):
     """The fragment of every vertex (-1: in no tetrahedron)."""
     vertex_fragment = np.full(nv, -1, dtype=np.int64)
@@ -298,5 +328,16 @@ class ActiveSet3d(ActiveSet):
         if not keep.all():
             own = pen.fragment == self.vertex_fragment[pen.vertex]
             keep |= ~own & ~np.isin(np.asarray(pen.fragment, dtype=np.int64) * len(a.points) + pen.vertex, self.covered)
+        deep = np.flatnonzero(keep & at_copy & (pen.gap < -self.penetration_tol))
         rows = rows.subset(np.flatnonzero(keep))
-        return rows, self.codec.codes(rows)
+        codes = self.codec.codes(rows)
+        if len(deep):
+            # and, where the lip at the copy is folded, a row on every coincident face there
+            folded = folded_rows_at_copies(a.points, a.faces, rows, np.isin(np.flatnonzero(keep), deep),
+                                           self.vertex_fragment, tied_pairs(self.geometry.holds, len(a.points)))
+            folded_codes = self.codec.codes(folded)
+            first = np.sort(np.unique(folded_codes, return_index=True)[1])
+            first = first[~np.isin(folded_codes[first], codes)]
+            rows = NodeToFaceRows.stack([rows, folded.subset(first)])
+            codes = np.concatenate([codes, folded_codes[first]])
+        return rows, codes

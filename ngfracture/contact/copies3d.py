@@ -32,13 +32,26 @@ fixed ones, so that they neither conflict with them nor duplicate them reversed:
   opposite: n_f . (x_t - x_s) >= 0 is the same inequality), where there is one; rows of
   both directions on nearly parallel faces, imposed together, block the slip of the copies
   (docs/contact.md, "Crack lips in 3D").
+
+:func:`folded_rows_at_copies` completes such a row where the surface at the copy bends: a
+copy s found inside the side of its copy t gets a row on every face at t coincident with
+a face at s and off the found row's plane (as the kink rows of lips,
+:data:`~ngfracture.contact.kinks3d.KINK`). For two copies that is the whole first-order condition (s out of t's side iff
+n_f . (x_s - x_t) >= 0 on every such face f, :mod:`~ngfracture.contact.kinks3d`), which
+the fixed rows impose at points of two copies on different fragments only on one face
+(more rows there would add to the sphere's stick rows, which tie the core's vertices to
+the glass, on all of the faceted interface). Where the lip is folded, one row lets s
+slide along its face past the fold into t's side, and once s is deeper than the fold the
+detection's master face at t can be one whose plane s is in front of: its row does not
+hold s (the coarse confined sphere at x = 2.533e-3, a glass vertex of a piece being cut
+off 5.3e-5 deep in the copy it was split from).
 """
 import numpy as np
 
-from .kinks3d import point_groups
+from .kinks3d import KINK, partner_faces, point_groups
 from .rows3d import NodeToFaceRows
 
-__all__ = ["found_rows_at_copies"]
+__all__ = ["found_rows_at_copies", "folded_rows_at_copies"]
 
 
 def _point_ids(X, F):
@@ -115,3 +128,67 @@ def found_rows_at_copies(points, faces, rows, vertex_fragment):
     out = NodeToFaceRows(slave=slave, master=master, face=face, bary=bary, normal=normal, dist=rows.dist.copy(),
                          g=g, nv=rows.nv)
     return out, at_copy
+
+
+def folded_rows_at_copies(points, faces, rows, pick, vertex_fragment, tied=None):
+    """Rows of the picked found rows' slaves on the faces at their copy where the lip there bends.
+
+    Only pairs of copies on different fragments at points of two copies are completed:
+    elsewhere the fixed rows have every such face (lips: the kink rows; three or more
+    copies: the partner-face rows), and pairs whose relative motion the scene's own rows
+    tie (``tied``: the sphere's stick rows) keep their one row, the others being dependent
+    on those rows (the sphere's faceted interface).
+
+    Parameters
+    ----------
+    points : numpy.ndarray, shape (nv, 3)
+        Reference coordinates (copies bitwise equal).
+    faces : numpy.ndarray of int, shape (nf, 3)
+        Boundary faces, outward.
+    rows : NodeToFaceRows
+        Rows of :func:`found_rows_at_copies`.
+    pick : numpy.ndarray of bool, shape (len(rows),)
+        The rows to complete: rows at a copy of their slave (barycentric 1 there).
+    vertex_fragment : numpy.ndarray of int, shape (nv,)
+        The fragment of every vertex.
+    tied : numpy.ndarray of int or None
+        Pairs of vertices tied by other rows, as codes min * nv + max (sorted).
+
+    Returns
+    -------
+    NodeToFaceRows
+        For every pair (s, t) of a picked row's slave and copy, the rows of s on the faces
+        at t coincident with a face at s whose unit normal differs from that of each picked
+        row of the pair by more than :data:`~ngfracture.contact.kinks3d.KINK` (nearly
+        parallel rows, imposed together, block the slip of the copies), sorted by pair and
+        face: projected at the copy (g = 0), the face's normal of the reference
+        configuration, ``dist`` 0 (the copies' points equal).
+    """
+    X, F = np.asarray(points), np.asarray(faces, dtype=np.int64)
+    nv = rows.nv
+    vf = np.asarray(vertex_fragment, dtype=np.int64)
+    pid = _point_ids(X, F)
+    s = rows.slave
+    t = rows.master[np.arange(len(rows)), np.argmax(rows.bary, axis=1)]
+    two = np.bincount(pid[pid >= 0], minlength=1)[np.maximum(pid[s], 0)] == 2
+    ok = np.asarray(pick, dtype=bool) & two & (pid[s] >= 0) & (vf[s] != vf[t])
+    if tied is not None and len(tied):
+        ok &= ~np.isin(np.minimum(s, t) * nv + np.maximum(s, t), tied)
+    r = np.flatnonzero(ok)
+    s, t = s[r], t[r]
+    code = s * nv + t
+    pair = np.unique(code)
+    slave, face, corner = partner_faces(X, F, pair // nv, pair % nv, all_pairs=True, one_way=False)
+    master = F[face]
+    p = X[master]
+    area2 = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+    normal = area2 / np.linalg.norm(area2, axis=1)[:, None] if len(face) else np.zeros((0, 3))
+    same = (slave * nv + master[np.arange(len(face)), corner])[:, None] == code[None, :]   # [incidence, picked row]
+    parallel = 1.0 - normal @ rows.normal[r].T <= KINK
+    keep = ~np.any(same & parallel, axis=1)
+    slave, face, corner, master, normal = slave[keep], face[keep], corner[keep], master[keep], normal[keep]
+    bary = np.zeros((len(face), 3))
+    bary[np.arange(len(face)), corner] = 1.0
+    zero = np.zeros(len(face))
+    return NodeToFaceRows(slave=slave, master=master, face=face, bary=bary, normal=normal, dist=zero,
+                          g=zero.copy(), nv=nv)

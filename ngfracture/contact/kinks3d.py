@@ -55,7 +55,7 @@ def point_groups(points, faces):
     return on, np.cumsum(np.r_[False, np.any(P[1:] != P[:-1], axis=1)])
 
 
-def partner_faces(points, faces, slave, copy, all_pairs):
+def partner_faces(points, faces, slave, copy, all_pairs, one_way=True):
     """The faces at copy t coincident with a face at slave s, for pairs of copies s > t.
 
     Parameters
@@ -68,6 +68,9 @@ def partner_faces(points, faces, slave, copy, all_pairs):
         Pairs (s, t) of vertices at the same reference point.
     all_pairs : bool
         Every pair s > t (True) or only those at points with three or more copies.
+    one_way : bool
+        Only pairs with s > t (True), or every given pair (False: the caller chose the
+        direction).
 
     Returns
     -------
@@ -81,7 +84,7 @@ def partner_faces(points, faces, slave, copy, all_pairs):
     on, group = point_groups(points, faces)
     point = np.full(len(points), -1, dtype=np.int64)
     point[on] = group
-    pick = slave > copy
+    pick = slave > copy if one_way else np.ones(len(slave), dtype=bool)
     if not all_pairs:
         pick &= np.bincount(group, minlength=1)[point[slave]] >= 3
     s, t = slave[pick], copy[pick]
