@@ -48,25 +48,16 @@ off 5.3e-5 deep in the copy it was split from).
 """
 import numpy as np
 
-from .kinks3d import KINK, partner_faces, point_groups
+from .kinks3d import KINK, face_point_keys, partner_faces, point_ids
 from .rows3d import NodeToFaceRows
 
 __all__ = ["found_rows_at_copies", "folded_rows_at_copies"]
 
 
-def _point_ids(X, F):
-    """Per vertex the number of its reference point among the boundary vertices (-1 elsewhere)."""
-    on, group = point_groups(X, F)
-    pid = np.full(len(X), -1, dtype=np.int64)
-    pid[on] = group
-    return pid
-
 
 def _partner_at(F, pid, face, vertex):
     """For every (face, vertex): the face on the same three points with ``vertex`` as a corner, or -1."""
-    K = np.sort(pid[F], axis=1)
-    _, key = np.unique(K, axis=0, return_inverse=True)
-    key = key.ravel()
+    key = face_point_keys(F, pid)
     order = np.argsort(key, kind="stable")
     start = np.searchsorted(key[order], key[face])
     count = np.searchsorted(key[order], key[face], side="right") - start
@@ -107,7 +98,7 @@ def found_rows_at_copies(points, faces, rows, vertex_fragment):
         return rows, np.zeros(0, dtype=bool)
     X, F = np.asarray(points), np.asarray(faces, dtype=np.int64)
     vf = np.asarray(vertex_fragment, dtype=np.int64)
-    pid = _point_ids(X, F)
+    pid = point_ids(X, F)
     same = pid[rows.master] == pid[rows.slave][:, None]                  # [row, corner]
     at_copy = same.any(axis=1) & (pid[rows.slave] >= 0)
     slave, face, normal = rows.slave.copy(), rows.face.copy(), rows.normal.copy()
@@ -167,7 +158,7 @@ def folded_rows_at_copies(points, faces, rows, pick, vertex_fragment, tied=None)
     X, F = np.asarray(points), np.asarray(faces, dtype=np.int64)
     nv = rows.nv
     vf = np.asarray(vertex_fragment, dtype=np.int64)
-    pid = _point_ids(X, F)
+    pid = point_ids(X, F)
     s = rows.slave
     t = rows.master[np.arange(len(rows)), np.argmax(rows.bary, axis=1)]
     two = np.bincount(pid[pid >= 0], minlength=1)[np.maximum(pid[s], 0)] == 2

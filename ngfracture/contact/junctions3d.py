@@ -39,18 +39,11 @@ twin opposing the slave's vertex normal), which the patch test needs.
 """
 import numpy as np
 
-from .kinks3d import KINK, point_groups
+from .kinks3d import KINK, point_ids
 from .rows3d import NodeToFaceRows, face_gap_rows, fragment_twin_rows, no_face_rows
 
 __all__ = ["fragment_pair_rows", "covered_pairs"]
 
-
-def _point_ids(X, F):
-    """Per vertex the number of its reference point among the boundary vertices (-1 off the boundary)."""
-    on, group = point_groups(X, F)
-    pid = np.full(len(X), -1, dtype=np.int64)
-    pid[on] = group
-    return pid
 
 
 def _on_several_fragments(pid, vf):
@@ -129,7 +122,7 @@ def fragment_pair_rows(points, faces, vertex_fragment):
     """
     X, F, vf = _checked(points, faces, vertex_fragment)
     nv = len(X)
-    pid = _point_ids(X, F)
+    pid = point_ids(X, F)
     ff = vf[F[:, 0]] if len(F) else np.zeros(0, dtype=np.int64)
     a, b = _matched_faces(F, pid, ff)
     matched = np.zeros(nv, dtype=bool)

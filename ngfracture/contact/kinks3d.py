@@ -24,7 +24,7 @@ set imposes the ones that bind.
 """
 import numpy as np
 
-__all__ = ["KINK", "point_groups", "partner_faces"]
+__all__ = ["KINK", "point_groups", "point_ids", "face_point_keys", "partner_faces"]
 
 #: 1 - cos of the smallest angle between a lip's face and the face of its one row for which
 #: the face gets a row of its own (about 2.6 degrees)
@@ -55,6 +55,46 @@ def point_groups(points, faces):
     return on, np.cumsum(np.r_[False, np.any(P[1:] != P[:-1], axis=1)])
 
 
+def point_ids(points, faces):
+    """Per vertex the number of its reference point among the boundary vertices (-1 elsewhere).
+
+    Parameters
+    ----------
+    points : numpy.ndarray, shape (nv, 3)
+        Reference coordinates (copies bitwise equal).
+    faces : numpy.ndarray of int, shape (nf, 3)
+        Boundary faces.
+
+    Returns
+    -------
+    numpy.ndarray of int64, shape (nv,)
+        The ``group`` of :func:`point_groups` at every boundary vertex, -1 elsewhere.
+    """
+    on, group = point_groups(points, faces)
+    pid = np.full(len(points), -1, dtype=np.int64)
+    pid[on] = group
+    return pid
+
+
+def face_point_keys(faces, pid):
+    """Per face a number that is equal exactly for faces on the same three reference points.
+
+    Parameters
+    ----------
+    faces : numpy.ndarray of int, shape (nf, 3)
+        Boundary faces.
+    pid : numpy.ndarray of int, shape (nv,)
+        :func:`point_ids` of the same faces.
+
+    Returns
+    -------
+    numpy.ndarray of int, shape (nf,)
+        The number of the face's sorted point triple among the distinct ones.
+    """
+    _, key = np.unique(np.sort(pid[faces], axis=1), axis=0, return_inverse=True)
+    return key.ravel()
+
+
 def partner_faces(points, faces, slave, copy, all_pairs, one_way=True):
     """The faces at copy t coincident with a face at slave s, for pairs of copies s > t.
 
@@ -81,15 +121,12 @@ def partner_faces(points, faces, slave, copy, all_pairs, one_way=True):
     corner : numpy.ndarray of int
         The position of t in that face (0, 1 or 2).
     """
-    on, group = point_groups(points, faces)
-    point = np.full(len(points), -1, dtype=np.int64)
-    point[on] = group
+    point = point_ids(points, faces)
     pick = slave > copy if one_way else np.ones(len(slave), dtype=bool)
     if not all_pairs:
-        pick &= np.bincount(group, minlength=1)[point[slave]] >= 3
+        pick &= np.bincount(point[point >= 0], minlength=1)[point[slave]] >= 3
     s, t = slave[pick], copy[pick]
-    _, key = np.unique(np.sort(point[faces], axis=1), axis=0, return_inverse=True)
-    key, flat = key.ravel(), faces.ravel()
+    key, flat = face_point_keys(faces, point), faces.ravel()
     inc = np.argsort(flat, kind="stable")
     start = np.searchsorted(flat[inc], t)
     count = np.searchsorted(flat[inc], t, side="right") - start
