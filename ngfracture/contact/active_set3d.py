@@ -324,16 +324,16 @@ class ActiveSet3d(ActiveSet):
         # one inside the wedge of a copy (master face at the copy) gets that face's row
         # (copies3d: where several copies meet the fixed rows are not the whole condition)
         twin = np.asarray(pen.twin, dtype=np.int64)
-        keep = (twin < 0) | (at_copy & (pen.gap < -self.penetration_tol))
+        deep_at_copy = at_copy & (pen.gap < -self.penetration_tol)
+        keep = (twin < 0) | deep_at_copy
         if not keep.all():
             own = pen.fragment == self.vertex_fragment[pen.vertex]
             keep |= ~own & ~np.isin(np.asarray(pen.fragment, dtype=np.int64) * len(a.points) + pen.vertex, self.covered)
-        deep = np.flatnonzero(keep & at_copy & (pen.gap < -self.penetration_tol))
         rows = rows.subset(np.flatnonzero(keep))
         codes = self.codec.codes(rows)
-        if len(deep):
+        if deep_at_copy.any():
             # and, where the lip at the copy is folded, a row on every coincident face there
-            folded = folded_rows_at_copies(a.points, a.faces, rows, np.isin(np.flatnonzero(keep), deep),
+            folded = folded_rows_at_copies(a.points, a.faces, rows, deep_at_copy[keep],
                                            self.vertex_fragment, tied_pairs(self.geometry.holds, len(a.points)))
             folded_codes = self.codec.codes(folded)
             first = np.sort(np.unique(folded_codes, return_index=True)[1])

@@ -239,7 +239,7 @@ class ContactSolver:
         nv, n = prob.mesh.nv, prob.fes.ndof // dim
         fixed = prob.assemble_constraints().fixed_dofs
         v, c = fixed % n, fixed // n
-        holds = self._held_modes()
+        holds = self._rows_kept_in_any_case()
         if dim == 3:
             arrays = prob.arrays
             geometry = Geometry(arrays=arrays, fragment=comp[arrays.tets[:, 0]], seams=None,
@@ -251,7 +251,7 @@ class ContactSolver:
                             holds=holds)
         return geometry, fixed
 
-    def _held_modes(self):
+    def _rows_kept_in_any_case(self):
         """The general rows that contact rows must be independent of, in the P1 layout (or None).
 
         With fix_free_modes "all", the rows that hold the pieces; and the problem's own
