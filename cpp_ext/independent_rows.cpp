@@ -106,6 +106,15 @@ namespace ngfracture
       }
     };
 
+    // The pivot: the first active row whose residual is within 1e-12 of the largest, best
+    // (the first of near ties, so that rounding does not decide between equal rows).
+    int64_t FirstPivot (const std::vector<char> & active, const std::vector<double> & res, double best)
+    {
+      for (size_t i = 0; i < active.size(); i++)
+        if (active[i] && res[i] >= best * (1.0 - 1e-12)) return int64_t(i);
+      return -1;
+    }
+
     std::vector<int32_t> Support (const double * v, int64_t n)
     {
       std::vector<int32_t> supp;
@@ -151,9 +160,7 @@ namespace ngfracture
         for (int64_t i = 0; i < k; i++)
           if (active[i]) best = std::max(best, res[i]);
         if (!(best > rtol)) break;
-        int64_t j = -1;
-        for (int64_t i = 0; i < k && j < 0; i++)
-          if (active[i] && res[i] >= best * (1.0 - 1e-12)) j = i;
+        int64_t j = FirstPivot(active, res, best);
         active[j] = 0;
         picked.push_back(int32_t(j));
         double * q = &R[j*n];
@@ -223,9 +230,7 @@ namespace ngfracture
               best = std::max(best, res[i]);
             }
         if (!(best > rtol)) break;
-        int64_t j = -1;
-        for (int64_t i = 0; i < k && j < 0; i++)
-          if (active[i] && res[i] >= best * (1.0 - 1e-12)) j = i;
+        int64_t j = FirstPivot(active, res, best);
         active[j] = 0;
         picked.push_back(int32_t(j));
         double * q = &R[j*n];
