@@ -48,7 +48,7 @@ off 5.3e-5 deep in the copy it was split from).
 """
 import numpy as np
 
-from .kinks3d import KINK, face_point_keys, partner_faces, point_ids
+from .kinks3d import KINK, expand_ranges, face_point_keys, partner_faces, point_ids
 from .rows3d import NodeToFaceRows
 
 __all__ = ["found_rows_at_copies", "folded_rows_at_copies"]
@@ -174,9 +174,15 @@ def folded_rows_at_copies(points, faces, rows, pick, vertex_fragment, tied=None)
     p = X[master]
     area2 = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
     normal = area2 / np.linalg.norm(area2, axis=1)[:, None] if len(face) else np.zeros((0, 3))
-    same = (slave * nv + master[np.arange(len(face)), corner])[:, None] == code[None, :]   # [incidence, picked row]
-    parallel = 1.0 - normal @ rows.normal[r].T <= KINK
-    keep = ~np.any(same & parallel, axis=1)
+    # an incidence is dropped where a picked row of its pair has a parallel face
+    order = np.argsort(code, kind="stable")
+    incidence_code = slave * nv + master[np.arange(len(face)), corner]
+    start = np.searchsorted(code[order], incidence_code)
+    incidence, slot = expand_ranges(start, np.searchsorted(code[order], incidence_code, side="right") - start)
+    picked = r[order[slot]]
+    parallel = 1.0 - np.sum(normal[incidence] * rows.normal[picked], axis=1) <= KINK
+    keep = np.ones(len(face), dtype=bool)
+    keep[incidence[parallel]] = False
     slave, face, corner, master, normal = slave[keep], face[keep], corner[keep], master[keep], normal[keep]
     bary = np.zeros((len(face), 3))
     bary[np.arange(len(face)), corner] = 1.0

@@ -39,7 +39,7 @@ twin opposing the slave's vertex normal), which the patch test needs.
 """
 import numpy as np
 
-from .kinks3d import KINK, point_ids
+from .kinks3d import KINK, expand_ranges, point_ids
 from .rows3d import NodeToFaceRows, face_gap_rows, fragment_twin_rows, no_face_rows
 
 __all__ = ["fragment_pair_rows", "covered_pairs"]
@@ -68,8 +68,7 @@ def _matched_faces(F, pid, face_fragment):
     group = np.cumsum(np.r_[False, np.any(Ks[1:] != Ks[:-1], axis=1)]) if len(F) else np.zeros(0, dtype=np.int64)
     first = np.searchsorted(group, group)
     size = np.searchsorted(group, group, side="right") - first
-    who = np.repeat(np.arange(len(order)), size)
-    other = np.repeat(first, size) + (np.arange(len(who)) - np.repeat(np.cumsum(size) - size, size))
+    who, other = expand_ranges(first, size)
     a, b = order[who], order[other]
     keep = face_fragment[a] != face_fragment[b]
     return a[keep], b[keep]

@@ -24,7 +24,7 @@ set imposes the ones that bind.
 """
 import numpy as np
 
-__all__ = ["KINK", "point_groups", "point_ids", "face_point_keys", "partner_faces"]
+__all__ = ["KINK", "point_groups", "point_ids", "face_point_keys", "partner_faces", "expand_ranges"]
 
 #: 1 - cos of the smallest angle between a lip's face and the face of its one row for which
 #: the face gets a row of its own (about 2.6 degrees)
@@ -130,10 +130,26 @@ def partner_faces(points, faces, slave, copy, all_pairs, one_way=True):
     inc = np.argsort(flat, kind="stable")
     start = np.searchsorted(flat[inc], t)
     count = np.searchsorted(flat[inc], t, side="right") - start
-    pair = np.repeat(np.arange(len(start)), count)
-    slot = np.repeat(start, count) + np.arange(len(pair)) - np.repeat(np.cumsum(count) - count, count)
+    pair, slot = expand_ranges(start, count)
     face, corner = np.divmod(inc[slot], 3)
     s = s[pair]
     nk = len(faces) + 1                                                    # more than the number of keys
     keep = np.isin(s * nk + key[face], flat * nk + np.repeat(key, 3))     # f's key is that of a face at s
     return s[keep], face[keep], corner[keep]
+
+
+def expand_ranges(start, count):
+    """For entries e with ranges [start_e, start_e + count_e): (e, index) for every index of every range.
+
+    Parameters
+    ----------
+    start, count : numpy.ndarray of int, shape (m,)
+
+    Returns
+    -------
+    owner, index : numpy.ndarray of int
+        The entry and the index, entry by entry, indices increasing.
+    """
+    owner = np.repeat(np.arange(len(start)), count)
+    offset = np.arange(len(owner)) - np.repeat(np.cumsum(count) - count, count)
+    return owner, np.repeat(start, count) + offset

@@ -61,7 +61,7 @@ from typing import ClassVar
 import numpy as np
 import scipy.sparse as sp
 
-from .kinks3d import KINK, partner_faces, point_groups
+from .kinks3d import KINK, expand_ranges, partner_faces, point_groups
 from .rows import RowTable
 
 __all__ = ["NodeToFaceRows", "no_face_rows", "node_to_face_rows", "twin_rows", "fragment_twin_rows", "lip_rows", "face_gap_rows",
@@ -421,7 +421,7 @@ def _copy_pairs(X, F):
     on, group = point_groups(X, F)
     first = np.searchsorted(group, group)                                  # start of each vertex's group
     size = np.searchsorted(group, group, side="right") - first
-    who, other = _ranges(first, size)
+    who, other = expand_ranges(first, size)
     return on[who], on[other]
 
 
@@ -440,7 +440,7 @@ def _rows_at_copies(X, F, s, t, per):
     inc = np.argsort(F.ravel(), kind="stable")
     start = np.searchsorted(F.ravel()[inc], t)
     count = np.searchsorted(F.ravel()[inc], t, side="right") - start
-    pair, slot = _ranges(start, count)
+    pair, slot = expand_ranges(start, count)
     face, k = np.divmod(inc[slot], 3)
     s, per = s[pair], per[pair]
     dots = np.einsum("ij,ij->i", unit[face], vnormal[s])
@@ -476,13 +476,6 @@ def _with_junction_rows(X, F, rows, s, t, lips):
     extra = NodeToFaceRows(slave=slave, master=F[face], face=face, bary=bary, normal=normal, dist=g.copy(), g=g,
                            nv=len(X))
     return NodeToFaceRows.stack([rows, extra])
-
-
-def _ranges(start, count):
-    """For entries e with ranges [start_e, start_e + count_e): (e, index) for every index of every range."""
-    owner = np.repeat(np.arange(len(start)), count)
-    offset = np.arange(len(owner)) - np.repeat(np.cumsum(count) - count, count)
-    return owner, np.repeat(start, count) + offset
 
 
 def relinearise_node_to_face(rows, points, displacement):
