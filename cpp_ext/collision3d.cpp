@@ -532,6 +532,27 @@ namespace ngfracture
       return true;
     }
 
+    // Whether boundary face f is a lip: another boundary face lies on its three points (the
+    // other side of a crack or of an interface of bodies meshed apart).
+    bool IsLip (const TetMesh3 & m, const Copies & copies, const VertexFaces & vfaces, int32_t f)
+    {
+      const int32_t * T = m.faces + 3*f;
+      std::array<int32_t,3> pts { copies.group[T[0]], copies.group[T[1]], copies.group[T[2]] };
+      std::sort(pts.begin(), pts.end());
+      int32_t g = copies.group[T[0]];
+      for (int64_t s = copies.start[g]; s < copies.start[g+1]; s++)
+        for (int64_t i = vfaces.start[copies.members[s]]; i < vfaces.start[copies.members[s]+1]; i++)
+          {
+            int32_t h = vfaces.at[i];
+            if (h == f) continue;
+            const int32_t * H = m.faces + 3*h;
+            std::array<int32_t,3> q { copies.group[H[0]], copies.group[H[1]], copies.group[H[2]] };
+            std::sort(q.begin(), q.end());
+            if (q == pts) return true;
+          }
+      return false;
+    }
+
     // v in the tetrahedron `tet` at its copy t: of the boundary faces of that tetrahedron
     // at t whose plane has v's reference star on its outer side (faces v's wedge can have
     // crossed into that tetrahedron: the lip between them, or where several cracks meet
@@ -540,9 +561,13 @@ namespace ngfracture
     // lies on), the one v is least deep behind at the current positions; -1 if none.
     // `depth` gets max(0, -signed distance). Faces of t elsewhere are not candidates: t's
     // wedge can be reflex, and v outside one of its planes may still be inside it.
+    // With `lips_of` (the copies), the candidates are instead the lips among those faces
+    // (IsLip), and only one that v is behind is returned (see the caller).
     int32_t SeparatingFace (const TetMesh3 & m, const VertexFaces & vfaces, const VertexFaces & stars,
-                            int32_t v, int32_t t, const int32_t * tet, double & depth)
+                            int32_t v, int32_t t, const int32_t * tet, double & depth,
+                            const Copies * lips_of = nullptr)
     {
+      bool any_side = lips_of != nullptr;
       int32_t best = -1;
       double best_s = -std::numeric_limits<double>::infinity();
       auto in_tet = [&] (int32_t w) { return tet[0] == w || tet[1] == w || tet[2] == w || tet[3] == w; };
@@ -556,7 +581,7 @@ namespace ngfracture
           double len = std::sqrt(Dot(n, n));
           if (!(len > 0)) continue;
           for (int d = 0; d < 3; d++) n[d] /= len;
-          if (!StarOnSide(m, stars, v, n, 1.0)) continue;
+          if (any_side ? !IsLip(m, *lips_of, vfaces, f) : !StarOnSide(m, stars, v, n, 1.0)) continue;
           Sub(m.x + 3*T[1], m.x + 3*T[0], e0); Sub(m.x + 3*T[2], m.x + 3*T[0], e1); Cross(e0, e1, n);
           len = std::sqrt(Dot(n, n));
           if (!(len > 0)) continue;
@@ -565,6 +590,7 @@ namespace ngfracture
           double s = Dot(n, r) / len;
           if (s > best_s || (s == best_s && f < best)) { best_s = s; best = f; }
         }
+      if (any_side && !(best_s < 0)) best = -1;
       depth = best >= 0 ? std::max(0.0, -best_s) : 0.0;
       return best;
     }
@@ -802,6 +828,11 @@ namespace ngfracture
             }
           double depth = 0;
           int32_t sep = t_copy >= 0 ? SeparatingFace(m, vfaces, stars, v, t_copy, m.tets + 4*t, depth) : -1;
+          // none: where three or more copies meet, v's wedge can lie across the plane of the
+          // lip it crossed into t's wedge; that lip still separates v if v is behind it (the
+          // nearest face of F may be the coincident lip of another copy, v in front of it)
+          if (sep < 0 && t_copy >= 0)
+            sep = SeparatingFace(m, vfaces, stars, v, t_copy, m.tets + 4*t, depth, &copies);
           if (sep >= 0)
             {
               const int32_t * T = m.faces + 3*sep;

@@ -259,7 +259,7 @@ class ActiveSet:
         self._mult_values = np.zeros(0)                  # their multipliers
         self._multipliers = {}                  # the dictionary, or (keys, kept, values) to make it from
         self.imposed = set()                    # every set imposed so far (sorted codes as bytes)
-        self.tried = np.zeros(0, dtype=np.int64)         # codes of every row imposed so far, sorted
+        self.tried = np.zeros(0, dtype=np.int64)         # codes of every row wanted or imposed so far, sorted
         self.exact = False                      # the complementarity problem chooses the set
         self.force_scale = 0.0                  # the largest force of any solve so far
         self.moving = True                      # rows re-linearised every round
@@ -378,7 +378,9 @@ class ActiveSet:
 
         A set that has not settled is replaced by the closed rows of the complementarity
         problem when the update revisits a set, when ``round_number`` is past
-        ``pdas_rounds``, and in every round after the first such choice.
+        ``pdas_rounds``, and in every round after the first such choice. Then the set is
+        settled when those closed rows are the rows of the last solve, whatever the signs of
+        that solve's multipliers of dependent rows.
 
         Parameters
         ----------
@@ -403,22 +405,28 @@ class ActiveSet:
         codes = self._codes(candidates.keys)
         kept_codes = np.unique(codes[kept])
         settled = self.solved and np.array_equal(kept_codes, self._mult_codes)
-        if self.moving and not settled:
-            self.last_penetration = np.inf     # the contraction is judged at one set only
         if not settled and (self.exact or round_number > self.pdas_rounds
                             or kept_codes.tobytes() in self.imposed):
             self.exact = True
-            # candidates: the rows the update wants and every row imposed before
+            # candidates: the rows the update wants and every row wanted or imposed before
+            # (a vertex sliding over a master vertex: a face that one set lets it penetrate
+            # must be a candidate when the problem is solved from the state of another set)
             tried = np.flatnonzero(np.isin(codes, self.tried))
             closed = complementarity(candidates.rows, np.union1d(want, tried))
             if closed is not None:
                 # closed rows that depend on others hold with them; as equalities they
                 # would make the system singular
-                choice = self._independent(candidates.rows, closed)
-                if not np.array_equal(np.unique(codes[choice]), self._mult_codes):
-                    kept, kept_codes = choice, np.unique(codes[choice])
+                kept = self._independent(candidates.rows, closed)
+                kept_codes = np.unique(codes[kept])
+                # the exact solution keeps the last set: settled. Dependent rows share
+                # their force in many ways; the share the solve's independent subset gave
+                # can tension a row that the complementarity problem compresses, and the
+                # update would release it and take it back, round after round
+                settled = self.solved and np.array_equal(kept_codes, self._mult_codes)
+        if self.moving and not settled:
+            self.last_penetration = np.inf     # the contraction is judged at one set only
         self.imposed.add(kept_codes.tobytes())
-        self.tried = np.union1d(self.tried, kept_codes)
+        self.tried = np.union1d(self.tried, np.union1d(kept_codes, codes[want]))
         return kept, settled
 
     def settle(self, candidates, other, U):

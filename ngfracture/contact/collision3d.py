@@ -54,7 +54,13 @@ that depth (0 if v is not behind it), the projection the nearest point of the fa
 are the faces v's wedge can have crossed: the lip between the two copies, or, where three
 or more copies meet, the lip of t towards a third copy that v slid past; not a face of t
 that v's wedge lies across (the side face that the edge of a lip pushed across the crack
-lies on). Else, in this order:
+lies on). If no face passes that test, the boundary face of that tetrahedron at t that v
+is least deep behind, if v is behind one: where three copies of a point lie on one
+fragment (a junction of cracks in it), v's wedge can lie across the plane of the lip it
+crossed into t's wedge, and the nearest face is then the coincident lip at the third copy,
+which v is in front of (the coarse confined sphere at x = 2.70e-3: v 1.4e-5 behind the lip
+at t, reported 2.35e-5 deep on the lip at the third copy, whose row did not hold it).
+Else, in this order:
 
 1. touching: a boundary face of F that holds v exactly (closed triangle, exact
    predicates) and whose outward normal does not point along v's normal (dot <= 0; v's
