@@ -553,6 +553,15 @@ namespace ngfracture
       return false;
     }
 
+    // The copies of v's point (v included) on fragment F.
+    int64_t CopiesOn (const Copies & copies, const std::vector<int32_t> & vfrag, int32_t v, int32_t F)
+    {
+      int64_t n = 0;
+      int32_t g = copies.group[v];
+      for (int64_t s = copies.start[g]; s < copies.start[g+1]; s++) n += vfrag[copies.members[s]] == F;
+      return n;
+    }
+
     // v in the tetrahedron `tet` at its copy t: of the boundary faces of that tetrahedron
     // at t whose plane has v's reference star on its outer side (faces v's wedge can have
     // crossed into that tetrahedron: the lip between them, or where several cracks meet
@@ -828,10 +837,11 @@ namespace ngfracture
             }
           double depth = 0;
           int32_t sep = t_copy >= 0 ? SeparatingFace(m, vfaces, stars, v, t_copy, m.tets + 4*t, depth) : -1;
-          // none: where three or more copies meet, v's wedge can lie across the plane of the
-          // lip it crossed into t's wedge; that lip still separates v if v is behind it (the
-          // nearest face of F may be the coincident lip of another copy, v in front of it)
-          if (sep < 0 && t_copy >= 0)
+          // none, and three or more copies of the point on F (cracks meeting inside F): v's
+          // wedge can lie across the plane of the lip it crossed into t's wedge; that lip
+          // still separates v if v is behind it (the nearest face of F may be the coincident
+          // lip of another copy, v in front of it)
+          if (sep < 0 && t_copy >= 0 && CopiesOn(copies, D.vfrag, v, F) >= 3)
             sep = SeparatingFace(m, vfaces, stars, v, t_copy, m.tets + 4*t, depth, &copies);
           if (sep >= 0)
             {

@@ -88,8 +88,9 @@ def test_detection_equals_brute_force(still):
     assert np.array_equal(pen.tet, t[first])
     # master face (collision3d's docstring): in a tetrahedron at a copy t of the vertex, the
     # face of that tetrahedron at t with the vertex's reference star outside its plane that
-    # the vertex is least deep behind; if none passes, the lip of that tetrahedron at t the
-    # vertex is least deep behind if it is behind one; else the nearest face of the block
+    # the vertex is least deep behind; if none passes and three copies of the point lie on
+    # the block, the lip of that tetrahedron at t the vertex is least deep behind if it is
+    # behind one; else the nearest face of the block
     # opposing the vertex's normal or coincident with one of its faces (partner faces)
     area2 = np.cross(x[F[:, 1]] - x[F[:, 0]], x[F[:, 2]] - x[F[:, 0]])
     ref2 = np.cross(X[F[:, 1]] - X[F[:, 0]], X[F[:, 2]] - X[F[:, 0]])
@@ -111,7 +112,8 @@ def test_detection_equals_brute_force(still):
             outside = np.all(n @ e.T >= -1e-9 * np.linalg.norm(e, axis=1), axis=1)
             sep = at[outside]
             lips = at[[points_count[points[g]] > 1 for g in at]]
-            if not len(sep) and len(lips):
+            on_block = int(np.count_nonzero(np.all(X == X[a], axis=1) & (vf == f)))
+            if not len(sep) and len(lips) and on_block >= 3:
                 signed = np.einsum("ij,j->i", area2[lips] / np.linalg.norm(area2[lips], axis=1)[:, None],
                                    x[a] - x[t[0]])
                 if signed.max() < 0:

@@ -259,7 +259,8 @@ class ActiveSet:
         self._mult_values = np.zeros(0)                  # their multipliers
         self._multipliers = {}                  # the dictionary, or (keys, kept, values) to make it from
         self.imposed = set()                    # every set imposed so far (sorted codes as bytes)
-        self.tried = np.zeros(0, dtype=np.int64)         # codes of every row wanted or imposed so far, sorted
+        self.tried = np.zeros(0, dtype=np.int64)         # codes of every row imposed so far, sorted
+        self.wanted = np.zeros(0, dtype=np.int64)        # codes of every row wanted so far, sorted
         self.exact = False                      # the complementarity problem chooses the set
         self.force_scale = 0.0                  # the largest force of any solve so far
         self.moving = True                      # rows re-linearised every round
@@ -405,19 +406,21 @@ class ActiveSet:
         codes = self._codes(candidates.keys)
         kept_codes = np.unique(codes[kept])
         settled = self.solved and np.array_equal(kept_codes, self._mult_codes)
+        self.wanted = np.union1d(self.wanted, codes[want])
         if not settled and (self.exact or round_number > self.pdas_rounds
                             or kept_codes.tobytes() in self.imposed):
             self.exact = True
-            # candidates: the rows the update wants and every row wanted or imposed before
-            # (a vertex sliding over a master vertex: a face that one set lets it penetrate
-            # must be a candidate when the problem is solved from the state of another set)
-            tried = np.flatnonzero(np.isin(codes, self.tried))
-            closed = complementarity(candidates.rows, np.union1d(want, tried))
-            if closed is not None:
-                # closed rows that depend on others hold with them; as equalities they
-                # would make the system singular
-                kept = self._independent(candidates.rows, closed)
-                kept_codes = np.unique(codes[kept])
+            choice = self._exact_choice(candidates, codes, want, complementarity)
+            if choice is not None and not np.array_equal(choice[1], self._mult_codes) \
+                    and choice[1].tobytes() in self.imposed:
+                # a cycle: a vertex sliding over a master vertex is held by one face in one
+                # set and by two others in the next, and the face the first set lets it
+                # penetrate is wanted only at that set's state; every row wanted in the
+                # solve becomes a candidate
+                self.tried = np.union1d(self.tried, self.wanted)
+                choice = self._exact_choice(candidates, codes, want, complementarity) or choice
+            if choice is not None:
+                kept, kept_codes = choice
                 # the exact solution keeps the last set: settled. Dependent rows share
                 # their force in many ways; the share the solve's independent subset gave
                 # can tension a row that the complementarity problem compresses, and the
@@ -426,8 +429,20 @@ class ActiveSet:
         if self.moving and not settled:
             self.last_penetration = np.inf     # the contraction is judged at one set only
         self.imposed.add(kept_codes.tobytes())
-        self.tried = np.union1d(self.tried, np.union1d(kept_codes, codes[want]))
+        self.tried = np.union1d(self.tried, kept_codes)
         return kept, settled
+
+    def _exact_choice(self, candidates, codes, want, complementarity):
+        """The closed rows of the complementarity problem of the wanted and tried rows, made
+        independent, and their sorted codes; None where the problem could not be solved."""
+        tried = np.flatnonzero(np.isin(codes, self.tried))
+        closed = complementarity(candidates.rows, np.union1d(want, tried))
+        if closed is None:
+            return None
+        # closed rows that depend on others hold with them; as equalities they would make
+        # the system singular
+        kept = self._independent(candidates.rows, closed)
+        return kept, np.unique(codes[kept])
 
     def settle(self, candidates, other, U):
         """Judge a settled set by its candidates re-linearised at X + U.
@@ -512,8 +527,12 @@ class ActiveSet:
         """The indices of an independent subset of rows[indices], with the fixed dofs and holds."""
         if not len(indices):
             return indices
-        return indices[independent_rows(rows.C[indices], fixed_dofs=self.geometry.fixed, G=self.geometry.holds,
-                                        rtol=self.rank_tol)]
+        C = rows.C[indices]
+        return indices[independent_rows(C, fixed_dofs=self.geometry.fixed, G=self._holds_for(C), rtol=self.rank_tol)]
+
+    def _holds_for(self, C):
+        """The rows kept in any case that the independence of the rows ``C`` is judged with."""
+        return self.geometry.holds
 
     def _split(self, rows):
         """Candidate rows as (seam rows, node-to-segment rows)."""

@@ -64,6 +64,7 @@ from .active_set import ActiveSet, Candidates, RowKeys, refreshed
 from .collision3d import PenetrationDetector3d
 from .copies3d import folded_rows_at_copies, found_rows_at_copies
 from .junctions3d import covered_pairs, fragment_pair_rows
+from .redundancy import holds_on_columns
 from .rows3d import NodeToFaceRows, lip_rows, no_face_rows, node_to_face_rows, relinearise_node_to_face
 
 __all__ = ["ActiveSet3d", "FaceKeys", "fixed_rows_3d"]
@@ -306,6 +307,12 @@ class ActiveSet3d(ActiveSet):
     def _key_codes(self, keys):
         """The codes of keys given as tuples (:meth:`FaceKeys.codes_of`)."""
         return self.codec.codes_of(keys)
+
+    def _holds_for(self, C):
+        """The holds that rows ``C`` can depend on (:func:`~ngfracture.contact.redundancy.holds_on_columns`):
+        the rows that hold a piece on its rigid modes are dense over the piece, and the
+        pieces of a 3D body are large."""
+        return holds_on_columns(self.geometry.holds, C, self.geometry.fixed, self.rank_tol)
 
     def _fresh_rows(self, candidates, U):
         """The candidate rows re-linearised at X + U (all of them: settle's judgement)."""

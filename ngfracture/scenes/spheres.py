@@ -244,7 +244,7 @@ def sphere3d(maxh=0.25, fine=None, band=None, expansion=None, dx=None, core_stif
     core's inner surface moves radially outward by x; frictionless contact passes the
     expansion on to the glass, whose outer surface is held (a rigid shell) when
     ``confined``; the interface sticks tangentially (:func:`stick_rows`). Radial cracks grow
-    from the hole; the coarse run stops at 2.1 x_c (docs/solid.md, "The sphere scenes").
+    from the hole and cut pieces off (docs/solid.md, "The sphere scenes").
 
     Parameters
     ----------
