@@ -362,6 +362,23 @@ namespace ngfracture
           if (members[s] != v && vfrag[members[s]] == F) return members[s];
         return -1;
       }
+
+      // the copies of v's point on fragment F, v included
+      int64_t CountOn (const std::vector<int32_t> & vfrag, int32_t v, int32_t F) const
+      {
+        int64_t n = 0;
+        int32_t g = group[v];
+        for (int64_t s = start[g]; s < start[g+1]; s++) n += vfrag[members[s]] == F;
+        return n;
+      }
+
+      // the points of boundary face T (its vertices' groups), sorted
+      std::array<int32_t,3> FacePoints (const int32_t * T) const
+      {
+        std::array<int32_t,3> p { group[T[0]], group[T[1]], group[T[2]] };
+        std::sort(p.begin(), p.end());
+        return p;
+      }
     };
 
     Copies MakeCopies (const TetMesh3 & m, const Topology & D)
@@ -537,29 +554,15 @@ namespace ngfracture
     bool IsLip (const TetMesh3 & m, const Copies & copies, const VertexFaces & vfaces, int32_t f)
     {
       const int32_t * T = m.faces + 3*f;
-      std::array<int32_t,3> pts { copies.group[T[0]], copies.group[T[1]], copies.group[T[2]] };
-      std::sort(pts.begin(), pts.end());
+      const std::array<int32_t,3> pts = copies.FacePoints(T);
       int32_t g = copies.group[T[0]];
       for (int64_t s = copies.start[g]; s < copies.start[g+1]; s++)
         for (int64_t i = vfaces.start[copies.members[s]]; i < vfaces.start[copies.members[s]+1]; i++)
           {
             int32_t h = vfaces.at[i];
-            if (h == f) continue;
-            const int32_t * H = m.faces + 3*h;
-            std::array<int32_t,3> q { copies.group[H[0]], copies.group[H[1]], copies.group[H[2]] };
-            std::sort(q.begin(), q.end());
-            if (q == pts) return true;
+            if (h != f && copies.FacePoints(m.faces + 3*h) == pts) return true;
           }
       return false;
-    }
-
-    // The copies of v's point (v included) on fragment F.
-    int64_t CopiesOn (const Copies & copies, const std::vector<int32_t> & vfrag, int32_t v, int32_t F)
-    {
-      int64_t n = 0;
-      int32_t g = copies.group[v];
-      for (int64_t s = copies.start[g]; s < copies.start[g+1]; s++) n += vfrag[copies.members[s]] == F;
-      return n;
     }
 
     // v in the tetrahedron `tet` at its copy t: of the boundary faces of that tetrahedron
@@ -576,7 +579,7 @@ namespace ngfracture
                             int32_t v, int32_t t, const int32_t * tet, double & depth,
                             const Copies * lips_of = nullptr)
     {
-      bool any_side = lips_of != nullptr;
+      bool lips_only = lips_of != nullptr;
       int32_t best = -1;
       double best_s = -std::numeric_limits<double>::infinity();
       auto in_tet = [&] (int32_t w) { return tet[0] == w || tet[1] == w || tet[2] == w || tet[3] == w; };
@@ -590,7 +593,7 @@ namespace ngfracture
           double len = std::sqrt(Dot(n, n));
           if (!(len > 0)) continue;
           for (int d = 0; d < 3; d++) n[d] /= len;
-          if (any_side ? !IsLip(m, *lips_of, vfaces, f) : !StarOnSide(m, stars, v, n, 1.0)) continue;
+          if (lips_only ? !IsLip(m, *lips_of, vfaces, f) : !StarOnSide(m, stars, v, n, 1.0)) continue;
           Sub(m.x + 3*T[1], m.x + 3*T[0], e0); Sub(m.x + 3*T[2], m.x + 3*T[0], e1); Cross(e0, e1, n);
           len = std::sqrt(Dot(n, n));
           if (!(len > 0)) continue;
@@ -599,7 +602,7 @@ namespace ngfracture
           double s = Dot(n, r) / len;
           if (s > best_s || (s == best_s && f < best)) { best_s = s; best = f; }
         }
-      if (any_side && !(best_s < 0)) best = -1;
+      if (lips_only && !(best_s < 0)) best = -1;
       depth = best >= 0 ? std::max(0.0, -best_s) : 0.0;
       return best;
     }
@@ -841,7 +844,7 @@ namespace ngfracture
           // wedge can lie across the plane of the lip it crossed into t's wedge; that lip
           // still separates v if v is behind it (the nearest face of F may be the coincident
           // lip of another copy, v in front of it)
-          if (sep < 0 && t_copy >= 0 && CopiesOn(copies, D.vfrag, v, F) >= 3)
+          if (sep < 0 && t_copy >= 0 && copies.CountOn(D.vfrag, v, F) >= 3)
             sep = SeparatingFace(m, vfaces, stars, v, t_copy, m.tets + 4*t, depth, &copies);
           if (sep >= 0)
             {

@@ -268,14 +268,15 @@ def holds_on_columns(G, C, fixed_dofs=None, rtol=1e-8, max_group=64):
     if G is None:
         return None
     G = sp.csr_matrix(G, dtype=np.float64)
+    G.sum_duplicates()
     C = sp.csr_matrix(C)
     ndof = G.shape[1]
     off = np.ones(ndof, dtype=bool)
     off[C.indices] = False
     if fixed_dofs is not None:
         off[np.asarray(fixed_dofs, dtype=np.int64)] = False
-    norms = np.sqrt(np.asarray(G.multiply(G).sum(axis=1)).ravel())
-    G = sp.diags(np.where(norms > 0, 1.0 / np.where(norms > 0, norms, 1.0), 0.0)) @ G
+    row, col, val = _unit_rows(G)
+    G = sp.csr_matrix((val, (row, col)), shape=G.shape)
     G_off = G[:, np.flatnonzero(off)].tocsr()
     touching = np.diff(G_off.indptr) > 0
     if not touching.any():
