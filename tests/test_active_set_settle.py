@@ -12,27 +12,22 @@ wanted in the solve as a candidate.
 """
 import numpy as np
 
-from ngfracture.contact.active_set import Geometry
 from ngfracture.contact.active_set3d import ActiveSet3d
-from ngfracture.geometry.pieces import fragmented_box
+
+from blocks3d import block_geometry, overlapping_blocks
 
 
-def overlapping_blocks():
+def overlapping_geometry():
     """A cube of 2 x 2 x 2 blocks, each expanded about its centroid: every lip overlaps."""
-    arrays, piece = fragmented_box(5, 2)
-    X = arrays.points
-    vf = np.full(len(X), -1)
-    vf[arrays.tets.ravel()] = np.repeat(piece, 4)
-    centre = np.stack([np.bincount(vf, weights=X[:, d]) / np.bincount(vf) for d in range(3)], axis=1)
-    geometry = Geometry(arrays=arrays, fragment=piece, seams=None, fixed=np.zeros(0, dtype=np.int64))
-    return geometry, 0.08 * (X - centre[vf])
+    arrays, piece, _, U = overlapping_blocks(5, 2, 0.08)
+    return block_geometry(arrays, piece), U
 
 
 def solved_with_one_tensile_row(exact_choice):
     """An active set after one solve whose first row pulls, and its next round's choice:
     past the primal-dual rounds, the complementarity problem returning the last set (or
     nothing, ``exact_choice`` False)."""
-    geometry, U = overlapping_blocks()
+    geometry, U = overlapping_geometry()
     active = ActiveSet3d(geometry, 1e-12)
     cand = active.update(U, {"collision": 0.0})
     want, kept, _ = active.primal_dual(cand)
@@ -70,7 +65,7 @@ def test_a_cycle_makes_every_wanted_row_a_candidate():
     the update releases G, and without F the problem chooses A again, a set imposed
     before. The choice must be solved again with every row wanted in the solve: it then
     keeps B, settled."""
-    geometry, U = overlapping_blocks()
+    geometry, U = overlapping_geometry()
     active = ActiveSet3d(geometry, 1e-12)
     cand = active.update(U, {"collision": 0.0})
     _, kept, _ = active.primal_dual(cand)

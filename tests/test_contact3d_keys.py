@@ -6,17 +6,17 @@ tetrahedra and master faces against a brute-force search over all pairs (exact o
 the crossed face of the tetrahedron at a copy, or the nearest face by distance to every
 face), on a fragmented cube whose blocks overlap.
 """
-from collections import Counter
-
 import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from ngfracture.contact.active_set import Candidates, Geometry, RowKeys
+from ngfracture.contact.active_set import Candidates, RowKeys
 from ngfracture.contact.active_set3d import ActiveSet3d, FaceKeys, fixed_rows_3d
-from ngfracture.contact.collision3d import PenetrationDetector3d, detect_penetrations_3d, orient3d
+from ngfracture.contact.collision3d import PenetrationDetector3d, detect_penetrations_3d
 from ngfracture.contact.rows3d import face_gap_rows, node_to_face_rows
-from ngfracture.geometry.pieces import fragmented_box
+
+from blocks3d import block_geometry, overlapping_blocks
+from detection3d_util import MasterReference, brute_force_pairs
 
 CELLS, PIECES = 5, 2
 
@@ -24,115 +24,27 @@ CELLS, PIECES = 5, 2
 def _body(seed=0):
     """The fragmented cube, and a displacement where every block overlaps its neighbours:
     each block expanded about its centroid by 0.2 cells across every lip, plus noise."""
-    arrays, piece = fragmented_box(CELLS, PIECES)
-    X = arrays.points
-    vf = np.full(len(X), -1)
-    vf[arrays.tets.ravel()] = np.repeat(piece, 4)
-    centre = np.stack([np.bincount(vf, weights=X[:, d]) / np.bincount(vf) for d in range(3)], axis=1)
-    U = 0.2 / CELLS * PIECES * (X - centre[vf])
-    U += np.random.default_rng(seed).normal(scale=0.05 / CELLS, size=U.shape)
-    return arrays, piece, vf, U
-
-
-def _closest_distance(p, A, B, C):
-    """Distance from p to every triangle (A, B, C): the plane's foot if inside, else the nearest edge."""
-    n = np.cross(B - A, C - A)
-    n /= np.linalg.norm(n, axis=1)[:, None]
-    foot = p - np.einsum("ij,ij->i", p - A, n)[:, None] * n
-    inside = np.all([np.einsum("ij,ij->i", np.cross(Q - P, foot - P), n) >= 0
-                     for P, Q in ((A, B), (B, C), (C, A))], axis=0)
-    best = np.linalg.norm(p - foot, axis=1)
-    edges = []
-    for P, Q in ((A, B), (B, C), (C, A)):
-        e = Q - P
-        t = np.clip(np.einsum("ij,ij->i", p - P, e) / np.einsum("ij,ij->i", e, e), 0.0, 1.0)
-        edges.append(np.linalg.norm(p - (P + t[:, None] * e), axis=1))
-    return np.where(inside, best, np.min(edges, axis=0))
+    return overlapping_blocks(CELLS, PIECES, 0.2 / CELLS * PIECES, noise=0.05 / CELLS, seed=seed)
 
 
 @pytest.mark.parametrize("still", [False, True])
 def test_detection_equals_brute_force(still):
     """With ``still`` half of the blocks do not move: their common lips stay closed, and the
-    closed seams the detection decides before its sweep must be the brute force's."""
+    closed seams the detection decides before its sweep must be the brute force's
+    (``detection3d_util``: pairs by exact tests of every (vertex, tetrahedron), master
+    faces by the rules of collision3d's docstring)."""
     arrays, piece, vf, U = _body()
     X, T, F = arrays.points, arrays.tets, arrays.faces
     if still:
         U[vf >= 4] = 0.0
-    x = X + U
     pen = detect_penetrations_3d(X, T, F, piece, displacement=U)
-    # brute force: every (boundary vertex, tetrahedron of another block), exactly
-    bv = np.unique(F)
-    v, t = np.repeat(bv, len(T)), np.tile(np.arange(len(T)), len(bv))
-    other = vf[v] != piece[t]
-    v, t = v[other], t[other]
-    corners = [x[T[t, k]] for k in range(4)]
-    s = orient3d(*corners).astype(int)
-    inside = s != 0
-    for k in range(4):
-        w = list(corners)
-        w[k] = x[v]
-        inside &= orient3d(*w) * s >= 0
-    v, t = v[inside], t[inside]
-    # closed seams: a copy on the block at the same reference and current point
-    key = {(tuple(X[u]), int(vf[u])): u for u in bv.tolist()}
-    twin = np.array([key.get((tuple(X[a]), int(piece[b])), -1) for a, b in zip(v.tolist(), t.tolist())])
-    closed = (twin >= 0) & np.all(x[v] == x[np.maximum(twin, 0)], axis=1)
-    assert pen.stats["closed_seams"] == len(np.unique(v[closed] * len(T) + piece[t[closed]]))
-    assert (pen.stats["closed_seams"] > 100) == still
-    v, t = v[~closed], t[~closed]
-    order = np.lexsort((t, piece[t], v))
-    v, t = v[order], t[order]
-    first = np.r_[True, (v[1:] != v[:-1]) | (piece[t][1:] != piece[t][:-1])]
+    vertex, fragment, tet, closed = brute_force_pairs(X, T, F, piece, U)
+    assert pen.stats["closed_seams"] == closed
+    assert (closed > 100) == still
     assert len(pen) > 100
-    assert np.array_equal(pen.vertex, v[first]) and np.array_equal(pen.fragment, piece[t][first])
-    assert np.array_equal(pen.tet, t[first])
-    # master face (collision3d's docstring): in a tetrahedron at a copy t of the vertex, the
-    # face of that tetrahedron at t with the vertex's reference star outside its plane that
-    # the vertex is least deep behind; if none passes and three copies of the point lie on
-    # the block, the lip of that tetrahedron at t the vertex is least deep behind if it is
-    # behind one; else the nearest face of the block
-    # opposing the vertex's normal or coincident with one of its faces (partner faces)
-    area2 = np.cross(x[F[:, 1]] - x[F[:, 0]], x[F[:, 2]] - x[F[:, 0]])
-    ref2 = np.cross(X[F[:, 1]] - X[F[:, 0]], X[F[:, 2]] - X[F[:, 0]])
-    vnormal = np.zeros((len(X), 3))
-    np.add.at(vnormal, F.ravel(), np.repeat(area2, 3, axis=0))
-    face_block = vf[F[:, 0]]
-    points = [frozenset(map(tuple, X[f])) for f in F]
-    points_count = Counter(points)                 # a lip: another face on its three points
-    star = [np.unique(T[np.any(T == u, axis=1)]) for u in range(len(X))]
-    crossed = behind = 0
-    for i in range(len(pen)):
-        a, f, tet = pen.vertex[i], pen.fragment[i], T[pen.tet[i]]
-        t = [u for u in tet if u != a and np.array_equal(X[u], X[a])]
-        sep = []
-        if t:
-            at = np.flatnonzero(np.all(np.isin(F, tet), axis=1) & np.any(F == t[0], axis=1))
-            n = ref2[at] / np.linalg.norm(ref2[at], axis=1)[:, None]
-            e = X[star[a]] - X[a]
-            outside = np.all(n @ e.T >= -1e-9 * np.linalg.norm(e, axis=1), axis=1)
-            sep = at[outside]
-            lips = at[[points_count[points[g]] > 1 for g in at]]
-            on_block = int(np.count_nonzero(np.all(X == X[a], axis=1) & (vf == f)))
-            if not len(sep) and len(lips) and on_block >= 3:
-                signed = np.einsum("ij,j->i", area2[lips] / np.linalg.norm(area2[lips], axis=1)[:, None],
-                                   x[a] - x[t[0]])
-                if signed.max() < 0:
-                    sep = lips
-                    behind += 1
-        if len(sep):
-            crossed += 1
-            signed = np.einsum("ij,j->i", area2[sep] / np.linalg.norm(area2[sep], axis=1)[:, None], x[a] - x[t[0]])
-            assert pen.face[i] == sep[np.lexsort((sep, -signed))[0]]
-            assert abs(pen.gap[i] + max(0.0, -signed.max())) <= 1e-12 / CELLS
-            continue
-        mine = {points[g] for g in np.flatnonzero(np.any(F == a, axis=1))}
-        partner = np.array([points[g] in mine and bool(np.any(np.all(X[F[g]] == X[a], axis=1)))
-                            for g in range(len(F))])
-        cand = np.flatnonzero((face_block == f) & ((area2 @ vnormal[a] < 0) | partner) & np.all(F != a, axis=1))
-        d = _closest_distance(x[a][None, :], x[F[cand, 0]], x[F[cand, 1]], x[F[cand, 2]])
-        assert pen.face[i] in cand
-        assert abs(-pen.gap[i] - d.min()) <= 1e-12 / CELLS
-        assert d[cand == pen.face[i]][0] <= d.min() + 1e-12 / CELLS
+    assert np.array_equal(pen.vertex, vertex) and np.array_equal(pen.fragment, fragment)
+    assert np.array_equal(pen.tet, tet)
+    crossed, behind = MasterReference(X, U, T, F, piece).check(pen, 1e-12 / CELLS)
     assert crossed > 0                         # both rules are exercised
     print(f"{len(pen)} pairs, {crossed} on a face at a copy, {behind} of them by the lip rule")
 
@@ -202,7 +114,7 @@ def test_gap_rows_are_the_coordinate_conversion():
 def test_codes_choose_as_tuples():
     """Two active sets fed the same candidates, one with RowKeys and one with key tuples."""
     arrays, piece, vf, U = _body(3)
-    geometry = Geometry(arrays=arrays, fragment=piece, seams=None, fixed=np.zeros(0, dtype=np.int64))
+    geometry = block_geometry(arrays, piece)
     coded, plain = ActiveSet3d(geometry, 1e-12), ActiveSet3d(geometry, 1e-12)
     rng = np.random.default_rng(3)
     for rnd, u in enumerate((U, 0.5 * U, np.zeros_like(U)), start=1):
@@ -225,11 +137,8 @@ def test_redundancy_shortcuts_choose_the_plain_rows(monkeypatch):
     rows) and of the closed body (every row independent): the rows independent_rows keeps
     with its Gram test per component must be those of the pivoted QR alone."""
     from ngfracture.contact import redundancy
-    arrays, piece, vf, _ = _body()
-    X = arrays.points
-    centre = np.stack([np.bincount(vf, weights=X[:, d]) / np.bincount(vf) for d in range(3)], axis=1)
-    U = 0.2 / CELLS * PIECES * (X - centre[vf])          # the blocks overlap, without noise
-    geometry = Geometry(arrays=arrays, fragment=piece, seams=None, fixed=np.zeros(0, dtype=np.int64))
+    arrays, piece, _, U = overlapping_blocks(CELLS, PIECES, 0.2 / CELLS * PIECES)     # without noise
+    geometry = block_geometry(arrays, piece)
     active = ActiveSet3d(geometry, 1e-12)
     dropped = []
     for u in (U, np.zeros_like(U)):

@@ -1,0 +1,51 @@
+"""A fragmented cube whose blocks overlap: the common body of the 3D contact tests.
+
+Used by ``test_contact3d_keys.py`` (with noise) and ``test_active_set_settle.py``
+(without); import with ``PYTHONPATH=.:tests``.
+"""
+import numpy as np
+
+from ngfracture.contact.active_set import Geometry
+from ngfracture.geometry.pieces import fragmented_box
+
+
+def overlapping_blocks(cells, pieces, expansion, noise=0.0, seed=0):
+    """The cube of ``pieces``^3 blocks (``cells`` a side), each expanded about its centroid.
+
+    Parameters
+    ----------
+    cells, pieces : int
+        Cells a side of the unit cube and blocks a side (``geometry.pieces.fragmented_box``).
+    expansion : float
+        The displacement of a vertex is ``expansion`` times its offset from its block's
+        centroid: every lip overlaps its neighbour by ``expansion`` times the block size.
+    noise : float
+        Standard deviation of a normal noise added to every component (0: none).
+    seed : int
+        Seed of the noise (``numpy.random.default_rng``).
+
+    Returns
+    -------
+    arrays : ngfracture.geometry.solid.SolidArrays
+        The mesh (the blocks' lips are coincident faces on bitwise-equal copies).
+    piece : numpy.ndarray of int64, shape (ne,)
+        The block of every tetrahedron.
+    vf : numpy.ndarray of int64, shape (nv,)
+        The block of every vertex.
+    U : numpy.ndarray, shape (nv, 3)
+        The displacement.
+    """
+    arrays, piece = fragmented_box(cells, pieces)
+    X = arrays.points
+    vf = np.full(len(X), -1)
+    vf[arrays.tets.ravel()] = np.repeat(piece, 4)
+    centre = np.stack([np.bincount(vf, weights=X[:, d]) / np.bincount(vf) for d in range(3)], axis=1)
+    U = expansion * (X - centre[vf])
+    if noise:
+        U += np.random.default_rng(seed).normal(scale=noise, size=U.shape)
+    return arrays, piece, vf, U
+
+
+def block_geometry(arrays, piece):
+    """The ``active_set.Geometry`` of the blocks: no seams, no fixed vertex."""
+    return Geometry(arrays=arrays, fragment=piece, seams=None, fixed=np.zeros(0, dtype=np.int64))

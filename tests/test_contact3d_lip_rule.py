@@ -1,0 +1,120 @@
+"""The detection's lip rule at points of three copies on one fragment (docs/contact.md,
+"Points of several copies"; ``SeparatingFace(..., lips_only)`` in cpp_ext/collision3d.cpp).
+
+The body is the junction cube of ``test_contact3d_crack_junction.py``: two cracks inside
+one fragment meet along the line x = y = 1/2, z > 1/2, where every point has three copies
+on that fragment: W0 in the half x < 1/2, W1 and W2 in the quarters x > 1/2 below and
+above y = 1/2. The copy of W0 is moved slightly into a tetrahedron of W1 or W2 at the
+copy t there whose boundary faces at t all have W0's reference star across their plane
+(the lip y = 1/2, and the free top face at the top point): no face passes the star test,
+and the master must be the lip of that tetrahedron at t the vertex is least deep behind,
+the gap minus the exact distance to that lip's plane. The nearest face (the rule
+without the lip fallback) is another one, on the plane x = 1/2 (at z = 3/4 half as deep);
+at the top the free face is nearer than the lip (a rule over every face of the
+tetrahedron would take it). The whole detection must equal the brute-force reference of
+``detection3d_util`` (the rules of collision3d's docstring).
+"""
+from fractions import Fraction
+
+import numpy as np
+import pytest
+
+from ngfracture.contact.collision3d import detect_penetrations_3d
+from ngfracture.contact.rows3d import node_to_face_rows
+
+from detection3d_util import MasterReference, brute_force_pairs
+from test_contact3d_crack_junction import N, junction_cube, wedge_labels
+
+H = 1.0 / N                 # the cell size
+EPS = 1e-3                  # the vertex moves by about EPS cells
+
+
+def copies_of(X, z):
+    """The copies of the junction point at height z."""
+    return np.flatnonzero(np.all(X == [0.5, 0.5, z], axis=1))
+
+
+def faces_at(F, tet, t):
+    """The boundary faces of tetrahedron ``tet`` (its vertices) at vertex t."""
+    return np.flatnonzero(np.all(np.isin(F, tet), axis=1) & np.any(F == t, axis=1))
+
+
+def star_passes(X, T, F, v, face):
+    """Whether v's reference star lies on the outer side of the face's reference plane."""
+    n = np.cross(X[F[face, 1]] - X[F[face, 0]], X[F[face, 2]] - X[F[face, 0]])
+    e = X[np.unique(T[np.any(T == v, axis=1)])] - X[v]
+    return bool(np.all(e @ n >= -1e-9 * np.linalg.norm(n) * np.linalg.norm(e, axis=1)))
+
+
+def exact_signed(x, face, p):
+    """Signed distance of p from the plane of the face's (current) points, from exact products."""
+    A, B, C = (np.array([Fraction(float(c)) for c in x[k]]) for k in face)
+    n = np.cross(B - A, C - A)
+    r = np.array([Fraction(float(c)) for c in p]) - A
+    s = float(n @ r) / float(n @ n) ** 0.5
+    return s
+
+
+# (height of the point, wedge of the holding tetrahedron, weights of its three edges from
+# the point): the vertex moves to P + EPS sum_k w_k (X_k - P), inside that tetrahedron
+CASES = {"inner point": (0.75, 1, (0.4, 0.1, 0.1)), "top point": (1.0, 2, (0.1, 0.1, 0.3))}
+
+
+def holding_tet(a, labels, v, t, wedge):
+    """The tetrahedron of ``wedge`` at copy t whose boundary faces at t all fail v's star
+    test and include a lip; asserts there is one."""
+    X, T, F = a.points, a.tets, a.faces
+    for k in np.flatnonzero(np.any(T == t, axis=1) & (labels == wedge)):
+        at = faces_at(F, T[k], t)
+        if len(at) and not any(star_passes(X, T, F, v, f) for f in at):
+            return int(k), at
+    raise AssertionError(f"no tetrahedron of wedge {wedge} at copy {t} fails the star test")
+
+
+@pytest.mark.parametrize("case", sorted(CASES))
+def test_the_master_is_the_lip_the_vertex_is_least_deep_behind(case):
+    z, wedge, weights = CASES[case]
+    a = junction_cube()
+    X, T, F = a.points, a.tets, a.faces
+    labels = wedge_labels(a)
+    copies = copies_of(X, z)
+    side = [set(labels[np.any(T == c, axis=1)].tolist()) for c in copies]
+    assert len(copies) == 3 and sorted(map(tuple, side)) == [(0,), (1,), (2,)]
+    v, t = (int(copies[side.index({w})]) for w in (0, wedge))
+    k, at = holding_tet(a, labels, v, t, wedge)
+    others = [u for u in T[k] if u != t]
+    U = np.zeros_like(X)
+    U[v] = EPS * sum(w * (X[u] - X[t]) for w, u in zip(weights, others))
+    x = X + U
+    ref = MasterReference(X, U, T, F, np.zeros(len(T), np.int64))
+    lips = [f for f in at if ref.points_count[ref.points[f]] > 1]
+    assert len(lips) == 1 and len(at) == (1 if z < 1 else 2)
+    lip = lips[0]
+    depth = -exact_signed(x, F[lip], x[v])
+    assert np.isclose(depth, EPS * H * (weights[0] if z < 1 else weights[2]), rtol=1e-9)
+    if z == 1.0:                       # the free top face is nearer: only lips are candidates
+        top = next(f for f in at if f != lip)
+        assert 0.0 < -exact_signed(x, F[top], x[v]) < depth / 2
+
+    pen = detect_penetrations_3d(X, T, F, np.zeros(len(T), np.int64), displacement=U)
+    i = np.flatnonzero(pen.vertex == v)
+    assert len(i) == 1
+    i = int(i[0])
+    assert pen.fragment[i] == 0 and pen.tet[i] == k and pen.twin[i] >= 0
+    assert pen.face[i] == lip
+    assert abs(-pen.gap[i] - depth) <= 1e-15 * depth
+    # the nearest face rule (without the lip fallback) would take a face on the plane x = 1/2
+    cand, d = ref.nearest(v, 0)
+    assert np.all(X[F[cand[d == d.min()]], 0] == 0.5) and abs(d.min() - depth) > 0.2 * depth
+
+    # the brute-force reference: the same pairs, the same master faces, the same key
+    assert ref.at_copy(v, 0, T[k]) == (lip, pytest.approx(-depth, rel=1e-15), True)
+    vertex, fragment, tet, closed = brute_force_pairs(X, T, F, np.zeros(len(T), np.int64), U)
+    assert np.array_equal(pen.vertex, vertex) and np.array_equal(pen.fragment, fragment)
+    assert np.array_equal(pen.tet, tet) and pen.stats["closed_seams"] == closed
+    crossed, behind = ref.check(pen, 1e-15)
+    assert behind == 1
+    key = node_to_face_rows(X, F, pen).keys()[i]
+    assert key == ("f", v, *sorted(F[lip].tolist()))
+    print(f"\n{case}: {len(pen)} pairs, {crossed} at a copy, {behind} by the lip rule; depth {depth:.6g} "
+          f"(detected - exact {-pen.gap[i] - depth:.3g}), nearest face {d.min():.6g}, {closed} closed seams")
