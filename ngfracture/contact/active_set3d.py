@@ -182,15 +182,15 @@ def fixed_rows_3d(points, tets, faces, fragment):
     ValueError
         On inconsistent arrays (see :func:`~ngfracture.contact.collision3d.detect_penetrations_3d`).
     """
-    return _fixed_rows(points, tets, faces, fragment, FaceKeys(faces), PenetrationDetector3d(points, tets, faces, fragment),
+    detector = PenetrationDetector3d(points, tets, faces, fragment)         # checks the arrays
+    return _fixed_rows(points, faces, _vertex_fragment(len(points), tets, fragment), FaceKeys(faces), detector,
                        CopyIndex(points, faces))
 
 
-def _fixed_rows(points, tets, faces, fragment, codec, detector, index):
-    """:func:`fixed_rows_3d` with the keys' codec, the mesh's detector and copy index given."""
-    nv = len(points)
+def _fixed_rows(points, faces, vertex_fragment, codec, detector, index):
+    """:func:`fixed_rows_3d` with the vertices' fragments, the keys' codec, the mesh's
+    detector and copy index given."""
     touching = node_to_face_rows(points, faces, detector.detect())
-    vertex_fragment = _vertex_fragment(nv, tets, fragment)
     rows = NodeToFaceRows.stack([touching, fragment_pair_rows(points, faces, vertex_fragment, index=index),
                                  lip_rows(points, faces, vertex_fragment, index=index)])
     codes = codec.codes(rows)
@@ -286,10 +286,10 @@ class ActiveSet3d(ActiveSet):
         relinearised = None
         if self.seam_rows is None:
             t0 = time.perf_counter()
-            self.seam_rows, self.seam_keys = _fixed_rows(a.points, a.tets, a.faces, self.geometry.fragment, self.codec,
+            self.vertex_fragment = _vertex_fragment(len(a.points), a.tets, self.geometry.fragment)
+            self.seam_rows, self.seam_keys = _fixed_rows(a.points, a.faces, self.vertex_fragment, self.codec,
                                                          self.detector, self.copy_index)
             timings["collision"] += time.perf_counter() - t0
-            self.vertex_fragment = _vertex_fragment(len(a.points), a.tets, self.geometry.fragment)
             self.covered = covered_pairs(a.points, self.seam_rows, self.vertex_fragment)
         elif self.moving:
             old = NodeToFaceRows.stack([self.seam_rows, self.n2s])
