@@ -787,8 +787,16 @@ namespace ngfracture
       return closed;
     }
 
+    // The boundary faces and the reference stars at every vertex (MakeVertexFaces,
+    // MakeVertexStars): from the connectivity alone, made once per mesh by a detector.
+    struct Incidence
+    {
+      VertexFaces vfaces, stars;
+    };
+
+    // `incidence` the mesh's (made here, if there is a hit, when null)
     std::vector<Penetration3> Detect (const TetMesh3 & m, const Topology & T, const Copies & copies,
-                                      Collision3Stats * stats)
+                                      Collision3Stats * stats, const Incidence * incidence = nullptr)
     {
       Collision3Stats st;
       Derived D { T.vfrag, T.ffrag, T.bverts, T.lip, {}, {}, {}, {} };
@@ -822,7 +830,13 @@ namespace ngfracture
       fg.Build(lo, hi);
       D.flo = std::move(lo); D.fhi = std::move(hi);
 
-      VertexFaces vfaces = MakeVertexFaces(m), stars = MakeVertexStars(m);
+      Incidence own;
+      if (!incidence)
+        {
+          own = Incidence { MakeVertexFaces(m), MakeVertexStars(m) };
+          incidence = &own;
+        }
+      const VertexFaces & vfaces = incidence->vfaces, & stars = incidence->stars;
       for (size_t s = 0; s < hits.size(); s++)
         {
           auto [v, F, t] = hits[s];
@@ -883,6 +897,7 @@ namespace ngfracture
     int64_t nv, ne, nf;
     Topology T;
     Copies copies;
+    Incidence incidence;
 
     TetMesh3 Mesh (const double * x) const
     { return TetMesh3 { X.data(), x, tets.data(), faces.data(), fragment.data(), nv, ne, nf }; }
@@ -898,6 +913,7 @@ namespace ngfracture
     I.fragment.assign(m.fragment, m.fragment + m.ne);
     I.nv = m.nv; I.ne = m.ne; I.nf = m.nf;
     MakeTopology(I.Mesh(I.X.data()), I.T, I.copies);
+    I.incidence = Incidence { MakeVertexFaces(I.Mesh(I.X.data())), MakeVertexStars(I.Mesh(I.X.data())) };
   }
 
   PenetrationDetector3::~PenetrationDetector3 () = default;
@@ -906,6 +922,6 @@ namespace ngfracture
 
   std::vector<Penetration3> PenetrationDetector3::Detect (const double * x, Collision3Stats * stats) const
   {
-    return ngfracture::Detect(impl_->Mesh(x), impl_->T, impl_->copies, stats);
+    return ngfracture::Detect(impl_->Mesh(x), impl_->T, impl_->copies, stats, &impl_->incidence);
   }
 }

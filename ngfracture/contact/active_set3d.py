@@ -64,6 +64,7 @@ from .active_set import ActiveSet, Candidates, RowKeys, refreshed
 from .collision3d import PenetrationDetector3d
 from .copies3d import folded_rows_at_copies, found_rows_at_copies
 from .junctions3d import covered_pairs, fragment_pair_rows
+from .kinks3d import CopyIndex, isin_ints, unique_ints
 from .redundancy import holds_on_columns
 from .rows3d import NodeToFaceRows, lip_rows, no_face_rows, node_to_face_rows, relinearise_node_to_face
 
@@ -181,16 +182,17 @@ def fixed_rows_3d(points, tets, faces, fragment):
     ValueError
         On inconsistent arrays (see :func:`~ngfracture.contact.collision3d.detect_penetrations_3d`).
     """
-    return _fixed_rows(points, tets, faces, fragment, FaceKeys(faces), PenetrationDetector3d(points, tets, faces, fragment))
+    detector = PenetrationDetector3d(points, tets, faces, fragment)         # checks the arrays
+    return _fixed_rows(points, faces, _vertex_fragment(len(points), tets, fragment), FaceKeys(faces), detector,
+                       CopyIndex(points, faces))
 
 
-def _fixed_rows(points, tets, faces, fragment, codec, detector):
-    """:func:`fixed_rows_3d` with the keys' codec and the mesh's detector given."""
-    nv = len(points)
+def _fixed_rows(points, faces, vertex_fragment, codec, detector, index):
+    """:func:`fixed_rows_3d` with the vertices' fragments, the keys' codec, the mesh's
+    detector and copy index given."""
     touching = node_to_face_rows(points, faces, detector.detect())
-    vertex_fragment = _vertex_fragment(nv, tets, fragment)
-    rows = NodeToFaceRows.stack([touching, fragment_pair_rows(points, faces, vertex_fragment),
-                                 lip_rows(points, faces, vertex_fragment)])
+    rows = NodeToFaceRows.stack([touching, fragment_pair_rows(points, faces, vertex_fragment, index=index),
+                                 lip_rows(points, faces, vertex_fragment, index=index)])
     codes = codec.codes(rows)
     first = np.sort(np.unique(codes, return_index=True)[1])
     return rows.subset(first), RowKeys(codes[first], codec)
@@ -217,12 +219,12 @@ def tied_pairs(holds, nv):
     H = sp.csr_matrix(holds)
     H.eliminate_zeros()
     row = np.repeat(np.arange(H.shape[0]), np.diff(H.indptr))
-    v = np.unique(row * nv + H.indices % nv)                  # (row, vertex), each once
+    v = unique_ints(row * nv + H.indices % nv)                  # (row, vertex), each once
     row, v = v // nv, v % nv
     count = np.bincount(row, minlength=H.shape[0])
     two = count[row] == 2
     row, v = row[two], v[two]
-    return np.unique(v[0::2] * nv + v[1::2])                  # sorted within a row: min first
+    return unique_ints(v[0::2] * nv + v[1::2])                  # sorted within a row: min first
 
 
 def _vertex_fragment(nv, tets, fragment):
@@ -259,6 +261,8 @@ class ActiveSet3d(ActiveSet):
         a = geometry.arrays
         # the detection's work on the mesh alone, done once for every detection of the solve
         self.detector = PenetrationDetector3d(a.points, a.tets, a.faces, geometry.fragment)
+        # and the boundary's arrays that the rows at copies of a point look up
+        self.copy_index = CopyIndex(a.points, a.faces)
 
     def update(self, U, timings):
         """The candidate rows at X + U, the configuration of the last solve.
@@ -282,10 +286,10 @@ class ActiveSet3d(ActiveSet):
         relinearised = None
         if self.seam_rows is None:
             t0 = time.perf_counter()
-            self.seam_rows, self.seam_keys = _fixed_rows(a.points, a.tets, a.faces, self.geometry.fragment, self.codec,
-                                                         self.detector)
-            timings["collision"] += time.perf_counter() - t0
             self.vertex_fragment = _vertex_fragment(len(a.points), a.tets, self.geometry.fragment)
+            self.seam_rows, self.seam_keys = _fixed_rows(a.points, a.faces, self.vertex_fragment, self.codec,
+                                                         self.detector, self.copy_index)
+            timings["collision"] += time.perf_counter() - t0
             self.covered = covered_pairs(a.points, self.seam_rows, self.vertex_fragment)
         elif self.moving:
             old = NodeToFaceRows.stack([self.seam_rows, self.n2s])
@@ -294,8 +298,8 @@ class ActiveSet3d(ActiveSet):
         found, found_codes = self._node_to_face(U, timings)
         n2s_codes = self.n2s_keys.codes
         known = np.concatenate([n2s_codes, self.seam_keys.codes])
-        retained = np.flatnonzero(self._has_multiplier(n2s_codes)[0] | np.isin(n2s_codes, found_codes))
-        new = np.flatnonzero(~np.isin(found_codes, known))
+        retained = np.flatnonzero(self._has_multiplier(n2s_codes)[0] | isin_ints(n2s_codes, found_codes))
+        new = np.flatnonzero(~isin_ints(found_codes, known))
         self.n2s = NodeToFaceRows.stack([self.n2s.subset(retained), found.subset(new)])
         self.n2s_keys = RowKeys(np.concatenate([n2s_codes[retained], found_codes[new]]), self.codec)
         rows = NodeToFaceRows.stack([self.seam_rows, self.n2s])
@@ -325,7 +329,7 @@ class ActiveSet3d(ActiveSet):
         pen = self.detector.detect(U)
         timings["collision"] += time.perf_counter() - t0
         rows, at_copy = found_rows_at_copies(a.points, a.faces, node_to_face_rows(a.points, a.faces, pen),
-                                             self.vertex_fragment)
+                                             self.vertex_fragment, index=self.copy_index)
         # a vertex with a twin on the master fragment talks to it through its twin row; a
         # lip vertex in its own fragment, through the lip row of its pair of copies; but
         # one inside the wedge of a copy (master face at the copy) gets that face's row
@@ -335,16 +339,17 @@ class ActiveSet3d(ActiveSet):
         keep = (twin < 0) | deep_at_copy
         if not keep.all():
             own = pen.fragment == self.vertex_fragment[pen.vertex]
-            keep |= ~own & ~np.isin(np.asarray(pen.fragment, dtype=np.int64) * len(a.points) + pen.vertex, self.covered)
+            keep |= ~own & ~isin_ints(np.asarray(pen.fragment, dtype=np.int64) * len(a.points) + pen.vertex, self.covered)
         rows = rows.subset(np.flatnonzero(keep))
         codes = self.codec.codes(rows)
         if deep_at_copy.any():
             # and, where the lip at the copy is folded, a row on every coincident face there
             folded = folded_rows_at_copies(a.points, a.faces, rows, deep_at_copy[keep],
-                                           self.vertex_fragment, tied_pairs(self.geometry.holds, len(a.points)))
+                                           self.vertex_fragment, tied_pairs(self.geometry.holds, len(a.points)),
+                                           index=self.copy_index)
             folded_codes = self.codec.codes(folded)
             first = np.sort(np.unique(folded_codes, return_index=True)[1])
-            first = first[~np.isin(folded_codes[first], codes)]
+            first = first[~isin_ints(folded_codes[first], codes)]
             rows = NodeToFaceRows.stack([rows, folded.subset(first)])
             codes = np.concatenate([codes, folded_codes[first]])
         return rows, codes

@@ -48,19 +48,18 @@ off 5.3e-5 deep in the copy it was split from).
 """
 import numpy as np
 
-from .kinks3d import KINK, expand_ranges, face_point_keys, partner_faces, point_ids
+from .kinks3d import KINK, CopyIndex, expand_ranges, isin_ints, partner_faces, unique_ints
 from .rows3d import NodeToFaceRows
 
 __all__ = ["found_rows_at_copies", "folded_rows_at_copies"]
 
 
 
-def _partner_at(F, pid, face, vertex):
+def _partner_at(index, face, vertex):
     """For every (face, vertex): the face on the same three points with ``vertex`` as a corner, or -1."""
-    key = face_point_keys(F, pid)
-    order = np.argsort(key, kind="stable")
-    start = np.searchsorted(key[order], key[face])
-    count = np.searchsorted(key[order], key[face], side="right") - start
+    F, key, order = index.faces, index.face_key, index.key_order
+    start = np.searchsorted(index.key_sorted, key[face])
+    count = np.searchsorted(index.key_sorted, key[face], side="right") - start
     out = np.full(len(face), -1, dtype=np.int64)
     for shift in range(int(count.max(initial=0))):            # the faces on the same points: a few at most
         slot = np.minimum(start + shift, len(order) - 1)
@@ -70,7 +69,7 @@ def _partner_at(F, pid, face, vertex):
     return out
 
 
-def found_rows_at_copies(points, faces, rows, vertex_fragment):
+def found_rows_at_copies(points, faces, rows, vertex_fragment, index=None):
     """Detected rows on faces at a copy of the slave: projected there, in the fixed rows' direction.
 
     Parameters
@@ -83,6 +82,8 @@ def found_rows_at_copies(points, faces, rows, vertex_fragment):
         Rows of detected pairs (:func:`~ngfracture.contact.rows3d.node_to_face_rows`).
     vertex_fragment : numpy.ndarray of int, shape (nv,)
         The fragment of every vertex.
+    index : ngfracture.contact.kinks3d.CopyIndex, optional
+        The index of ``points`` and ``faces`` (made here if not given).
 
     Returns
     -------
@@ -98,14 +99,16 @@ def found_rows_at_copies(points, faces, rows, vertex_fragment):
         return rows, np.zeros(0, dtype=bool)
     X, F = np.asarray(points), np.asarray(faces, dtype=np.int64)
     vf = np.asarray(vertex_fragment, dtype=np.int64)
-    pid = point_ids(X, F)
+    if index is None:
+        index = CopyIndex(X, F)
+    pid = index.point
     same = pid[rows.master] == pid[rows.slave][:, None]                  # [row, corner]
     at_copy = same.any(axis=1) & (pid[rows.slave] >= 0)
     slave, face, normal = rows.slave.copy(), rows.face.copy(), rows.normal.copy()
     copy = rows.master[np.arange(len(rows)), same.argmax(axis=1)]
     reverse = at_copy & ((vf[slave] < vf[copy]) | ((vf[slave] == vf[copy]) & (slave < copy)))
     r = np.flatnonzero(reverse)
-    partner = _partner_at(F, pid, face[r], slave[r])
+    partner = _partner_at(index, face[r], slave[r])
     r, partner = r[partner >= 0], partner[partner >= 0]
     slave[r], copy[r], face[r] = copy[r], slave[r], partner
     master = F[face]
@@ -121,7 +124,7 @@ def found_rows_at_copies(points, faces, rows, vertex_fragment):
     return out, at_copy
 
 
-def folded_rows_at_copies(points, faces, rows, pick, vertex_fragment, tied=None):
+def folded_rows_at_copies(points, faces, rows, pick, vertex_fragment, tied=None, index=None):
     """Rows of the picked found rows' slaves on the faces at their copy where the lip there bends.
 
     Only pairs of copies on different fragments at points of two copies are completed:
@@ -144,6 +147,8 @@ def folded_rows_at_copies(points, faces, rows, pick, vertex_fragment, tied=None)
         The fragment of every vertex.
     tied : numpy.ndarray of int or None
         Pairs of vertices tied by other rows, as codes min * nv + max (sorted).
+    index : ngfracture.contact.kinks3d.CopyIndex, optional
+        The index of ``points`` and ``faces`` (made here if not given).
 
     Returns
     -------
@@ -158,18 +163,21 @@ def folded_rows_at_copies(points, faces, rows, pick, vertex_fragment, tied=None)
     X, F = np.asarray(points), np.asarray(faces, dtype=np.int64)
     nv = rows.nv
     vf = np.asarray(vertex_fragment, dtype=np.int64)
-    pid = point_ids(X, F)
+    if index is None:
+        index = CopyIndex(X, F)
+    pid = index.point
     s = rows.slave
     t = rows.master[np.arange(len(rows)), np.argmax(rows.bary, axis=1)]
-    two = np.bincount(pid[pid >= 0], minlength=1)[np.maximum(pid[s], 0)] == 2
+    two = index.copies[np.maximum(pid[s], 0)] == 2
     ok = np.asarray(pick, dtype=bool) & two & (pid[s] >= 0) & (vf[s] != vf[t])
     if tied is not None and len(tied):
-        ok &= ~np.isin(np.minimum(s, t) * nv + np.maximum(s, t), tied)
+        ok &= ~isin_ints(np.minimum(s, t) * nv + np.maximum(s, t), tied)
     r = np.flatnonzero(ok)
     s, t = s[r], t[r]
     code = s * nv + t
-    pair = np.unique(code)
-    slave, face, corner = partner_faces(X, F, pair // nv, pair % nv, all_pairs=True, one_way=False)
+    pair = unique_ints(code)
+    slave, face, corner = partner_faces(X, F, pair // nv, pair % nv, all_pairs=True, one_way=False,
+                                        index=index)
     master = F[face]
     p = X[master]
     area2 = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])

@@ -39,7 +39,7 @@ twin opposing the slave's vertex normal), which the patch test needs.
 """
 import numpy as np
 
-from .kinks3d import KINK, expand_ranges, point_ids
+from .kinks3d import KINK, CopyIndex, expand_ranges, unique_ints
 from .rows3d import NodeToFaceRows, face_gap_rows, fragment_twin_rows, no_face_rows
 
 __all__ = ["fragment_pair_rows", "covered_pairs"]
@@ -60,12 +60,9 @@ def _on_several_fragments(pid, vf):
     return out
 
 
-def _matched_faces(F, pid, face_fragment):
+def _matched_faces(index, face_fragment):
     """Ordered pairs (a, b) of faces on the same three points and on different fragments."""
-    K = np.sort(pid[F], axis=1)
-    order = np.lexsort((K[:, 2], K[:, 1], K[:, 0]))
-    Ks = K[order]
-    group = np.cumsum(np.r_[False, np.any(Ks[1:] != Ks[:-1], axis=1)]) if len(F) else np.zeros(0, dtype=np.int64)
+    order, group = index.key_order, index.key_sorted      # faces by sorted point triple, stable
     first = np.searchsorted(group, group)
     size = np.searchsorted(group, group, side="right") - first
     who, other = expand_ranges(first, size)
@@ -92,7 +89,7 @@ def _checked(points, faces, vertex_fragment):
     return X, F, vf.astype(np.int64)
 
 
-def fragment_pair_rows(points, faces, vertex_fragment):
+def fragment_pair_rows(points, faces, vertex_fragment, index=None):
     """Twin rows of fragmented bodies: one row per (copy, neighbouring copy), one direction per pair.
 
     See the module docstring for the rule and why.
@@ -105,6 +102,8 @@ def fragment_pair_rows(points, faces, vertex_fragment):
         Boundary faces, outward (the crack lips among them).
     vertex_fragment : array_like of int, shape (nv,)
         The fragment of every vertex.
+    index : ngfracture.contact.kinks3d.CopyIndex, optional
+        The index of ``points`` and ``faces`` (made here if not given).
 
     Returns
     -------
@@ -121,14 +120,15 @@ def fragment_pair_rows(points, faces, vertex_fragment):
     """
     X, F, vf = _checked(points, faces, vertex_fragment)
     nv = len(X)
-    pid = point_ids(X, F)
+    index = CopyIndex(X, F) if index is None else index
+    pid = index.point
     ff = vf[F[:, 0]] if len(F) else np.zeros(0, dtype=np.int64)
-    a, b = _matched_faces(F, pid, ff)
+    a, b = _matched_faces(index, ff)
     matched = np.zeros(nv, dtype=bool)
     matched[F[a].ravel()] = True
     fallback = no_face_rows(nv)
     if np.any(_on_several_fragments(pid, vf) & ~matched):      # else every fallback row is dropped
-        fallback = fragment_twin_rows(X, F, vf)
+        fallback = fragment_twin_rows(X, F, vf, index=index)
         fallback = fallback.subset(np.flatnonzero(~matched[fallback.slave]))
     one_way = ff[a] > ff[b]
     a, b = a[one_way], b[one_way]
@@ -139,9 +139,7 @@ def fragment_pair_rows(points, faces, vertex_fragment):
     slave = F[a][np.arange(len(a))[:, None], same.argmax(axis=2)].ravel()
     face = np.repeat(b, 3)
     k = np.tile(np.arange(3), len(b))
-    p = X[F]
-    area2 = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
-    unit = area2 / np.linalg.norm(area2, axis=1)[:, None]
+    area2, unit = index.area2, index.unit
     copy = F[face, k]
     group = np.lexsort((copy, slave))                                     # by (slave, master copy)
     slave, face, k, copy = slave[group], face[group], k[group], copy[group]
@@ -154,7 +152,7 @@ def fragment_pair_rows(points, faces, vertex_fragment):
     best = best[np.r_[True, owner[best][1:] != owner[best][:-1]]]
     # where three or more copies meet (a crack reaching an interface) and the surface at the
     # master copy bends, every matched face there off the best one's plane gets its row too
-    copies = np.bincount(pid[pid >= 0])
+    copies = index.copies
     chosen = np.empty(owner[-1] + 1, dtype=np.int64)
     chosen[owner[best]] = face[best]
     bend = 1.0 - np.einsum("ij,ij->i", unit[face], unit[chosen[owner]]) > KINK
@@ -209,5 +207,5 @@ def covered_pairs(points, rows, vertex_fragment):
     copy = np.all(X[m] == X[s][:, None, :], axis=2)                      # [row, corner]
     has = copy.any(axis=1) & (vf[m[:, 0]] != vf[s])
     t = m[np.flatnonzero(has), copy[has].argmax(axis=1)]
-    return np.unique(np.r_[vf[m[:, 0]] * nv + s, vf[s[has]] * nv + t])
+    return unique_ints(np.r_[vf[m[:, 0]] * nv + s, vf[s[has]] * nv + t])
 

@@ -61,7 +61,7 @@ from typing import ClassVar
 import numpy as np
 import scipy.sparse as sp
 
-from .kinks3d import KINK, expand_ranges, partner_faces, point_groups
+from .kinks3d import KINK, CopyIndex, expand_ranges, isin_ints, partner_faces
 from .rows import RowTable
 
 __all__ = ["NodeToFaceRows", "no_face_rows", "node_to_face_rows", "twin_rows", "fragment_twin_rows", "lip_rows", "face_gap_rows",
@@ -314,13 +314,14 @@ def twin_rows(points, faces, slave):
     mask = np.asarray(slave)
     if mask.shape != (nv,) or mask.dtype != bool:
         raise ValueError(f"slave must be a boolean mask of shape ({nv},), got {mask.dtype} {mask.shape}")
-    s, t = _copy_pairs(X, F)
+    index = CopyIndex(X, F)
+    s, t = _copy_pairs(index)
     pick = mask[s] & ~mask[t]
-    rows = _with_junction_rows(X, F, _rows_at_copies(X, F, s[pick], t[pick], s[pick]), s[pick], t[pick], False)
+    rows = _with_junction_rows(index, _rows_at_copies(index, s[pick], t[pick], s[pick]), s[pick], t[pick], False)
     return rows.subset(np.lexsort((rows.face, rows.slave)))
 
 
-def fragment_twin_rows(points, faces, vertex_fragment):
+def fragment_twin_rows(points, faces, vertex_fragment, index=None):
     """The twin rows of every fragment's vertices as slaves, all fragments in one pass.
 
     The rows of ``twin_rows(points, faces, vertex_fragment == f)`` for every fragment f in
@@ -337,6 +338,8 @@ def fragment_twin_rows(points, faces, vertex_fragment):
     vertex_fragment : array_like of int, shape (nv,)
         The fragment of every vertex (vertices of one fragment never have twins among
         themselves).
+    index : ngfracture.contact.kinks3d.CopyIndex, optional
+        The index of ``points`` and ``faces`` (made here if not given).
 
     Returns
     -------
@@ -349,13 +352,14 @@ def fragment_twin_rows(points, faces, vertex_fragment):
         On wrong shapes or vertex numbers out of range.
     """
     X, F, vf = _fragment_arrays(points, faces, vertex_fragment)
-    s, t = _copy_pairs(X, F)
+    index = CopyIndex(X, F) if index is None else index
+    s, t = _copy_pairs(index)
     pick = vf[s] != vf[t]
-    rows = _with_junction_rows(X, F, _rows_at_copies(X, F, s[pick], t[pick], s[pick]), s[pick], t[pick], False)
+    rows = _with_junction_rows(index, _rows_at_copies(index, s[pick], t[pick], s[pick]), s[pick], t[pick], False)
     return rows.subset(np.lexsort((rows.face, rows.slave, vf[rows.slave])))
 
 
-def lip_rows(points, faces, vertex_fragment):
+def lip_rows(points, faces, vertex_fragment, index=None):
     """Rows between the coincident lips of a crack inside one fragment, one per pair of copies.
 
     The lips of a crack that does not cut its fragment through are on one fragment: every
@@ -380,6 +384,8 @@ def lip_rows(points, faces, vertex_fragment):
         Boundary faces, outward (the crack faces among them).
     vertex_fragment : array_like of int, shape (nv,)
         Fragment of every vertex.
+    index : ngfracture.contact.kinks3d.CopyIndex, optional
+        The index of ``points`` and ``faces`` (made here if not given).
 
     Returns
     -------
@@ -394,12 +400,13 @@ def lip_rows(points, faces, vertex_fragment):
     """
     X, F, frag = _fragment_arrays(points, faces, vertex_fragment)
     nv = len(X)
-    s, t = _copy_pairs(X, F)
+    index = CopyIndex(X, F) if index is None else index
+    s, t = _copy_pairs(index)
     pick = (frag[s] == frag[t]) & (s > t)
     s, t = s[pick], t[pick]
     if not len(s):              # no crack inside a fragment
         return no_face_rows(nv)
-    rows = _with_junction_rows(X, F, _rows_at_copies(X, F, s, t, s * nv + t), s, t, True)
+    rows = _with_junction_rows(index, _rows_at_copies(index, s, t, s * nv + t), s, t, True)
     copy = rows.master[np.arange(len(rows)), np.argmax(rows.bary, axis=1)] if len(rows) else rows.slave
     return rows.subset(np.lexsort((rows.face, copy, rows.slave)))
 
@@ -416,32 +423,30 @@ def _fragment_arrays(points, faces, vertex_fragment):
     return X, F, vf
 
 
-def _copy_pairs(X, F):
+def _copy_pairs(index):
     """Every ordered pair (s, t) of boundary vertices at the bitwise-equal reference point, s == t included."""
-    on, group = point_groups(X, F)
+    on, group = index.on, index.group
     first = np.searchsorted(group, group)                                  # start of each vertex's group
     size = np.searchsorted(group, group, side="right") - first
     who, other = expand_ranges(first, size)
     return on[who], on[other]
 
 
-def _rows_at_copies(X, F, s, t, per):
+def _rows_at_copies(index, s, t, per):
     """Rows of slaves s on the face at their copy t opposing s's normal most, one per value of ``per``."""
+    X, F = index.points, index.faces
     nv = len(X)
     if not len(s):
         return no_face_rows(nv)
-    p = X[F]
-    area2 = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
-    unit = area2 / np.linalg.norm(area2, axis=1)[:, None]
+    area2, unit = index.area2, index.unit
     # the faces' area normals summed at their vertices, in face order (as np.add.at sums)
     vnormal = np.stack([np.bincount(F.ravel(), weights=np.repeat(area2[:, d], 3), minlength=nv)
                         for d in range(3)], axis=1)
     # candidate faces: every face at the copy
-    inc = np.argsort(F.ravel(), kind="stable")
-    start = np.searchsorted(F.ravel()[inc], t)
-    count = np.searchsorted(F.ravel()[inc], t, side="right") - start
+    start = np.searchsorted(index.incident, t)
+    count = np.searchsorted(index.incident, t, side="right") - start
     pair, slot = expand_ranges(start, count)
-    face, k = np.divmod(inc[slot], 3)
+    face, k = np.divmod(index.incidence[slot], 3)
     s, per = s[pair], per[pair]
     dots = np.einsum("ij,ij->i", unit[face], vnormal[s])
     best = np.lexsort((face, dots, per))                                   # per group: most opposed, smaller face
@@ -457,15 +462,14 @@ def _rows_at_copies(X, F, s, t, per):
     return NodeToFaceRows(slave=s, master=master, face=face, bary=bary, normal=normal, dist=g.copy(), g=g, nv=nv)
 
 
-def _with_junction_rows(X, F, rows, s, t, lips):
+def _with_junction_rows(index, rows, s, t, lips):
     """``rows`` and rows on the partner faces of :func:`~ngfracture.contact.kinks3d.partner_faces` it lacks."""
-    slave, face, k = partner_faces(X, F, s, t, all_pairs=lips)
+    X, F = index.points, index.faces
+    slave, face, k = partner_faces(X, F, s, t, all_pairs=lips, index=index)
     bary = np.zeros((len(slave), 3))
     bary[np.arange(len(slave)), k] = 1.0
-    p = X[F[face]]
-    area2 = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
-    normal = area2 / np.linalg.norm(area2, axis=1)[:, None]
-    keep = ~np.isin(slave * len(F) + face, rows.slave * len(F) + rows.face)
+    normal = index.unit[face]
+    keep = ~isin_ints(slave * len(F) + face, rows.slave * len(F) + rows.face)
     if lips and len(rows):        # only faces at a kink against the pair's row (kinks3d.KINK)
         pair = rows.slave * len(X) + rows.master[np.arange(len(rows)), np.argmax(rows.bary, axis=1)]
         want = slave * len(X) + F[face, k]
