@@ -83,6 +83,21 @@ namespace ngfracture
           }
       }
 
+      // the slots s of cell (i, j, k): f(s) for items[s]
+      template <typename F> void VisitSlots (int64_t i, int64_t j, int64_t k, F && f) const
+      {
+        if (!Valid(i) || !Valid(j) || !Valid(k)) return;
+        if (!first.empty())
+          {
+            int64_t c = Linear(i, j, k);
+            for (int32_t s = first[c]; s < first[c+1]; s++) f(s);
+            return;
+          }
+        auto it = range.find(Key(i, j, k));
+        if (it == range.end()) return;
+        for (int32_t s = it->second.first; s < it->second.second; s++) f(s);
+      }
+
       template <typename F> void Visit (int64_t i, int64_t j, int64_t k, F && f) const
       {
         if (!Valid(i) || !Valid(j) || !Valid(k)) return;
@@ -402,6 +417,52 @@ namespace ngfracture
       return c;
     }
 
+    // A boundary vertex in the grid, with what the sweep tests first, in the order of the
+    // grid's items: a tetrahedron reads the vertices of a cell from consecutive memory.
+    struct GridPoint
+    {
+      double p[3];
+      int32_t v;
+      int32_t frag;        // the vertex's fragment
+      bool lip;            // a copy of its point on its own fragment (D.lip)
+    };
+
+    // The closed cells of a dense grid: cells whose vertices are of at most 8 fragments,
+    // none a lip vertex, and every vertex decided (DecideClosedSeams) for every one of
+    // those fragments but its own. A tetrahedron of one of those fragments finds no pair
+    // there (the sweep's test rejects every vertex before its exact test: its own, or
+    // decided; ``decided`` only grows), so it skips the cell. ``closed_set[c]`` is the
+    // number of cell c's fragments in ``sets`` (padded with -1), or -1 for a cell that is
+    // empty or not closed.
+    void ClosedCells (const HashGrid & g, const std::vector<GridPoint> & points, const Decided & decided,
+                      std::vector<int32_t> & closed_set, std::vector<std::array<int32_t,8>> & sets)
+    {
+      closed_set.assign(g.first.size() - 1, -1);
+      for (size_t c = 0; c + 1 < g.first.size(); c++)
+        {
+          int32_t s0 = g.first[c], s1 = g.first[c+1];
+          if (s0 == s1) continue;
+          std::array<int32_t,8> frags;
+          frags.fill(-1);
+          int n = 0;
+          bool closed = true;
+          for (int32_t s = s0; s < s1 && closed; s++)
+            {
+              closed = !points[s].lip;
+              int32_t F = points[s].frag;
+              if (std::find(frags.begin(), frags.begin() + n, F) != frags.begin() + n) continue;
+              if (n == 8) closed = false;
+              else frags[n++] = F;
+            }
+          for (int32_t s = s0; s < s1 && closed; s++)
+            for (int i = 0; i < n && closed; i++)
+              closed = frags[i] == points[s].frag || decided.Has(points[s].v, frags[i]);
+          if (!closed) continue;
+          closed_set[c] = int32_t(sets.size());
+          sets.push_back(frags);
+        }
+    }
+
     // Every (boundary vertex, tetrahedron of another fragment) with the vertex in the
     // closed tetrahedron, and (lip vertex, tetrahedron of its own fragment not at the
     // vertex): each tetrahedron's box swept over the vertex grid. A pair found in a
@@ -409,12 +470,18 @@ namespace ngfracture
     // that fragment (a closed seam, or a closed lip) is no hit, only counted; any other is
     // a hit in that tetrahedron, the smallest that holds it (the sweep goes in increasing
     // order). The twin is looked up only for a pair found. Pairs in ``decided`` are not
-    // tested (DecideClosedSeams).
-    std::vector<Hit> SweepTets (const TetMesh3 & m, const Derived & D, const Copies & copies, const HashGrid & g,
+    // tested (DecideClosedSeams). ``points`` are the grid's items (GridPoint, slot by slot).
+    std::vector<Hit> SweepTets (const TetMesh3 & m, const Copies & copies, const std::vector<int32_t> & vfrag,
+                                const HashGrid & g, const std::vector<GridPoint> & points,
                                 Decided & decided, Collision3Stats & st)
     {
       std::vector<Hit> hits;
-      int64_t closed = 0;
+      int64_t closed = 0, box_tests = 0;
+      // dense grid: the cells that hold no pair of a tetrahedron of any of their vertices'
+      // fragments (ClosedCells)
+      std::vector<int32_t> closed_set;
+      std::vector<std::array<int32_t,8>> sets;
+      if (!g.first.empty()) ClosedCells(g, points, decided, closed_set, sets);
       for (int64_t t = 0; t < m.ne; t++)
         {
           const int32_t * T = m.tets + 4*t;
@@ -429,33 +496,43 @@ namespace ngfracture
               a[d] = std::max<int64_t>(g.Cell(lo[d], d), 0);
               b[d] = std::min<int64_t>(g.Cell(hi[d], d), g.span - 1);
             }
-          for (int64_t i = a[0]; i <= b[0]; i++)
-            for (int64_t j = a[1]; j <= b[1]; j++)
-              for (int64_t k = a[2]; k <= b[2]; k++)
-                g.Visit(i, j, k, [&] (int32_t v)
+          auto test = [&] (int32_t slot)
                   {
-                    st.box_tests++;
-                    if (D.vfrag[v] == F)
+                    box_tests++;
+                    const GridPoint & q = points[slot];
+                    const int32_t v = q.v;
+                    if (q.frag == F)
                       {
                         // self-contact across a crack: a lip vertex in a tetrahedron of
                         // its own fragment that is not one of its own
-                        if (!D.lip[v] || T[0] == v || T[1] == v || T[2] == v || T[3] == v) return;
+                        if (!q.lip || T[0] == v || T[1] == v || T[2] == v || T[3] == v) return;
                       }
-                    const double * p = m.x + 3*v;
-                    for (int d = 0; d < 3; d++)
-                      if (p[d] < lo[d] || p[d] > hi[d]) return;
+                    const double * p = q.p;
+                    if (p[0] < lo[0] || p[0] > hi[0] || p[1] < lo[1] || p[1] > hi[1] || p[2] < lo[2] || p[2] > hi[2])
+                      return;
                     if (decided.Has(v, F)) return;
                     st.exact_tests++;
                     if (orientation == 2)
                       orientation = Orient3dSign(m.x + 3*T[0], m.x + 3*T[1], m.x + 3*T[2], m.x + 3*T[3]);
                     if (!InClosedTet(m.x, T, p, orientation)) return;
                     decided.Insert(v, F);
-                    int32_t twin = copies.Twin(D.vfrag, v, F);
+                    int32_t twin = copies.Twin(vfrag, v, F);
                     bool seam = twin >= 0 && std::memcmp(p, m.x + 3*twin, 3 * sizeof(double)) == 0;
                     if (seam) closed++;
                     else hits.emplace_back(v, F, int32_t(t));
-                  });
+                  };
+          for (int64_t i = a[0]; i <= b[0]; i++)
+            for (int64_t j = a[1]; j <= b[1]; j++)
+              for (int64_t k = a[2]; k <= b[2]; k++)
+                {
+                  if (closed_set.empty()) { g.VisitSlots(i, j, k, test); continue; }
+                  int64_t c = g.Linear(i, j, k);
+                  int32_t e = closed_set[c];
+                  if (e >= 0 && std::find(sets[e].begin(), sets[e].end(), F) != sets[e].end()) continue;
+                  for (int32_t slot = g.first[c]; slot < g.first[c+1]; slot++) test(slot);
+                }
         }
+      st.box_tests += box_tests;
       st.closed_seams = closed;
       std::sort(hits.begin(), hits.end());
       return hits;
@@ -520,32 +597,20 @@ namespace ngfracture
       return out;
     }
 
-    // The vertices of the tetrahedra at every vertex (CSR, with repeats; reference stars).
-    VertexFaces MakeVertexStars (const TetMesh3 & m)
+    // Every vertex w of the reference star of c (the vertices of the tetrahedra at c,
+    // Topology::at) on the side `sign` of the plane through X_c with normal n
+    // (sign * n . (X_w - X_c) >= -1e-9 |X_w - X_c|: the star's own face vertices lie on it
+    // up to rounding; the length is needed only where the product is negative).
+    bool StarOnSide (const TetMesh3 & m, const Topology & topo, int32_t c, const double * n, double sign)
     {
-      VertexFaces st;
-      st.start.assign(m.nv + 1, 0);
-      for (int64_t i = 0; i < 4*m.ne; i++) st.start[m.tets[i] + 1] += 4;
-      for (int64_t v = 0; v < m.nv; v++) st.start[v+1] += st.start[v];
-      st.at.resize(st.start[m.nv]);
-      std::vector<int64_t> fill(st.start.begin(), st.start.end() - 1);
-      for (int64_t t = 0; t < m.ne; t++)
+      for (int64_t i = topo.start[c]; i < topo.start[c+1]; i++)
         for (int k = 0; k < 4; k++)
-          for (int j = 0; j < 4; j++) st.at[fill[m.tets[4*t+k]]++] = m.tets[4*t+j];
-      return st;
-    }
-
-    // Every vertex w of the reference star of c on the side `sign` of the plane through X_c
-    // with normal n (sign * n . (X_w - X_c) >= -1e-9 |X_w - X_c|: the star's own face
-    // vertices lie on it up to rounding).
-    bool StarOnSide (const TetMesh3 & m, const VertexFaces & stars, int32_t c, const double * n, double sign)
-    {
-      for (int64_t i = stars.start[c]; i < stars.start[c+1]; i++)
-        {
-          double e[3];
-          Sub(m.X + 3*stars.at[i], m.X + 3*c, e);
-          if (sign * Dot(n, e) < -1e-9 * std::sqrt(Dot(e, e))) return false;
-        }
+          {
+            double e[3];
+            Sub(m.X + 3*m.tets[4*topo.at[i]+k], m.X + 3*c, e);
+            double side = sign * Dot(n, e);
+            if (side < 0 && side < -1e-9 * std::sqrt(Dot(e, e))) return false;
+          }
       return true;
     }
 
@@ -575,7 +640,7 @@ namespace ngfracture
     // wedge can be reflex, and v outside one of its planes may still be inside it.
     // With `lips_of` (the copies), the candidates are instead the lips among those faces
     // (IsLip), and only one that v is behind is returned (see the caller).
-    int32_t SeparatingFace (const TetMesh3 & m, const VertexFaces & vfaces, const VertexFaces & stars,
+    int32_t SeparatingFace (const TetMesh3 & m, const VertexFaces & vfaces, const Topology & topo,
                             int32_t v, int32_t t, const int32_t * tet, double & depth,
                             const Copies * lips_of = nullptr)
     {
@@ -593,7 +658,7 @@ namespace ngfracture
           double len = std::sqrt(Dot(n, n));
           if (!(len > 0)) continue;
           for (int d = 0; d < 3; d++) n[d] /= len;
-          if (lips_only ? !IsLip(m, *lips_of, vfaces, f) : !StarOnSide(m, stars, v, n, 1.0)) continue;
+          if (lips_only ? !IsLip(m, *lips_of, vfaces, f) : !StarOnSide(m, topo, v, n, 1.0)) continue;
           Sub(m.x + 3*T[1], m.x + 3*T[0], e0); Sub(m.x + 3*T[2], m.x + 3*T[0], e1); Cross(e0, e1, n);
           len = std::sqrt(Dot(n, n));
           if (!(len > 0)) continue;
@@ -787,11 +852,11 @@ namespace ngfracture
       return closed;
     }
 
-    // The boundary faces and the reference stars at every vertex (MakeVertexFaces,
-    // MakeVertexStars): from the connectivity alone, made once per mesh by a detector.
+    // The boundary faces at every vertex (MakeVertexFaces): from the connectivity alone,
+    // made once per mesh by a detector.
     struct Incidence
     {
-      VertexFaces vfaces, stars;
+      VertexFaces vfaces;
     };
 
     // `incidence` the mesh's (made here, if there is a hit, when null)
@@ -811,10 +876,18 @@ namespace ngfracture
       for (size_t s = 0; s < D.bverts.size(); s++)
         std::copy(m.x + 3*D.bverts[s], m.x + 3*D.bverts[s] + 3, &lo[3*s]);
       vg.Build(lo, lo);
-      for (auto & it : vg.items) it = D.bverts[it];        // grid items: vertex numbers
+      std::vector<GridPoint> points(vg.items.size());
+      for (size_t s = 0; s < vg.items.size(); s++)
+        {
+          int32_t v = D.bverts[vg.items[s]];
+          vg.items[s] = v;                                   // grid items: vertex numbers
+          GridPoint & q = points[s];
+          std::copy(m.x + 3*v, m.x + 3*v + 3, q.p);
+          q.v = v; q.frag = D.vfrag[v]; q.lip = D.lip[v] != 0;
+        }
       Decided decided(m.nv);
       int64_t closed = DecideClosedSeams(m, T, copies, decided);
-      std::vector<Hit> hits = SweepTets(m, D, copies, vg, decided, st);
+      std::vector<Hit> hits = SweepTets(m, copies, D.vfrag, vg, points, decided, st);
       st.closed_seams += closed;
       if (hits.empty()) { if (stats) *stats = st; return out; }
 
@@ -833,10 +906,10 @@ namespace ngfracture
       Incidence own;
       if (!incidence)
         {
-          own = Incidence { MakeVertexFaces(m), MakeVertexStars(m) };
+          own = Incidence { MakeVertexFaces(m) };
           incidence = &own;
         }
-      const VertexFaces & vfaces = incidence->vfaces, & stars = incidence->stars;
+      const VertexFaces & vfaces = incidence->vfaces;
       for (size_t s = 0; s < hits.size(); s++)
         {
           auto [v, F, t] = hits[s];
@@ -853,13 +926,13 @@ namespace ngfracture
               if (w != v && copies.group[w] == copies.group[v]) t_copy = w;
             }
           double depth = 0;
-          int32_t sep = t_copy >= 0 ? SeparatingFace(m, vfaces, stars, v, t_copy, m.tets + 4*t, depth) : -1;
+          int32_t sep = t_copy >= 0 ? SeparatingFace(m, vfaces, T, v, t_copy, m.tets + 4*t, depth) : -1;
           // none, and three or more copies of the point on F (cracks meeting inside F): v's
           // wedge can lie across the plane of the lip it crossed into t's wedge; that lip
           // still separates v if v is behind it (the nearest face of F may be the coincident
           // lip of another copy, v in front of it)
           if (sep < 0 && t_copy >= 0 && copies.CountOn(D.vfrag, v, F) >= 3)
-            sep = SeparatingFace(m, vfaces, stars, v, t_copy, m.tets + 4*t, depth, &copies);
+            sep = SeparatingFace(m, vfaces, T, v, t_copy, m.tets + 4*t, depth, &copies);
           if (sep >= 0)
             {
               const int32_t * T = m.faces + 3*sep;
@@ -913,7 +986,7 @@ namespace ngfracture
     I.fragment.assign(m.fragment, m.fragment + m.ne);
     I.nv = m.nv; I.ne = m.ne; I.nf = m.nf;
     MakeTopology(I.Mesh(I.X.data()), I.T, I.copies);
-    I.incidence = Incidence { MakeVertexFaces(I.Mesh(I.X.data())), MakeVertexStars(I.Mesh(I.X.data())) };
+    I.incidence = Incidence { MakeVertexFaces(I.Mesh(I.X.data())) };
   }
 
   PenetrationDetector3::~PenetrationDetector3 () = default;

@@ -319,8 +319,20 @@ class ActiveSet3d(ActiveSet):
         return holds_on_columns(self.geometry.holds, C, self.geometry.fixed, self.rank_tol)
 
     def _fresh_rows(self, candidates, U):
-        """The candidate rows re-linearised at X + U (all of them: settle's judgement)."""
-        return relinearise_node_to_face(candidates.rows, self.geometry.arrays.points, U)
+        """The candidate rows re-linearised at X + U, in their order (settle's judgement).
+
+        The rows that :meth:`update` re-linearised at this U (``candidates.relinearised``,
+        the first ones) are taken from there: a row's re-linearisation depends on the row
+        only through its vertices, its face and the side of its normal (and, at a copy or
+        on a squeezed face, its barycentrics and normal, which the re-linearisation keeps),
+        so re-linearising a row again at the same U gives it bit for bit. Only the rows
+        found new in this round are re-linearised here.
+        """
+        done = candidates.relinearised
+        if done is None:
+            return relinearise_node_to_face(candidates.rows, self.geometry.arrays.points, U)
+        new = candidates.rows.subset(np.arange(len(done), len(candidates.rows)))
+        return NodeToFaceRows.stack([done, relinearise_node_to_face(new, self.geometry.arrays.points, U)])
 
     def _node_to_face(self, U, timings):
         """The pairs detected at X + U that no twin row covers, as rows with their key codes."""

@@ -110,6 +110,27 @@ class NodeToFaceRows(RowTable):
         """The gap rows as a sparse matrix, shape (m, 3 nv), built at first use."""
         return _gap_matrix(self.slave, self.master, self.bary, self.normal, self.nv)
 
+    @classmethod
+    def stack(cls, parts):
+        """The rows of several row sets of one mesh, in order (``RowTable.stack``).
+
+        Where every part has built its ``C``, the stack's is theirs stacked: a row of C
+        depends on its own row's fields only, so it is the one :attr:`C` would build.
+        """
+        out = super().stack(parts)
+        if len(parts) > 1 and all("C" in p.__dict__ for p in parts):
+            out.__dict__["C"] = sp.vstack([p.C for p in parts], format="csr")
+        elif len(parts) == 1 and "C" in parts[0].__dict__:
+            out.__dict__["C"] = parts[0].C
+        return out
+
+    def subset(self, rows):
+        """The rows ``rows`` (``RowTable.subset``), with their rows of ``C`` where it is built."""
+        out = super().subset(rows)
+        if "C" in self.__dict__:
+            out.__dict__["C"] = self.C[np.asarray(rows)]
+        return out
+
     def keys(self):
         """The key of every row, ("f", slave, master vertices sorted): a row's identity for the active set.
 
