@@ -44,7 +44,9 @@ linear in the numbers of tetrahedra and boundary vertices for bounded cell occup
 Up to 2^22 cells the grid is an array of ranges over all cells, filled by a counting sort
 (a lookup is an index); beyond, a hash map of the occupied cells. The tetrahedra are
 swept in increasing order, so the first one holding a pair (vertex, fragment) is the
-smallest, and later tetrahedra of that fragment do not test the pair again.
+smallest, and later tetrahedra of that fragment do not test the pair again. Closed seams
+are decided before the sweep; a cell whose vertices are all decided for the fragments
+of its vertices (and none is a lip vertex) is skipped by the tetrahedra of those fragments.
 
 Master face. For a pair whose vertex lies in a tetrahedron at its copy t on F (a crack
 lip, or where several cracks meet): among the boundary faces of that tetrahedron at t,
