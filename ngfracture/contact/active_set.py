@@ -426,8 +426,11 @@ class ActiveSet:
                 # can tension a row that the complementarity problem compresses, and the
                 # update would release it and take it back, round after round
                 settled = self.solved and np.array_equal(kept_codes, self._mult_codes)
-        if self.moving and not settled:
-            self.last_penetration = np.inf     # the contraction is judged at one set only
+        if not settled:
+            # the contraction is judged at one set only: rows frozen at another set's solution
+            # overlap to second order in the motion to this one, and their first update is
+            # judged afresh
+            self.last_penetration = np.inf
         self.imposed.add(kept_codes.tobytes())
         self.tried = np.union1d(self.tried, kept_codes)
         return kept, settled

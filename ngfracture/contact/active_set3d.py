@@ -298,7 +298,13 @@ class ActiveSet3d(ActiveSet):
         found, found_codes = self._node_to_face(U, timings)
         n2s_codes = self.n2s_keys.codes
         known = np.concatenate([n2s_codes, self.seam_keys.codes])
-        retained = np.flatnonzero(self._has_multiplier(n2s_codes)[0] | isin_ints(n2s_codes, found_codes))
+        retain = self._has_multiplier(n2s_codes)[0] | isin_ints(n2s_codes, found_codes)
+        if self.exact:
+            # the complementarity problem chooses among the rows wanted or imposed in the
+            # solve; one it released stays a candidate, or the next problem cannot see the
+            # penetration that releasing it lets happen
+            retain |= isin_ints(n2s_codes, np.union1d(self.tried, self.wanted))
+        retained = np.flatnonzero(retain)
         new = np.flatnonzero(~isin_ints(found_codes, known))
         self.n2s = NodeToFaceRows.stack([self.n2s.subset(retained), found.subset(new)])
         self.n2s_keys = RowKeys(np.concatenate([n2s_codes[retained], found_codes[new]]), self.codec)
