@@ -107,8 +107,8 @@ def face_point_keys(faces, pid):
 class CopyIndex:
     """The arrays of a mesh's boundary that the rows at copies of a point look up.
 
-    Made once per mesh (an active set's set-up) from copies of the arrays, so it cannot go
-    stale, and passed to :func:`partner_faces` and the functions of rows3d, junctions3d and
+    Made once per mesh (:class:`~ngfracture.contact.setup3d.MeshSetup3d`) from copies of
+    the arrays, so it cannot go stale, and passed to :func:`partner_faces` and the functions of rows3d, junctions3d and
     copies3d that take ``index``; each array is the one those functions compute without it.
 
     Parameters
