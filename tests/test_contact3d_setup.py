@@ -7,7 +7,9 @@ making it afresh, bit for bit, and is never taken for other arrays.
 - ``ActiveSet3d``'s two rounds on overlapping blocks (lips, junctions of 4 and 8 copies):
   candidates, keys, gaps, chosen rows and settling equal with and without a reused set-up,
   and the set-up's fixed rows unchanged by the solve;
-- ``MeshSetups`` makes a new set-up where one bit of the arrays differs.
+- ``MeshSetups`` makes a new set-up where one bit of the arrays differs;
+- a run (blocks3d, through ``run.step.LoadStep``) makes one set-up for its mesh, and its
+  accepted displacements equal those of a run making one per solve, bit for bit.
 """
 import dataclasses
 
@@ -137,3 +139,35 @@ def test_the_set_up_copies_its_arrays():
     X[0, 0] += 1.0
     assert not setup.fits(X, arrays.tets, arrays.faces, piece)
     assert np.array_equal(setup.points, arrays.points)
+
+
+def test_a_run_with_the_set_up_cache_equals_one_without(tmp_path, monkeypatch):
+    """blocks3d through LoadStep: its solves on the one mesh share a set-up, and every
+    accepted displacement equals, bit for bit, that of a run making one per solve."""
+    from ngfracture.contact import setup3d
+    from ngfracture.run.simulation import Simulation
+    from ngfracture.scenes import blocks3d
+    made, asked = [], []
+    cached = setup3d.MeshSetups.setup
+
+    def counted(self, *arrays):
+        before = self.made
+        out = cached(self, *arrays)
+        asked.append(1)
+        made.append(self.made - before)
+        return out
+
+    def run(folder):
+        steps = []
+        Simulation(blocks3d(), out=tmp_path / folder, pictures="none").run(
+            on_step=lambda accepted: steps.append(accepted.problem.u.vec.FV().NumPy().copy()))
+        return steps
+
+    monkeypatch.setattr(setup3d.MeshSetups, "setup", counted)
+    with_cache = run("cached")
+    assert len(asked) >= 4 and sum(made) == 1          # one mesh: one set-up for every solve
+    monkeypatch.setattr(setup3d.MeshSetups, "setup", lambda self, *arrays: setup3d.MeshSetup3d(*arrays))
+    without = run("fresh")
+    assert len(with_cache) == len(without) >= 4
+    for a, b in zip(with_cache, without):
+        assert np.array_equal(a, b)
