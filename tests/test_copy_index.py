@@ -89,3 +89,18 @@ def test_rows_with_the_index_are_those_without():
         plain = rows(points, faces, vf)
         assert_rows_equal(plain, rows(points, faces, vf, index=index))
     assert len(fragment_pair_rows(points, faces, vf)) > 0 and len(lip_rows(points, faces, vf)) > 0
+
+
+def test_the_index_unit_normals_are_those_computed_for_any_set_of_faces():
+    """The rows at copies take a face's unit normal from the index (computed over all
+    faces): equal, bit for bit, to the normal computed for any subset of faces."""
+    a, _ = fragmented_box(4, 2)
+    X = a.points - 1e-3 * a.points ** 2        # coordinates that round
+    index = CopyIndex(X, a.faces)
+    rng = np.random.default_rng(0)
+    for k in (1, 2, 7, 100, len(a.faces)):
+        face = rng.choice(len(a.faces), size=k)
+        p = X[a.faces[face]]
+        area2 = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+        plain = area2 / np.linalg.norm(area2, axis=1)[:, None]
+        assert np.array_equal(plain.view(np.int64), index.unit[face].view(np.int64)), k

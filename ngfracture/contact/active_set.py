@@ -56,6 +56,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .collision import detect_collisions
+from .intsets import isin_ints, union_ints, unique_ints
 from .redundancy import independent_rows
 from .rows import ContactConstraints, no_constraints, reachable, relinearise_node_to_segment, select_contacts
 from .seams import KINK_ANGLE, seam_constraints
@@ -364,7 +365,7 @@ class ActiveSet:
         has, lam = self._has_multiplier(codes)
         enter = candidates.gap < -self.penetration_tol
         if self.warm:
-            enter |= np.isin(codes, self._key_codes(list(self.warm)))
+            enter |= isin_ints(codes, self._key_codes(list(self.warm)))
         want = np.where(has, lam <= 0.0, enter)
         self.warm = set()        # a warm row that the solve releases is judged like any other
         want = np.flatnonzero(want)
@@ -404,9 +405,9 @@ class ActiveSet:
             True if they are the rows imposed in the last solve.
         """
         codes = self._codes(candidates.keys)
-        kept_codes = np.unique(codes[kept])
+        kept_codes = unique_ints(codes[kept])
         settled = self.solved and np.array_equal(kept_codes, self._mult_codes)
-        self.wanted = np.union1d(self.wanted, codes[want])
+        self.wanted = union_ints(self.wanted, codes[want])
         if not settled and (self.exact or round_number > self.pdas_rounds
                             or kept_codes.tobytes() in self.imposed):
             self.exact = True
@@ -417,7 +418,7 @@ class ActiveSet:
                 # set and by two others in the next, and the face the first set lets it
                 # penetrate is wanted only at that set's state; every row wanted in the
                 # solve becomes a candidate
-                self.tried = np.union1d(self.tried, self.wanted)
+                self.tried = union_ints(self.tried, self.wanted)
                 choice = self._exact_choice(candidates, codes, want, complementarity) or choice
             if choice is not None:
                 kept, kept_codes = choice
@@ -432,20 +433,20 @@ class ActiveSet:
             # judged afresh
             self.last_penetration = np.inf
         self.imposed.add(kept_codes.tobytes())
-        self.tried = np.union1d(self.tried, kept_codes)
+        self.tried = union_ints(self.tried, kept_codes)
         return kept, settled
 
     def _exact_choice(self, candidates, codes, want, complementarity):
         """The closed rows of the complementarity problem of the wanted and tried rows, made
         independent, and their sorted codes; None where the problem could not be solved."""
-        tried = np.flatnonzero(np.isin(codes, self.tried))
-        closed = complementarity(candidates.rows, np.union1d(want, tried))
+        tried = np.flatnonzero(isin_ints(codes, self.tried))
+        closed = complementarity(candidates.rows, union_ints(want, tried))
         if closed is None:
             return None
         # closed rows that depend on others hold with them; as equalities they would make
         # the system singular
         kept = self._independent(candidates.rows, closed)
-        return kept, np.unique(codes[kept])
+        return kept, unique_ints(codes[kept])
 
     def settle(self, candidates, other, U):
         """Judge a settled set by its candidates re-linearised at X + U.

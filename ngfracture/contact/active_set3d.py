@@ -61,96 +61,13 @@ import numpy as np
 import scipy.sparse as sp
 
 from .active_set import ActiveSet, Candidates, RowKeys, refreshed
-from .collision3d import PenetrationDetector3d
 from .copies3d import folded_rows_at_copies, found_rows_at_copies
-from .junctions3d import covered_pairs, fragment_pair_rows
-from .kinks3d import CopyIndex, isin_ints, unique_ints
+from .kinks3d import isin_ints, unique_ints
 from .redundancy import holds_on_columns
-from .rows3d import NodeToFaceRows, lip_rows, no_face_rows, node_to_face_rows, relinearise_node_to_face
+from .rows3d import NodeToFaceRows, no_face_rows, node_to_face_rows, relinearise_node_to_face
+from .setup3d import FaceKeys, MeshSetup3d
 
 __all__ = ["ActiveSet3d", "FaceKeys", "fixed_rows_3d"]
-
-
-class FaceKeys:
-    """The int64 codes of node-to-face keys on one mesh (see the module docstring).
-
-    Parameters
-    ----------
-    faces : array_like of int, shape (nf, 3)
-        The mesh's boundary faces.
-
-    Raises
-    ------
-    ValueError
-        If ``faces`` is not of shape (nf, 3) with vertex numbers >= 0.
-    """
-
-    def __init__(self, faces):
-        F = np.asarray(faces)
-        if F.ndim != 2 or F.shape[1] != 3 or (F.size and (not np.issubdtype(F.dtype, np.integer) or F.min() < 0)):
-            raise ValueError(f"faces must be vertex numbers >= 0 of shape (nf, 3), got {F.dtype} {F.shape}")
-        S = np.sort(F.astype(np.int64), axis=1)
-        order = np.lexsort((S[:, 2], S[:, 1], S[:, 0]))
-        S = S[order]
-        first = np.r_[True, np.any(S[1:] != S[:-1], axis=1)] if len(S) else np.zeros(0, dtype=bool)
-        self.triples = S[first]                 # the distinct vertex sets, sorted
-        self.face_set = np.empty(len(S), dtype=np.int64)
-        self.face_set[order] = np.cumsum(first) - 1
-        self.n = max(len(self.triples), 1)
-        self._lookup = None
-
-    def codes(self, rows):
-        """The codes of the keys of some rows.
-
-        Parameters
-        ----------
-        rows : ngfracture.contact.rows3d.NodeToFaceRows
-            Rows of this mesh (their master the vertices of their face).
-
-        Returns
-        -------
-        numpy.ndarray of int64
-
-        Raises
-        ------
-        ValueError
-            If a row's master is not the vertex set of its face.
-        """
-        sets = self.face_set[np.asarray(rows.face, dtype=np.int64)]
-        if not np.array_equal(self.triples[sets], np.sort(rows.master, axis=1)):
-            raise ValueError("FaceKeys.codes: a row's master is not the vertex set of its face")
-        return np.asarray(rows.slave, dtype=np.int64) * self.n + sets
-
-    def codes_of(self, keys):
-        """The codes of keys given as tuples ("f", slave, a, b, c); -1 for a key of no face.
-
-        Parameters
-        ----------
-        keys : sequence of tuple
-
-        Returns
-        -------
-        numpy.ndarray of int64
-        """
-        if self._lookup is None:
-            self._lookup = {tuple(t): i for i, t in enumerate(self.triples.tolist())}
-        look = self._lookup
-        return np.fromiter(((k[1] * self.n + look[k[2:]]) if k[2:] in look else -1 for k in keys),
-                           dtype=np.int64, count=len(keys))
-
-    def decode(self, codes):
-        """The key tuples ("f", slave, master vertices sorted) of codes.
-
-        Parameters
-        ----------
-        codes : numpy.ndarray of int64
-
-        Returns
-        -------
-        list of tuple
-        """
-        slave, sets = np.divmod(np.asarray(codes, dtype=np.int64), self.n)
-        return [("f", s, a, b, c) for s, (a, b, c) in zip(slave.tolist(), self.triples[sets].tolist())]
 
 
 def fixed_rows_3d(points, tets, faces, fragment):
@@ -182,20 +99,8 @@ def fixed_rows_3d(points, tets, faces, fragment):
     ValueError
         On inconsistent arrays (see :func:`~ngfracture.contact.collision3d.detect_penetrations_3d`).
     """
-    detector = PenetrationDetector3d(points, tets, faces, fragment)         # checks the arrays
-    return _fixed_rows(points, faces, _vertex_fragment(len(points), tets, fragment), FaceKeys(faces), detector,
-                       CopyIndex(points, faces))
-
-
-def _fixed_rows(points, faces, vertex_fragment, codec, detector, index):
-    """:func:`fixed_rows_3d` with the vertices' fragments, the keys' codec, the mesh's
-    detector and copy index given."""
-    touching = node_to_face_rows(points, faces, detector.detect())
-    rows = NodeToFaceRows.stack([touching, fragment_pair_rows(points, faces, vertex_fragment, index=index),
-                                 lip_rows(points, faces, vertex_fragment, index=index)])
-    codes = codec.codes(rows)
-    first = np.sort(np.unique(codes, return_index=True)[1])
-    return rows.subset(first), RowKeys(codes[first], codec)
+    setup = MeshSetup3d(points, tets, faces, fragment)         # checks the arrays
+    return setup.rows, setup.keys
 
 
 def tied_pairs(holds, nv):
@@ -227,13 +132,6 @@ def tied_pairs(holds, nv):
     return unique_ints(v[0::2] * nv + v[1::2])                  # sorted within a row: min first
 
 
-def _vertex_fragment(nv, tets, fragment):
-    """The fragment of every vertex (-1: in no tetrahedron)."""
-    vertex_fragment = np.full(nv, -1, dtype=np.int64)
-    vertex_fragment[np.asarray(tets).ravel()] = np.repeat(np.asarray(fragment, dtype=np.int64), 4)
-    return vertex_fragment
-
-
 class ActiveSet3d(ActiveSet):
     """The active set of a contact solve on a tetrahedral mesh (see the module docstring).
 
@@ -246,28 +144,29 @@ class ActiveSet3d(ActiveSet):
     penetration_tol : float
         Penetration depth (a length) that makes an inactive row enter, and that a settled
         set may leave.
+    setups : ngfracture.contact.setup3d.MeshSetups, optional
+        Where to take the work on the mesh alone from (the set-up of an earlier solve on
+        these arrays, bitwise); without it that work is done here. The results are the same.
     **options
         ``rank_tol``, ``pdas_rounds``, ``max_updates``, ``warm`` of ActiveSet (``tol`` and
         ``kink_angle`` have no role in 3D).
     """
 
-    def __init__(self, geometry, penetration_tol, **options):
+    def __init__(self, geometry, penetration_tol, setups=None, **options):
         super().__init__(geometry, 0.0, penetration_tol, **options)
-        self.n2s = no_face_rows(len(geometry.arrays.points))
-        self.vertex_fragment = None
-        self.covered = np.zeros(0, dtype=np.int64)     # (vertex, fragment) a fixed row covers, as codes
-        self.codec = FaceKeys(geometry.arrays.faces)
-        self.n2s_keys = RowKeys(np.zeros(0, dtype=np.int64), self.codec)
         a = geometry.arrays
-        # the detection's work on the mesh alone, done once for every detection of the solve
-        self.detector = PenetrationDetector3d(a.points, a.tets, a.faces, geometry.fragment)
-        # and the boundary's arrays that the rows at copies of a point look up
-        self.copy_index = CopyIndex(a.points, a.faces)
+        # the work on the mesh alone (codec, detector, copy index, fixed rows): made here or
+        # taken from the set-up of the solve before on the same mesh
+        mesh = (a.points, a.tets, a.faces, geometry.fragment)
+        self.setup = MeshSetup3d(*mesh) if setups is None else setups.setup(*mesh)
+        self.codec = self.setup.codec
+        self.n2s = no_face_rows(len(a.points))
+        self.n2s_keys = RowKeys(np.zeros(0, dtype=np.int64), self.codec)
 
     def update(self, U, timings):
         """The candidate rows at X + U, the configuration of the last solve.
 
-        The first call builds the fixed rows; later calls re-linearise every candidate at
+        The first call takes the fixed rows of the mesh's set-up; later calls re-linearise every candidate at
         U (while the rows move). Rows found at U join; found rows of the last update stay
         while they are active or found again.
 
@@ -285,12 +184,7 @@ class ActiveSet3d(ActiveSet):
         a = self.geometry.arrays
         relinearised = None
         if self.seam_rows is None:
-            t0 = time.perf_counter()
-            self.vertex_fragment = _vertex_fragment(len(a.points), a.tets, self.geometry.fragment)
-            self.seam_rows, self.seam_keys = _fixed_rows(a.points, a.faces, self.vertex_fragment, self.codec,
-                                                         self.detector, self.copy_index)
-            timings["collision"] += time.perf_counter() - t0
-            self.covered = covered_pairs(a.points, self.seam_rows, self.vertex_fragment)
+            self.seam_rows, self.seam_keys = self.setup.rows, self.setup.keys
         elif self.moving:
             old = NodeToFaceRows.stack([self.seam_rows, self.n2s])
             relinearised = relinearise_node_to_face(old, a.points, U)
@@ -344,10 +238,11 @@ class ActiveSet3d(ActiveSet):
         """The pairs detected at X + U that no twin row covers, as rows with their key codes."""
         a = self.geometry.arrays
         t0 = time.perf_counter()
-        pen = self.detector.detect(U)
+        setup = self.setup
+        pen = setup.detector.detect(U)
         timings["collision"] += time.perf_counter() - t0
         rows, at_copy = found_rows_at_copies(a.points, a.faces, node_to_face_rows(a.points, a.faces, pen),
-                                             self.vertex_fragment, index=self.copy_index)
+                                             setup.vertex_fragment, index=setup.copy_index)
         # a vertex with a twin on the master fragment talks to it through its twin row; a
         # lip vertex in its own fragment, through the lip row of its pair of copies; but
         # one inside the wedge of a copy (master face at the copy) gets that face's row
@@ -356,15 +251,16 @@ class ActiveSet3d(ActiveSet):
         deep_at_copy = at_copy & (pen.gap < -self.penetration_tol)
         keep = (twin < 0) | deep_at_copy
         if not keep.all():
-            own = pen.fragment == self.vertex_fragment[pen.vertex]
-            keep |= ~own & ~isin_ints(np.asarray(pen.fragment, dtype=np.int64) * len(a.points) + pen.vertex, self.covered)
+            own = pen.fragment == setup.vertex_fragment[pen.vertex]
+            keep |= ~own & ~isin_ints(np.asarray(pen.fragment, dtype=np.int64) * len(a.points) + pen.vertex,
+                                      setup.covered)
         rows = rows.subset(np.flatnonzero(keep))
         codes = self.codec.codes(rows)
         if deep_at_copy.any():
             # and, where the lip at the copy is folded, a row on every coincident face there
             folded = folded_rows_at_copies(a.points, a.faces, rows, deep_at_copy[keep],
-                                           self.vertex_fragment, tied_pairs(self.geometry.holds, len(a.points)),
-                                           index=self.copy_index)
+                                           setup.vertex_fragment, tied_pairs(self.geometry.holds, len(a.points)),
+                                           index=setup.copy_index)
             folded_codes = self.codec.codes(folded)
             first = np.sort(np.unique(folded_codes, return_index=True)[1])
             first = first[~isin_ints(folded_codes[first], codes)]

@@ -281,9 +281,9 @@ class PenetrationDetector3d:
     What depends only on the mesh (the fragment of every vertex and face, the boundary
     vertices, the tetrahedra at every vertex, the copies of every boundary vertex and the
     lip flags) is computed once, in C++, on copies of the arrays given here: later changes
-    to those arrays do not reach it, so it cannot go stale. A contact solve makes one per
-    mesh (:class:`~ngfracture.contact.active_set3d.ActiveSet3d`) and detects with it in
-    every round. :meth:`detect` returns what :func:`detect_penetrations_3d` returns for the
+    to those arrays do not reach it, so it cannot go stale. One is made per mesh
+    (:class:`~ngfracture.contact.setup3d.MeshSetup3d`) and every round of every contact
+    solve on the mesh detects with it. :meth:`detect` returns what :func:`detect_penetrations_3d` returns for the
     same arrays, bit for bit.
 
     Parameters

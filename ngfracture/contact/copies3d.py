@@ -112,9 +112,7 @@ def found_rows_at_copies(points, faces, rows, vertex_fragment, index=None):
     r, partner = r[partner >= 0], partner[partner >= 0]
     slave[r], copy[r], face[r] = copy[r], slave[r], partner
     master = F[face]
-    p = X[master[at_copy]]
-    area2 = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
-    normal[at_copy] = area2 / np.linalg.norm(area2, axis=1)[:, None]
+    normal[at_copy] = index.unit[face[at_copy]]          # the face's unit normal, computed as here
     bary = rows.bary.copy()
     bary[at_copy] = (master[at_copy] == copy[at_copy, None]).astype(np.float64)
     g = rows.g.copy()
@@ -179,9 +177,7 @@ def folded_rows_at_copies(points, faces, rows, pick, vertex_fragment, tied=None,
     slave, face, corner = partner_faces(X, F, pair // nv, pair % nv, all_pairs=True, one_way=False,
                                         index=index)
     master = F[face]
-    p = X[master]
-    area2 = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
-    normal = area2 / np.linalg.norm(area2, axis=1)[:, None] if len(face) else np.zeros((0, 3))
+    normal = index.unit[face]                             # the faces' unit normals
     # an incidence is dropped where a picked row of its pair has a parallel face
     order = np.argsort(code, kind="stable")
     incidence_code = slave * nv + master[np.arange(len(face)), corner]

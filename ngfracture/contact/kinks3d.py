@@ -24,6 +24,8 @@ set imposes the ones that bind.
 """
 import numpy as np
 
+from .intsets import isin_ints, sorted_members, unique_ints
+
 __all__ = ["KINK", "CopyIndex", "point_groups", "point_ids", "face_point_keys", "partner_faces", "expand_ranges",
            "sorted_members", "unique_ints", "isin_ints"]
 
@@ -102,63 +104,11 @@ def face_point_keys(faces, pid):
     return key.ravel()
 
 
-def unique_ints(values):
-    """``numpy.unique`` of integers by a sort: the sorted distinct values, the same array.
-
-    numpy 2 finds the distinct values of a plain ``numpy.unique`` (and of ``numpy.isin``'s
-    sort) by a hash table, which for the int64 codes of this package is several times
-    slower than a sort (15 ms against 1 ms for 97000 codes).
-
-    Parameters
-    ----------
-    values : numpy.ndarray of int
-
-    Returns
-    -------
-    numpy.ndarray, shape (k,)
-    """
-    a = np.sort(np.ravel(values))
-    return a[np.r_[True, a[1:] != a[:-1]]] if len(a) else a
-
-
-def isin_ints(values, test):
-    """``numpy.isin(values, test)`` for integers, by a sort and a binary search.
-
-    Parameters
-    ----------
-    values, test : numpy.ndarray of int
-
-    Returns
-    -------
-    numpy.ndarray of bool, the shape of ``values``
-    """
-    return sorted_members(unique_ints(test), np.asarray(values))
-
-
-def sorted_members(table, values):
-    """Which values are in a sorted array without repeats (``numpy.isin`` by a binary search).
-
-    Parameters
-    ----------
-    table : numpy.ndarray, shape (k,)
-        Sorted, unique.
-    values : numpy.ndarray
-
-    Returns
-    -------
-    numpy.ndarray of bool, the shape of ``values``
-    """
-    if not len(table):
-        return np.zeros(np.shape(values), dtype=bool)
-    pos = np.minimum(np.searchsorted(table, values), len(table) - 1)
-    return table[pos] == values
-
-
 class CopyIndex:
     """The arrays of a mesh's boundary that the rows at copies of a point look up.
 
-    Made once per mesh (an active set's set-up) from copies of the arrays, so it cannot go
-    stale, and passed to :func:`partner_faces` and the functions of rows3d, junctions3d and
+    Made once per mesh (:class:`~ngfracture.contact.setup3d.MeshSetup3d`) from copies of
+    the arrays, so it cannot go stale, and passed to :func:`partner_faces` and the functions of rows3d, junctions3d and
     copies3d that take ``index``; each array is the one those functions compute without it.
 
     Parameters

@@ -178,6 +178,10 @@ class ContactSolver:
         Rounds of the primal-dual update before the set is chosen by the complementarity
         problem (also chosen so at once when the update revisits a set). Where the update
         converges, it settles within a few rounds (``docs/contact.md``).
+    setups : ngfracture.contact.setup3d.MeshSetups, optional
+        In 3D, the set-up of the mesh (fixed rows, detector, copy index) from an earlier
+        solve on the same arrays, and where this solve's is kept for the next; without it
+        each solve makes its own. Results do not depend on it.
     **solve_options
         Passed to ``problem.solve`` (method, tol, maxit, ...); ``fix_free_modes`` is True
         (free pieces are held on the rigid modes contact leaves free) unless given as "all"
@@ -196,7 +200,7 @@ class ContactSolver:
     """
 
     def __init__(self, problem, tol, penetration_tol=None, max_rounds=20, rank_tol=1e-5, max_updates=10,
-                 kink_angle=KINK_ANGLE, pdas_rounds=6, **solve_options):
+                 kink_angle=KINK_ANGLE, pdas_rounds=6, setups=None, **solve_options):
         if not np.isfinite(tol) or tol < 0:
             raise ValueError(f"contact detection tol must be finite and >= 0, got {tol!r}")
         for name, value, low in (("max_rounds", max_rounds, 1), ("max_updates", max_updates, 0),
@@ -223,6 +227,7 @@ class ContactSolver:
         self.max_updates = max_updates
         self.kink_angle = kink_angle
         self.pdas_rounds = pdas_rounds
+        self.setups = setups
         self.options = dict(solve_options)
         self.options["fix_free_modes"] = "all" if self.options.get("fix_free_modes") == "all" else True
 
@@ -278,7 +283,7 @@ class ContactSolver:
         """The active set of a solve: ActiveSet on triangles, ActiveSet3d on tetrahedra."""
         options = dict(rank_tol=self.rank_tol, pdas_rounds=self.pdas_rounds, max_updates=self.max_updates, warm=warm)
         if self.problem.dim == 3:
-            return ActiveSet3d(geometry, self.penetration_tol, **options)
+            return ActiveSet3d(geometry, self.penetration_tol, setups=self.setups, **options)
         return ActiveSet(geometry, self.tol, self.penetration_tol, kink_angle=self.kink_angle, **options)
 
     def _columns(self, C):

@@ -33,6 +33,7 @@ import traceback
 
 import numpy as np
 
+from ..contact.setup3d import MeshSetups
 from ..contact.solver import ContactSolver
 from ..fracture.crack_graph import crack_graph, tip_advances, tip_sizes
 from ..fracture.fragments import FragmentStatistics
@@ -58,8 +59,10 @@ __all__ = ["LoadStep"]
 class LoadStep:
     """The stages of a load step for one scene, criterion and step control.
 
-    Holds only its configuration; every stage takes what it works on as arguments and
-    returns a record.
+    Holds only its configuration, and the cache of the 3D contact set-up of the last mesh
+    solved (``contact_setups``, :class:`~ngfracture.contact.setup3d.MeshSetups`: a load
+    step on the same mesh reuses it; results do not depend on it); every stage takes what
+    it works on as arguments and returns a record.
 
     Parameters
     ----------
@@ -80,6 +83,7 @@ class LoadStep:
     def __init__(self, scene, control, criterion, contact, area_initial, dead_loads=False):
         self.scene, self.control, self.criterion, self.contact = scene, control, criterion, contact
         self.area_initial, self.dead_loads = area_initial, dead_loads
+        self.contact_setups = MeshSetups()
 
     # -- the physics of one configuration ------------------------------------------------------
     def problem(self, mesh, x, timings, u=None, check_mesh=True, triangle_piece=None):
@@ -174,7 +178,7 @@ class LoadStep:
     def _contact_equilibrium(self, prob, phase, options, timings, warm, lineage, start):
         """:meth:`equilibrium` with an active set of contact rows."""
         solver = ContactSolver(prob, tol=self.scene.contact_tol,   # its tol: detection threshold
-                               fix_free_modes=self.scene.fix_free_modes)
+                               fix_free_modes=self.scene.fix_free_modes, setups=self.contact_setups)
         solver.options.update(options)                              # Newton's tol, method, maxit
         result = solver.solve(warm=warm, lineage=lineage, start=start)
         collision = result.timings.get("collision", 0.0)

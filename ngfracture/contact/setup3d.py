@@ -1,0 +1,269 @@
+"""The part of a 3D contact solve that depends on the mesh only, made once per mesh.
+
+A run solves many times on one mesh (every load step without a new crack; the mesh changes
+only where a crack pass splits it), and every solve's active set
+(:class:`~ngfracture.contact.active_set3d.ActiveSet3d`) starts from the same work on the
+mesh alone: the keys' codec, the detector's set-up, the boundary's copy index, the
+vertices' fragments, and the fixed rows in the reference configuration (the touching
+pairs of the reference detection, the twin rows, the lip rows and partner-face rows) with
+the (vertex, fragment) pairs they cover. :class:`MeshSetup3d` is that work, made from
+copies of the arrays; :class:`MeshSetups` keeps the one of the last mesh and gives it to a
+solve whose arrays are bitwise those it was made from, else makes a new one. The set-up is
+a function of those arrays alone, so a solve with a set-up from the cache is the solve
+with one made afresh, bit for bit (``tests/test_contact3d_setup.py``).
+"""
+import numpy as np
+
+from .active_set import RowKeys
+from .collision3d import PenetrationDetector3d
+from .junctions3d import covered_pairs, fragment_pair_rows
+from .kinks3d import CopyIndex
+from .rows3d import NodeToFaceRows, lip_rows, node_to_face_rows
+
+__all__ = ["FaceKeys", "MeshSetup3d", "MeshSetups", "fixed_rows", "vertex_fragments"]
+
+
+class FaceKeys:
+    """The int64 codes of node-to-face keys on one mesh.
+
+    A row's key ("f", slave, master vertices sorted) is the code slave * n + i, with i the
+    number of the master's vertex set among the distinct vertex sets of the boundary faces
+    (codes are equal exactly where keys are; :mod:`ngfracture.contact.active_set3d`).
+
+    Parameters
+    ----------
+    faces : array_like of int, shape (nf, 3)
+        The mesh's boundary faces.
+
+    Raises
+    ------
+    ValueError
+        If ``faces`` is not of shape (nf, 3) with vertex numbers >= 0.
+    """
+
+    def __init__(self, faces):
+        F = np.asarray(faces)
+        if F.ndim != 2 or F.shape[1] != 3 or (F.size and (not np.issubdtype(F.dtype, np.integer) or F.min() < 0)):
+            raise ValueError(f"faces must be vertex numbers >= 0 of shape (nf, 3), got {F.dtype} {F.shape}")
+        S = np.sort(F.astype(np.int64), axis=1)
+        order = np.lexsort((S[:, 2], S[:, 1], S[:, 0]))
+        S = S[order]
+        first = np.r_[True, np.any(S[1:] != S[:-1], axis=1)] if len(S) else np.zeros(0, dtype=bool)
+        self.triples = S[first]                 # the distinct vertex sets, sorted
+        self.face_set = np.empty(len(S), dtype=np.int64)
+        self.face_set[order] = np.cumsum(first) - 1
+        self.n = max(len(self.triples), 1)
+        self._lookup = None
+
+    def codes(self, rows):
+        """The codes of the keys of some rows.
+
+        Parameters
+        ----------
+        rows : ngfracture.contact.rows3d.NodeToFaceRows
+            Rows of this mesh (their master the vertices of their face).
+
+        Returns
+        -------
+        numpy.ndarray of int64
+
+        Raises
+        ------
+        ValueError
+            If a row's master is not the vertex set of its face.
+        """
+        sets = self.face_set[np.asarray(rows.face, dtype=np.int64)]
+        if not np.array_equal(self.triples[sets], np.sort(rows.master, axis=1)):
+            raise ValueError("FaceKeys.codes: a row's master is not the vertex set of its face")
+        return np.asarray(rows.slave, dtype=np.int64) * self.n + sets
+
+    def codes_of(self, keys):
+        """The codes of keys given as tuples ("f", slave, a, b, c); -1 for a key of no face.
+
+        Parameters
+        ----------
+        keys : sequence of tuple
+
+        Returns
+        -------
+        numpy.ndarray of int64
+        """
+        if self._lookup is None:
+            self._lookup = {tuple(t): i for i, t in enumerate(self.triples.tolist())}
+        look = self._lookup
+        return np.fromiter(((k[1] * self.n + look[k[2:]]) if k[2:] in look else -1 for k in keys),
+                           dtype=np.int64, count=len(keys))
+
+    def decode(self, codes):
+        """The key tuples ("f", slave, master vertices sorted) of codes.
+
+        Parameters
+        ----------
+        codes : numpy.ndarray of int64
+
+        Returns
+        -------
+        list of tuple
+        """
+        slave, sets = np.divmod(np.asarray(codes, dtype=np.int64), self.n)
+        return [("f", s, a, b, c) for s, (a, b, c) in zip(slave.tolist(), self.triples[sets].tolist())]
+
+
+def vertex_fragments(nv, tets, fragment):
+    """The fragment of every vertex (-1: in no tetrahedron).
+
+    Parameters
+    ----------
+    nv : int
+        Number of vertices.
+    tets : numpy.ndarray of int, shape (ne, 4)
+    fragment : numpy.ndarray of int, shape (ne,)
+
+    Returns
+    -------
+    numpy.ndarray of int64, shape (nv,)
+    """
+    vertex_fragment = np.full(nv, -1, dtype=np.int64)
+    vertex_fragment[np.asarray(tets).ravel()] = np.repeat(np.asarray(fragment, dtype=np.int64), 4)
+    return vertex_fragment
+
+
+def fixed_rows(points, faces, vertex_fragment, codec, detector, index):
+    """The rows a 3D contact solve keeps as candidates throughout, from the mesh's set-up.
+
+    Parameters
+    ----------
+    points : numpy.ndarray, shape (nv, 3)
+        Reference coordinates.
+    faces : numpy.ndarray of int, shape (nf, 3)
+        Boundary faces, outward.
+    vertex_fragment : numpy.ndarray of int64, shape (nv,)
+        :func:`vertex_fragments`.
+    codec : FaceKeys
+    detector : ngfracture.contact.collision3d.PenetrationDetector3d
+    index : ngfracture.contact.kinks3d.CopyIndex
+
+    Returns
+    -------
+    rows : NodeToFaceRows
+        The pairs touching in the reference configuration (sorted by vertex and fragment),
+        then the twin rows of every fragment's vertices, then the lip rows.
+    keys : RowKeys
+        Their keys, without repeats (a repeated key keeps its first row).
+    """
+    touching = node_to_face_rows(points, faces, detector.detect())
+    rows = NodeToFaceRows.stack([touching, fragment_pair_rows(points, faces, vertex_fragment, index=index),
+                                 lip_rows(points, faces, vertex_fragment, index=index)])
+    codes = codec.codes(rows)
+    first = np.sort(np.unique(codes, return_index=True)[1])
+    return rows.subset(first), RowKeys(codes[first], codec)
+
+
+class MeshSetup3d:
+    """The mesh-only work of a 3D contact solve (see the module docstring).
+
+    Parameters
+    ----------
+    points : array_like, shape (nv, 3)
+        Reference coordinates.
+    tets : array_like of int, shape (ne, 4)
+    faces : array_like of int, shape (nf, 3)
+        Boundary faces, outward.
+    fragment : array_like of int, shape (ne,)
+        Fragment number per tetrahedron.
+
+    Attributes
+    ----------
+    points, tets, faces, fragment : numpy.ndarray
+        Copies of the arrays (their dtypes kept), which :meth:`fits` compares with.
+    codec : FaceKeys
+    detector : ngfracture.contact.collision3d.PenetrationDetector3d
+    copy_index : ngfracture.contact.kinks3d.CopyIndex
+    vertex_fragment : numpy.ndarray of int64
+    rows : NodeToFaceRows
+        The fixed rows in the reference configuration (:func:`fixed_rows`).
+    keys : RowKeys
+        Their keys.
+    covered : numpy.ndarray of int64
+        The (vertex, fragment) pairs they cover (:func:`~ngfracture.contact.junctions3d.covered_pairs`).
+
+    Raises
+    ------
+    ValueError
+        On inconsistent arrays (see :func:`~ngfracture.contact.collision3d.detect_penetrations_3d`).
+    """
+
+    def __init__(self, points, tets, faces, fragment):
+        self.points, self.tets, self.faces, self.fragment = (np.array(a) for a in (points, tets, faces, fragment))
+        self.detector = PenetrationDetector3d(self.points, self.tets, self.faces, self.fragment)   # checks
+        self.codec = FaceKeys(self.faces)
+        self.copy_index = CopyIndex(self.points, self.faces)
+        self.vertex_fragment = vertex_fragments(len(self.points), self.tets, self.fragment)
+        self.rows, self.keys = fixed_rows(self.points, self.faces, self.vertex_fragment, self.codec,
+                                          self.detector, self.copy_index)
+        self.covered = covered_pairs(self.points, self.rows, self.vertex_fragment)
+
+    def fits(self, points, tets, faces, fragment):
+        """Whether the arrays are bitwise those this set-up was made from.
+
+        Dtypes, shapes and bytes are compared (a -0.0 for a 0.0 differs).
+
+        Parameters
+        ----------
+        points, tets, faces, fragment : array_like
+            As for the constructor.
+
+        Returns
+        -------
+        bool
+        """
+        return all(_same_bits(np.asarray(a), b) for a, b in ((points, self.points), (tets, self.tets),
+                                                             (faces, self.faces), (fragment, self.fragment)))
+
+
+def _same_bits(a, b):
+    """Whether two arrays have one dtype, one shape and the same bytes."""
+    if a.dtype != b.dtype or a.shape != b.shape:
+        return False
+    a, b = np.ascontiguousarray(a).reshape(-1).view(np.uint8), np.ascontiguousarray(b).reshape(-1).view(np.uint8)
+    if len(a) % 8 == 0:                 # the same bytes, compared 8 at a time
+        a, b = a.view(np.int64), b.view(np.int64)
+    return np.array_equal(a, b)
+
+
+class MeshSetups:
+    """The :class:`MeshSetup3d` of the last mesh a solve asked for, reused while it fits.
+
+    The owner of the solves of a run (``run.step.LoadStep``) keeps one and gives it to every
+    contact solve (``ContactSolver(..., setups=...)``): solves on one mesh share one set-up,
+    a solve on another mesh (or on arrays changed in place) gets a new one, which replaces
+    the old. Results do not depend on whether the set-up came from here.
+
+    Attributes
+    ----------
+    made : int
+        Set-ups made so far (a solve whose set-up was reused adds none).
+    """
+
+    def __init__(self):
+        self._last = None
+        self.made = 0
+
+    def setup(self, points, tets, faces, fragment):
+        """The set-up of these arrays: the last one where it fits them, else a new one.
+
+        Parameters
+        ----------
+        points, tets, faces, fragment : array_like
+            As for :class:`MeshSetup3d`.
+
+        Returns
+        -------
+        MeshSetup3d
+        """
+        last = self._last
+        if last is None or not last.fits(points, tets, faces, fragment):
+            last = MeshSetup3d(points, tets, faces, fragment)
+            self._last = last
+            self.made += 1
+        return last
