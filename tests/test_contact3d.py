@@ -22,9 +22,10 @@ import pytest
 from ngfracture.contact.active_set import ActiveSet, Candidates, Geometry
 from ngfracture.contact.collision3d import detect_penetrations_3d
 from ngfracture.contact.rows3d import (NodeToFaceRows, face_gap_rows, no_face_rows, node_to_face_rows,
-                                       nodal_areas, relinearise_node_to_face, space_columns_3d, twin_rows)
+                                       relinearise_node_to_face, twin_rows)
+from ngfracture.contact.solver import space_columns_3d
 from ngfracture.fracture.strain import vertex_displacement
-from ngfracture.geometry.solid import merge_bodies, solid_mesh
+from ngfracture.geometry.solid import merge_bodies, nodal_areas, solid_mesh
 from ngfracture.geometry.structured import box_mesh
 from ngfracture.mechanics.materials import LinearElastic
 from ngfracture.mechanics.problem import ElasticProblem

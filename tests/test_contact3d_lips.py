@@ -38,7 +38,8 @@ import ngfracture as nf
 
 from ngfracture.contact.active_set3d import fixed_rows_3d
 from ngfracture.contact.collision3d import detect_penetrations_3d
-from ngfracture.contact.rows3d import lip_rows, nodal_areas
+from ngfracture.contact.rows3d import lip_rows
+from ngfracture.geometry.solid import nodal_areas
 from ngfracture.contact.solver import ContactSolver
 from ngfracture.fracture.strain import vertex_displacement
 from ngfracture.geometry.solid import SolidArrays, solid_mesh

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from ngfracture.contact.active_set3d import fixed_rows_3d
-from ngfracture.contact.rows3d import nodal_areas
+from ngfracture.geometry.solid import nodal_areas
 from ngfracture.geometry.solid import total_volume
 from ngfracture.run.invariants import penetration_depth_3d
 from ngfracture.run.scene import Scene

@@ -68,7 +68,9 @@ import pytest
 
 from ngfracture.contact.active_set import ActiveSet, Candidates, Geometry
 from ngfracture.contact.collision3d import detect_penetrations_3d
-from ngfracture.contact.rows3d import nodal_areas, node_to_face_rows, space_columns_3d
+from ngfracture.contact.rows3d import node_to_face_rows
+from ngfracture.contact.solver import space_columns_3d
+from ngfracture.geometry.solid import nodal_areas
 from ngfracture.fracture.strain import vertex_displacement
 from ngfracture.geometry.solid import merge_bodies, solid_mesh
 from ngfracture.geometry.structured import box_mesh

@@ -62,7 +62,7 @@ import scipy.sparse as sp
 
 from .active_set import ActiveSet, Candidates, RowKeys, refreshed
 from .copies3d import folded_rows_at_copies, found_rows_at_copies
-from .kinks3d import isin_ints, unique_ints
+from .intsets import isin_ints, union_ints, unique_ints
 from .redundancy import holds_on_columns
 from .rows3d import NodeToFaceRows, no_face_rows, node_to_face_rows, relinearise_node_to_face
 from .setup3d import FaceKeys, MeshSetup3d
@@ -197,7 +197,7 @@ class ActiveSet3d(ActiveSet):
             # the complementarity problem chooses among the rows wanted or imposed in the
             # solve; one it released stays a candidate, or the next problem cannot see the
             # penetration that releasing it lets happen
-            retain |= isin_ints(n2s_codes, np.union1d(self.tried, self.wanted))
+            retain |= isin_ints(n2s_codes, union_ints(self.tried, self.wanted))
         retained = np.flatnonzero(retain)
         new = np.flatnonzero(~isin_ints(found_codes, known))
         self.n2s = NodeToFaceRows.stack([self.n2s.subset(retained), found.subset(new)])

@@ -49,7 +49,7 @@ crack lip) a slave also gets a row on every coincident face at the copy (partner
 :mod:`ngfracture.contact.kinks3d`).
 The tributary area of a node, by which a force is a pressure, is the consistent nodal area
 of the surface: the integral of its hat function, a third of the area of every face at
-the node (:func:`nodal_areas`).
+the node (:func:`ngfracture.geometry.solid.nodal_areas`).
 
 Where the candidates come from (touching pairs of the reference configuration, fixed rows,
 found rows) is :mod:`ngfracture.contact.active_set3d`'s business.
@@ -65,7 +65,8 @@ from .kinks3d import KINK, CopyIndex, expand_ranges, isin_ints, partner_faces
 from .rows import RowTable
 
 __all__ = ["NodeToFaceRows", "no_face_rows", "node_to_face_rows", "twin_rows", "fragment_twin_rows", "lip_rows", "face_gap_rows",
-           "relinearise_node_to_face", "nodal_areas", "space_columns_3d"]
+           "relinearise_node_to_face"]
+
 
 @dataclass
 class NodeToFaceRows(RowTable):
@@ -116,6 +117,14 @@ class NodeToFaceRows(RowTable):
 
         Where every part has built its ``C``, the stack's is theirs stacked: a row of C
         depends on its own row's fields only, so it is the one :attr:`C` would build.
+
+        Parameters
+        ----------
+        parts : list of NodeToFaceRows
+
+        Returns
+        -------
+        NodeToFaceRows
         """
         out = super().stack(parts)
         if len(parts) > 1 and all("C" in p.__dict__ for p in parts):
@@ -125,7 +134,16 @@ class NodeToFaceRows(RowTable):
         return out
 
     def subset(self, rows):
-        """The rows ``rows`` (``RowTable.subset``), with their rows of ``C`` where it is built."""
+        """The rows ``rows`` (``RowTable.subset``), with their rows of ``C`` where it is built.
+
+        Parameters
+        ----------
+        rows : array_like of int or bool
+
+        Returns
+        -------
+        NodeToFaceRows
+        """
         out = super().subset(rows)
         if "C" in self.__dict__:
             out.__dict__["C"] = self.C[np.asarray(rows)]
@@ -557,61 +575,3 @@ def relinearise_node_to_face(rows, points, displacement):
     dist = np.einsum("ij,ij->i", q - np.einsum("ij,ijk->ik", b, p), n)
     return NodeToFaceRows(rows.slave, rows.master, rows.face, b, n, dist,
                           _gap_offset(X, rows.slave, rows.master, b, n), nv=rows.nv)
-
-
-def nodal_areas(points, faces):
-    """Consistent nodal areas of a triangulated surface: the integral of each vertex's hat function.
-
-    Parameters
-    ----------
-    points : array_like, shape (nv, 3)
-        Vertex coordinates.
-    faces : array_like of int, shape (nf, 3)
-        The surface's triangles.
-
-    Returns
-    -------
-    numpy.ndarray, shape (nv,)
-        A third of the area of every face at the vertex, summed (0 off the surface).
-
-    Raises
-    ------
-    ValueError
-        On wrong shapes or vertex numbers out of range.
-    """
-    X = _coordinates(points, "points")
-    F = np.asarray(faces)
-    F = _vertices(F, "faces", len(X), (F.shape[0] if F.ndim == 2 else -1, 3))
-    p = X[F]
-    area = 0.5 * np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1)
-    out = np.zeros(len(X))
-    np.add.at(out, F.ravel(), np.repeat(area / 3.0, 3))
-    return out
-
-
-def space_columns_3d(C, nv, n):
-    """Rows with their columns moved from the P1 layout (comp * nv + v) to the space's (comp * n + v).
-
-    Parameters
-    ----------
-    C : scipy.sparse matrix, shape (m, 3 nv)
-        Rows in the P1 layout.
-    nv : int
-        Number of vertices.
-    n : int
-        Dofs per component of the space (``fes.ndof // 3``; n >= nv, the vertex dofs first).
-
-    Returns
-    -------
-    scipy.sparse.csr_matrix, shape (m, 3 n)
-
-    Raises
-    ------
-    ValueError
-        If C does not have 3 nv columns or n < nv.
-    """
-    C = sp.csr_matrix(C)
-    if C.shape[1] != 3 * nv or n < nv:
-        raise ValueError(f"space_columns_3d: C has {C.shape[1]} columns, expected 3 nv = {3 * nv} (n = {n})")
-    comp, v = np.divmod(C.indices, nv)
-    return sp.csr_matrix((C.data, comp * n + v, C.indptr), shape=(C.shape[0], 3 * n))

@@ -39,7 +39,6 @@ import scipy.sparse as sp
 
 from .active_set import ActiveSet, Geometry, max_penetration
 from .active_set3d import ActiveSet3d
-from .rows3d import space_columns_3d
 from ..fracture.strain import vertex_displacement
 from ..geometry.meshio import boundary_only
 from .seams import KINK_ANGLE, find_seams
@@ -49,7 +48,7 @@ from ..linalg.qp import QPError
 from ..mechanics.newton import NewtonSolver, SolveStatus, check_solve_options
 from ..mechanics.tangent import SavedTangent
 
-__all__ = ["ContactResult", "ContactSolver", "space_columns", "LABEL"]
+__all__ = ["ContactResult", "ContactSolver", "space_columns", "space_columns_3d", "LABEL"]
 
 #: label of the problem's constraint rows that the contact solve owns
 LABEL = "contact"
@@ -502,3 +501,31 @@ def space_columns(C, nv, n):
     cols = C.indices
     mapped = np.where(cols < nv, cols, cols - nv + n)
     return sp.csr_matrix((C.data, mapped, C.indptr), shape=(C.shape[0], 2 * n))
+
+
+def space_columns_3d(C, nv, n):
+    """Rows with their columns moved from the P1 layout (comp * nv + v) to the space's (comp * n + v).
+
+    Parameters
+    ----------
+    C : scipy.sparse matrix, shape (m, 3 nv)
+        Rows in the P1 layout.
+    nv : int
+        Number of vertices.
+    n : int
+        Dofs per component of the space (``fes.ndof // 3``; n >= nv, the vertex dofs first).
+
+    Returns
+    -------
+    scipy.sparse.csr_matrix, shape (m, 3 n)
+
+    Raises
+    ------
+    ValueError
+        If C does not have 3 nv columns or n < nv.
+    """
+    C = sp.csr_matrix(C)
+    if C.shape[1] != 3 * nv or n < nv:
+        raise ValueError(f"space_columns_3d: C has {C.shape[1]} columns, expected 3 nv = {3 * nv} (n = {n})")
+    comp, v = np.divmod(C.indices, nv)
+    return sp.csr_matrix((C.data, comp * n + v, C.indptr), shape=(C.shape[0], 3 * n))

@@ -25,7 +25,7 @@ import ngsolve as ng
 import numpy as np
 
 __all__ = ["SolidArrays", "solid_to_arrays", "solid_mesh", "tet_volumes", "total_volume", "is_solid", "crack_area",
-           "merge_bodies"]
+           "merge_bodies", "nodal_areas"]
 
 #: from this many tetrahedra NGSolve builds a mesh's topology in its task manager
 PARALLEL_MIN_TETS = 20000
@@ -294,6 +294,43 @@ def crack_area(arrays, name="crack"):
         return 0.0
     x = np.asarray(arrays.points, dtype=float)[faces]
     return 0.25 * math.fsum(np.linalg.norm(np.cross(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0]), axis=1))
+
+
+def nodal_areas(points, faces):
+    """Consistent nodal areas of a triangulated surface: the integral of each vertex's hat function.
+
+    The tributary area by which a nodal contact force is a pressure.
+
+    Parameters
+    ----------
+    points : array_like, shape (nv, 3)
+        Vertex coordinates.
+    faces : array_like of int, shape (nf, 3)
+        The surface's triangles.
+
+    Returns
+    -------
+    numpy.ndarray, shape (nv,)
+        A third of the area of every face at the vertex, summed (0 off the surface).
+
+    Raises
+    ------
+    ValueError
+        On wrong shapes, non-finite coordinates or vertex numbers out of range.
+    """
+    X = np.asarray(points, dtype=np.float64)
+    F = np.asarray(faces)
+    if X.ndim != 2 or X.shape[1] != 3 or not np.isfinite(X).all():
+        raise ValueError(f"points must be finite coordinates of shape (nv, 3), got {X.shape}")
+    if F.ndim != 2 or F.shape[1] != 3 or (F.size and not np.issubdtype(F.dtype, np.integer)):
+        raise ValueError(f"faces must be integers of shape (nf, 3), got {F.dtype} {F.shape}")
+    if F.size and (F.min() < 0 or F.max() >= len(X)):
+        raise ValueError(f"faces hold vertex numbers outside [0, {len(X)})")
+    p = X[F]
+    area = 0.5 * np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1)
+    out = np.zeros(len(X))
+    np.add.at(out, F.ravel(), np.repeat(area / 3.0, 3))
+    return out
 
 
 def merge_bodies(bodies):
