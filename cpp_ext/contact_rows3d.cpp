@@ -113,6 +113,20 @@ namespace ngfracture
     return true;
   }
 
+  void GapOffsets3 (int64_t m, const double * X, const int64_t * slave, const int64_t * master,
+                    const double * bary, const double * normal, double * g)
+  {
+    for (int64_t r = 0; r < m; r++)
+      {
+        double proj[3], d[3];
+        const double * Q = X + 3 * slave[r];
+        Combination(X, master + 3 * r, bary + 3 * r, proj);
+        for (int k = 0; k < 3; k++)
+          d[k] = Q[k] - proj[k];
+        g[r] = Dot(d, normal + 3 * r);
+      }
+  }
+
   void RelineariseRows3 (int64_t m, const double * X, const double * x, const int64_t * slave,
                          const int64_t * master, const double * bary, const double * normal,
                          double * bary_out, double * normal_out, double * dist, double * g)
@@ -150,10 +164,7 @@ namespace ngfracture
         for (int k = 0; k < 3; k++)
           d[k] = q[k] - proj[k];
         dist[r] = Dot(d, n);
-        Combination(X, tri, b, proj);
-        for (int k = 0; k < 3; k++)
-          d[k] = Q[k] - proj[k];
-        g[r] = Dot(d, n);
       }
+    GapOffsets3(m, X, slave, master, bary_out, normal_out, g);
   }
 }

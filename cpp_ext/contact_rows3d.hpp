@@ -14,6 +14,10 @@ namespace ngfracture
                       const double * bary, const double * normal, std::vector<int32_t> & indptr,
                       std::vector<int32_t> & indices, std::vector<double> & data);
 
+  // g = n . (X_s - sum_l b_l X_l) of every row (rows3d._gap_offset)
+  void GapOffsets3 (int64_t m, const double * X, const int64_t * slave, const int64_t * master,
+                    const double * bary, const double * normal, double * g);
+
   // rows3d.relinearise_node_to_face: bary, normal (m x 3), dist and g (m) at x = X + U
   void RelineariseRows3 (int64_t m, const double * X, const double * x, const int64_t * slave,
                          const int64_t * master, const double * bary, const double * normal,

@@ -22,6 +22,21 @@ namespace
       throw std::invalid_argument(std::string("ngfracture.") + fn + ": " + name + " has the wrong shape");
   }
 
+  // every slave and master vertex in [0, nv)
+  void CheckVertices (const char * fn, const py::array_t<int64_t> & slave, const py::array_t<int64_t> & master,
+                      int64_t nv)
+  {
+    for (py::ssize_t r = 0; r < slave.shape(0); r++)
+      {
+        bool bad = slave.data()[r] < 0 || slave.data()[r] >= nv;
+        for (int l = 0; l < 3; l++)
+          bad |= master.data()[3 * r + l] < 0 || master.data()[3 * r + l] >= nv;
+        if (bad)
+          throw std::invalid_argument(std::string("ngfracture.") + fn + ": row " + std::to_string(r)
+                                      + " has a vertex outside [0, nv)");
+      }
+  }
+
   // (ids (k, 5), geometry (k, 10), stats) of the penetrations, as DetectPenetrations3d returns them
   py::tuple PenetrationTuple (const std::vector<Penetration3> & pen, const Collision3Stats & st)
   {
@@ -155,6 +170,35 @@ ValueError
     On shapes that do not match, or sizes beyond int32 indices.
 )doc");
 
+  m.def("GapOffsets3d",
+        [] (DArr X, LArr slave, LArr master, DArr bary, DArr normal)
+        {
+          py::ssize_t rows = slave.shape(0);
+          Check("GapOffsets3d", "points", X, 2, 3);
+          Check("GapOffsets3d", "slave", slave, 1, 0);
+          Check("GapOffsets3d", "master", master, 2, 3, rows);
+          Check("GapOffsets3d", "bary", bary, 2, 3, rows);
+          Check("GapOffsets3d", "normal", normal, 2, 3, rows);
+          CheckVertices("GapOffsets3d", slave, master, X.shape(0));
+          py::array_t<double> g(rows);
+          double * pg = g.mutable_data();
+          {
+            py::gil_scoped_release release;
+            GapOffsets3(rows, X.data(), slave.data(), master.data(), bary.data(), normal.data(), pg);
+          }
+          return g;
+        },
+        py::arg("points"), py::arg("slave"), py::arg("master"), py::arg("bary"), py::arg("normal"),
+        R"doc(The gaps g = n . (X_s - sum_l b_l X_l) of node-to-face rows (rows3d._gap_offset).
+
+Bit for bit the numpy computation (einsum's order of the sums).
+
+Raises
+------
+ValueError
+    On shapes that do not match or vertices out of range.
+)doc");
+
   m.def("RelineariseRows3d",
         [] (DArr X, DArr x, LArr slave, LArr master, DArr bary, DArr normal)
         {
@@ -165,16 +209,7 @@ ValueError
           Check("RelineariseRows3d", "master", master, 2, 3, rows);
           Check("RelineariseRows3d", "bary", bary, 2, 3, rows);
           Check("RelineariseRows3d", "normal", normal, 2, 3, rows);
-          const int64_t nv = X.shape(0);
-          for (py::ssize_t r = 0; r < rows; r++)
-            {
-              bool bad = slave.data()[r] < 0 || slave.data()[r] >= nv;
-              for (int l = 0; l < 3; l++)
-                bad |= master.data()[3 * r + l] < 0 || master.data()[3 * r + l] >= nv;
-              if (bad)
-                throw std::invalid_argument("ngfracture.RelineariseRows3d: row " + std::to_string(r)
-                                            + " has a vertex outside [0, nv)");
-            }
+          CheckVertices("RelineariseRows3d", slave, master, X.shape(0));
           py::array_t<double> b({ rows, py::ssize_t(3) }), n({ rows, py::ssize_t(3) }), dist(rows), g(rows);
           double * pb = b.mutable_data(), * pn = n.mutable_data(), * pd = dist.mutable_data(), * pg = g.mutable_data();
           {

@@ -1,7 +1,7 @@
 """The C++ kernels of the 3D node-to-face rows against their numpy reference, bit for bit.
 
-``rows3d._gap_matrix`` (``GapMatrixCsr3d``) and ``rows3d.relinearise_node_to_face``
-(``RelineariseRows3d``) compute in C++ what the numpy code below computes; the rows,
+``rows3d._gap_matrix`` (``GapMatrixCsr3d``), ``rows3d._gap_offset`` (``GapOffsets3d``) and
+``rows3d.relinearise_node_to_face`` (``RelineariseRows3d``) compute in C++ what the numpy code below computes; the rows,
 gaps and C matrices of every contact round go through them, so they must agree to the
 last bit (and in the sign of zeros) on rows of every kind: projections inside a face,
 on an edge or at a vertex (exact zeros), squeezed faces, rows anchored at a copy of the
@@ -53,6 +53,12 @@ def reference_relinearise(rows, X, x):
     dist = np.einsum("ij,ij->i", q - np.einsum("ij,ijk->ik", b, p), n)
     pos = X[rows.slave] - np.einsum("ij,ijk->ik", b, X[rows.master])
     return b, n, dist, np.einsum("ij,ij->i", pos, n)
+
+
+def reference_gap_offset(X, slave, master, bary, normal):
+    """The numpy gaps n . (X_s - sum_l b_l X_l), as rows3d had them."""
+    pos = X[slave] - np.einsum("ij,ijk->ik", bary, X[master])
+    return np.einsum("ij,ij->i", pos, normal)
 
 
 def random_rows(seed, m=4000, nv=3000):
@@ -108,6 +114,8 @@ def test_gap_matrix_equals_numpy(seed):
         assert same_bits(getattr(C, f), getattr(ref, f))
     assert C.nnz < 12 * len(rows)                                   # exact zeros were left out
     assert C.has_sorted_indices
+    assert same_bits(g, reference_gap_offset(X, rows.slave, rows.master, rows.bary, rows.normal))
+    assert np.count_nonzero(g == 0.0) >= 50                          # the rows anchored at a copy
 
 
 def test_gap_matrix_repeated_vertex_sums():
@@ -125,5 +133,7 @@ def test_kernels_reject_bad_input():
     X, U, rows = random_rows(0)
     with pytest.raises(ValueError, match="outside"):
         ext.RelineariseRows3d(X, X + U, rows.slave + 100, rows.master, rows.bary, rows.normal)
+    with pytest.raises(ValueError, match="outside"):
+        ext.GapOffsets3d(X, rows.slave, rows.master - len(X), rows.bary, rows.normal)
     with pytest.raises(ValueError, match="bary"):
         ext.GapMatrixCsr3d(rows.slave, rows.master, rows.bary[:5], rows.normal, len(X))
