@@ -17,6 +17,12 @@ def unique_ints(values):
     sort) by a hash table, which for the int64 codes of this package is several times
     slower than a sort (15 ms against 1 ms for 97000 codes).
 
+    The sort is numpy's stable one (timsort), which finds runs: the codes of the contact
+    work are mostly sorted already (two sorted sets joined, codes made in vertex order),
+    and at 105k tetrahedra its sorts of them take 0.7 ms a solve against 4.6 ms by the
+    default quicksort (random codes: 1.4 times the quicksort). The sorted values are the
+    same whatever the algorithm.
+
     Parameters
     ----------
     values : numpy.ndarray of int
@@ -25,7 +31,7 @@ def unique_ints(values):
     -------
     numpy.ndarray, shape (k,)
     """
-    a = np.sort(np.ravel(values))
+    a = np.sort(np.ravel(values), kind="stable")
     return a[np.r_[True, a[1:] != a[:-1]]] if len(a) else a
 
 

@@ -52,11 +52,12 @@ def _on_several_fragments(pid, vf):
     out = np.zeros(len(pid), dtype=bool)
     if not len(on):
         return out
-    low = np.full(pid.max() + 1, np.iinfo(np.int64).max)
-    high = np.full(pid.max() + 1, np.iinfo(np.int64).min)
-    np.minimum.at(low, pid[on], vf[on])
-    np.maximum.at(high, pid[on], vf[on])
-    out[on] = low[pid[on]] != high[pid[on]]
+    point, fragment = pid[on], vf[on]
+    some = np.zeros(pid.max() + 1, dtype=np.int64)
+    some[point] = fragment                    # the fragment of one copy of each point (any)
+    several = np.zeros(len(some), dtype=bool)
+    several[point[fragment != some[point]]] = True          # another copy on another fragment
+    out[on] = several[point]
     return out
 
 
@@ -87,6 +88,17 @@ def _checked(points, faces, vertex_fragment):
     if vf.shape != (nv,) or (vf.size and not np.issubdtype(vf.dtype, np.integer)):
         raise ValueError(f"vertex_fragment must be integers of shape ({nv},), got {vf.dtype} {vf.shape}")
     return X, F, vf.astype(np.int64)
+
+
+def _order_by(fragment, slave, master_fragment, face, nv, nf):
+    """``np.lexsort((face, master_fragment, slave, fragment))``: where the fragments are
+    non-negative and the codes fit, one stable sort of the int64 codes (the same order;
+    lexsort sorts key by key, twice as slow)."""
+    k = int(max(fragment.max(initial=0), master_fragment.max(initial=0))) + 1
+    low = min(fragment.min(initial=0), master_fragment.min(initial=0))
+    if low < 0 or float(k) * k * nv * nf >= 2.0 ** 62:
+        return np.lexsort((face, master_fragment, slave, fragment))
+    return np.argsort(((fragment * nv + slave) * k + master_fragment) * nf + face, kind="stable")
 
 
 def fragment_pair_rows(points, faces, vertex_fragment, index=None):
@@ -141,12 +153,12 @@ def fragment_pair_rows(points, faces, vertex_fragment, index=None):
     k = np.tile(np.arange(3), len(b))
     area2, unit = index.area2, index.unit
     copy = F[face, k]
-    group = np.lexsort((copy, slave))                                     # by (slave, master copy)
+    group = np.argsort(slave * nv + copy, kind="stable")                 # by (slave, master copy): lexsort's order
     slave, face, k, copy = slave[group], face[group], k[group], copy[group]
     start = np.r_[True, (slave[1:] != slave[:-1]) | (copy[1:] != copy[:-1])]
     owner = np.cumsum(start) - 1
-    mean = np.zeros((owner[-1] + 1, 3))
-    np.add.at(mean, owner, area2[face])
+    # the sums in the order of the rows from 0.0, as np.add.at makes them
+    mean = np.stack([np.bincount(owner, weights=area2[face, d], minlength=owner[-1] + 1) for d in range(3)], axis=1)
     score = np.einsum("ij,ij->i", unit[face], mean[owner])
     best = np.lexsort((face, -score, owner))
     best = best[np.r_[True, owner[best][1:] != owner[best][:-1]]]
@@ -160,7 +172,7 @@ def fragment_pair_rows(points, faces, vertex_fragment, index=None):
     keep[best] = True
     keep |= bend & (copies[pid[slave]] >= 3)
     slave, face, k = slave[keep], face[keep], k[keep]
-    order = np.lexsort((face, ff[face], slave, vf[slave]))
+    order = _order_by(vf[slave], slave, ff[face], face, nv, len(F))
     slave, face, k = slave[order], face[order], k[order]
     bary = np.zeros((len(slave), 3))
     bary[np.arange(len(slave)), k] = 1.0

@@ -156,7 +156,8 @@ class CopyIndex:
         self.area2 = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
         self.unit = self.area2 / np.linalg.norm(self.area2, axis=1)[:, None]
         nk = len(self.faces) + 1
-        self.vertex_keys = unique_ints(flat * nk + np.repeat(self.face_key, 3))
+        # in the vertices' order (mostly sorted: the stable sort of unique_ints finds the runs)
+        self.vertex_keys = unique_ints((flat * nk + np.repeat(self.face_key, 3))[self.incidence])
 
 
 def partner_faces(points, faces, slave, copy, all_pairs, one_way=True, index=None):

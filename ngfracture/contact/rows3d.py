@@ -61,6 +61,7 @@ from typing import ClassVar
 import numpy as np
 import scipy.sparse as sp
 
+from .. import _ngfracture as _ext
 from .kinks3d import KINK, CopyIndex, expand_ranges, isin_ints, partner_faces
 from .rows import RowTable
 
@@ -179,21 +180,20 @@ def no_face_rows(nv):
 
 
 def _gap_matrix(slave, master, bary, normal, nv):
-    """C of :func:`face_gap_rows`, for arrays already checked."""
+    """C of :func:`face_gap_rows`, for arrays already checked.
+
+    Rows of four distinct vertices (every row of a detection): the CSR arrays in C++
+    (``cpp_ext/contact_rows3d.cpp``), columns sorted per row, exact zeros left out, what the
+    conversion from coordinates gives; a row with a repeated vertex: that conversion, which
+    sums the duplicates.
+    """
     m = len(slave)
+    if 3 * nv < 2 ** 31 and 12 * m < 2 ** 31:
+        csr = _ext.GapMatrixCsr3d(slave, master, bary, normal, nv)
+        if csr is not None:
+            return sp.csr_matrix(csr, shape=(m, 3 * nv))
     w = np.concatenate([np.ones((m, 1)), -bary], axis=1)                  # weights of s, i, j, k
     verts = np.concatenate([slave[:, None], master], axis=1).astype(np.int64)
-    order = np.argsort(verts, axis=1, kind="stable")
-    vs = np.take_along_axis(verts, order, axis=1)
-    if not np.any(vs[:, 1:] == vs[:, :-1]) and 3 * nv < 2 ** 31 and 12 * m < 2 ** 31:
-        # four distinct vertices per row (no duplicate to sum): the CSR arrays directly,
-        # columns sorted within each row, as the conversion from coordinates makes them
-        ws = np.take_along_axis(w, order, axis=1)
-        cols = np.concatenate([vs + comp * nv for comp in range(3)], axis=1).ravel().astype(np.int32)
-        vals = np.concatenate([ws * normal[:, comp:comp + 1] for comp in range(3)], axis=1).ravel()
-        C = sp.csr_matrix((vals, cols, np.arange(0, 12 * m + 1, 12, dtype=np.int32)), shape=(m, 3 * nv))
-        C.eliminate_zeros()
-        return C
     rows = np.repeat(np.arange(m), 12)
     cols = np.concatenate([verts + comp * nv for comp in range(3)], axis=1).ravel()
     vals = np.concatenate([w * normal[:, comp:comp + 1] for comp in range(3)], axis=1).ravel()
@@ -203,8 +203,8 @@ def _gap_matrix(slave, master, bary, normal, nv):
 
 
 def _gap_offset(X, slave, master, bary, normal):
-    pos = X[slave] - np.einsum("ij,ijk->ik", bary, X[master])
-    return np.einsum("ij,ij->i", pos, normal)
+    """n . (X_s - sum_l b_l X_l) per row, in C++ (the numpy einsums' sums, bit for bit)."""
+    return _ext.GapOffsets3d(X, slave, master, bary, normal)
 
 
 def _vertices(v, name, nv, shape):
@@ -549,29 +549,15 @@ def relinearise_node_to_face(rows, points, displacement):
     ------
     ValueError
         On shapes that do not match the rows' vertices, or non-finite numbers.
+
+    Notes
+    -----
+    Computed in C++ (``cpp_ext/contact_rows3d.cpp``) in numpy's operations and order: bit
+    for bit the numpy computation (``tests/test_contact_rows3d_kernels.py``).
     """
     if len(rows) == 0:
         return rows
     X = _coordinates(points, "points", rows.nv)
     x = X + _coordinates(displacement, "displacement", rows.nv)
-    p = x[rows.master]
-    area2 = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
-    length = np.linalg.norm(area2, axis=1)
-    P = X[rows.master]
-    reference = np.linalg.norm(np.cross(P[:, 1] - P[:, 0], P[:, 2] - P[:, 0]), axis=1)
-    degenerate = ~(length > 1e-16 * reference)
-    face_normal = area2 / np.where(degenerate, 1.0, length)[:, None]
-    # barycentrics of the slave's projection: signed sub-areas over the area, along the face normal
-    q = x[rows.slave]
-    b = np.stack([np.einsum("ij,ij->i", np.cross(p[:, (l + 1) % 3] - q, p[:, (l + 2) % 3] - q), face_normal)
-                  for l in range(3)], axis=1) / np.where(degenerate, 1.0, length)[:, None]
-    n = face_normal * np.where(np.einsum("ij,ij->i", face_normal, rows.normal) < 0, -1.0, 1.0)[:, None]
-    n[degenerate] = rows.normal[degenerate]
-    b = np.clip(b, 0.0, None)
-    b /= np.where(b.sum(axis=1) > 0, b.sum(axis=1), 1.0)[:, None]
-    corner = rows.master[np.arange(len(rows)), np.argmax(rows.bary, axis=1)]
-    keep = degenerate | ((rows.bary.max(axis=1) == 1.0) & np.all(X[corner] == X[rows.slave], axis=1))
-    b[keep] = rows.bary[keep]
-    dist = np.einsum("ij,ij->i", q - np.einsum("ij,ijk->ik", b, p), n)
-    return NodeToFaceRows(rows.slave, rows.master, rows.face, b, n, dist,
-                          _gap_offset(X, rows.slave, rows.master, b, n), nv=rows.nv)
+    b, n, dist, g = _ext.RelineariseRows3d(X, x, rows.slave, rows.master, rows.bary, rows.normal)
+    return NodeToFaceRows(rows.slave, rows.master, rows.face, b, n, dist, g, nv=rows.nv)
