@@ -39,7 +39,9 @@ Candidates, each identified by its key ("f", slave, master vertices sorted):
   :func:`~ngfracture.contact.junctions3d.covered_pairs`) talks to it through that row only
   (a diagonal neighbour at a junction has none, and its overlap is a found row); a lip
   vertex found in its own fragment, through the lip row of its pair of copies. A found
-  row stays a candidate while it is active or found again, as in 2D.
+  row stays a candidate while it is active or found again, as in 2D, and once the
+  complementarity problem chooses the set, while it has been wanted or imposed in the
+  solve (a row the problem released must stay visible to the next problem).
 
 Every round re-linearises all candidates at the configuration of the last solve
 (:func:`~ngfracture.contact.rows3d.relinearise_node_to_face`), and rows whose gap does not
