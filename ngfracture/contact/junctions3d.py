@@ -39,11 +39,11 @@ twin opposing the slave's vertex normal), which the patch test needs.
 """
 import numpy as np
 
-from .kinks3d import KINK, CopyIndex, expand_ranges, unique_ints
+from .. import _ngfracture as _ext
+from .kinks3d import KINK, CopyIndex, unique_ints
 from .rows3d import NodeToFaceRows, face_gap_rows, fragment_twin_rows, no_face_rows
 
 __all__ = ["fragment_pair_rows", "covered_pairs"]
-
 
 
 def _on_several_fragments(pid, vf):
@@ -59,17 +59,6 @@ def _on_several_fragments(pid, vf):
     several[point[fragment != some[point]]] = True          # another copy on another fragment
     out[on] = several[point]
     return out
-
-
-def _matched_faces(index, face_fragment):
-    """Ordered pairs (a, b) of faces on the same three points and on different fragments."""
-    order, group = index.key_order, index.key_sorted      # faces by sorted point triple, stable
-    first = np.searchsorted(group, group)
-    size = np.searchsorted(group, group, side="right") - first
-    who, other = expand_ranges(first, size)
-    a, b = order[who], order[other]
-    keep = face_fragment[a] != face_fragment[b]
-    return a[keep], b[keep]
 
 
 def _checked(points, faces, vertex_fragment):
@@ -88,17 +77,6 @@ def _checked(points, faces, vertex_fragment):
     if vf.shape != (nv,) or (vf.size and not np.issubdtype(vf.dtype, np.integer)):
         raise ValueError(f"vertex_fragment must be integers of shape ({nv},), got {vf.dtype} {vf.shape}")
     return X, F, vf.astype(np.int64)
-
-
-def _order_by(fragment, slave, master_fragment, face, nv, nf):
-    """``np.lexsort((face, master_fragment, slave, fragment))``: where the fragments are
-    non-negative and the codes fit, one stable sort of the int64 codes (the same order;
-    lexsort sorts key by key, twice as slow)."""
-    k = int(max(fragment.max(initial=0), master_fragment.max(initial=0))) + 1
-    low = min(fragment.min(initial=0), master_fragment.min(initial=0))
-    if low < 0 or float(k) * k * nv * nf >= 2.0 ** 62:
-        return np.lexsort((face, master_fragment, slave, fragment))
-    return np.argsort(((fragment * nv + slave) * k + master_fragment) * nf + face, kind="stable")
 
 
 def fragment_pair_rows(points, faces, vertex_fragment, index=None):
@@ -134,49 +112,23 @@ def fragment_pair_rows(points, faces, vertex_fragment, index=None):
     nv = len(X)
     index = CopyIndex(X, F) if index is None else index
     pid = index.point
-    ff = vf[F[:, 0]] if len(F) else np.zeros(0, dtype=np.int64)
-    a, b = _matched_faces(index, ff)
-    matched = np.zeros(nv, dtype=bool)
-    matched[F[a].ravel()] = True
+    # C++ (cpp_ext/contact_setup3d.cpp; tests/test_fragment_pair_kernel.py keeps the numpy
+    # computation and compares): for every pair of matched faces a, b on fragments F > G
+    # and every corner t of b, the copy s of t's point on a; per (s, t) the face at t whose
+    # unit normal is nearest to the area-weighted mean normal of the matched faces at t
+    # (ties: the smaller face), and where three or more copies meet every face off its
+    # plane by more than KINK; sorted by (s's fragment, s, G, face), stably
+    slave, face, k, matched = _ext.FragmentPairEntries(F, vf, pid, index.key_order, index.key_sorted, index.area2,
+                                                       index.unit, index.copies, KINK)
     fallback = no_face_rows(nv)
     if np.any(_on_several_fragments(pid, vf) & ~matched):      # else every fallback row is dropped
         fallback = fragment_twin_rows(X, F, vf, index=index)
         fallback = fallback.subset(np.flatnonzero(~matched[fallback.slave]))
-    one_way = ff[a] > ff[b]
-    a, b = a[one_way], b[one_way]
-    if not len(a):
+    if not len(slave):
         return fallback
-    # every corner k of master face b, with the slave: the copy of its point on face a
-    same = pid[F[b]][:, :, None] == pid[F[a]][:, None, :]              # [pair, k in b, j in a]
-    slave = F[a][np.arange(len(a))[:, None], same.argmax(axis=2)].ravel()
-    face = np.repeat(b, 3)
-    k = np.tile(np.arange(3), len(b))
-    area2, unit = index.area2, index.unit
-    copy = F[face, k]
-    group = np.argsort(slave * nv + copy, kind="stable")                 # by (slave, master copy): lexsort's order
-    slave, face, k, copy = slave[group], face[group], k[group], copy[group]
-    start = np.r_[True, (slave[1:] != slave[:-1]) | (copy[1:] != copy[:-1])]
-    owner = np.cumsum(start) - 1
-    # the sums in the order of the rows from 0.0, as np.add.at makes them
-    mean = np.stack([np.bincount(owner, weights=area2[face, d], minlength=owner[-1] + 1) for d in range(3)], axis=1)
-    score = np.einsum("ij,ij->i", unit[face], mean[owner])
-    best = np.lexsort((face, -score, owner))
-    best = best[np.r_[True, owner[best][1:] != owner[best][:-1]]]
-    # where three or more copies meet (a crack reaching an interface) and the surface at the
-    # master copy bends, every matched face there off the best one's plane gets its row too
-    copies = index.copies
-    chosen = np.empty(owner[-1] + 1, dtype=np.int64)
-    chosen[owner[best]] = face[best]
-    bend = 1.0 - np.einsum("ij,ij->i", unit[face], unit[chosen[owner]]) > KINK
-    keep = np.zeros(len(face), dtype=bool)
-    keep[best] = True
-    keep |= bend & (copies[pid[slave]] >= 3)
-    slave, face, k = slave[keep], face[keep], k[keep]
-    order = _order_by(vf[slave], slave, ff[face], face, nv, len(F))
-    slave, face, k = slave[order], face[order], k[order]
     bary = np.zeros((len(slave), 3))
     bary[np.arange(len(slave)), k] = 1.0
-    master, normal = F[face], unit[face]
+    master, normal = F[face], index.unit[face]
     _, g = face_gap_rows(X, slave, master, bary, normal)
     rows = NodeToFaceRows(slave=slave, master=master, face=face, bary=bary, normal=normal, dist=g.copy(), g=g, nv=nv)
     return NodeToFaceRows.stack([rows, fallback]) if len(fallback) else rows

@@ -24,6 +24,7 @@ set imposes the ones that bind.
 """
 import numpy as np
 
+from .. import _ngfracture as _ext
 from .intsets import isin_ints, sorted_members, unique_ints
 
 __all__ = ["KINK", "CopyIndex", "point_groups", "point_ids", "face_point_keys", "partner_faces", "expand_ranges",
@@ -137,27 +138,28 @@ class CopyIndex:
         Every face's area normal (cross product of its edges from corner 0) and unit normal.
     vertex_keys : numpy.ndarray of int64
         The codes v (nf + 1) + face_key of every (vertex, face) incidence, sorted, unique.
+
+    Raises
+    ------
+    ValueError
+        On points not finite or not of shape (nv, 3), faces not of shape (nf, 3) or with
+        vertex numbers outside [0, nv).
     """
 
     def __init__(self, points, faces):
         self.points = np.array(points, dtype=np.float64)
         self.faces = np.array(faces, dtype=np.int64).reshape(-1, 3)
-        self.on, self.group = point_groups(self.points, self.faces)
+        if self.points.ndim != 2 or self.points.shape[1] != 3 or not np.isfinite(self.points).all():
+            raise ValueError(f"CopyIndex: points must be finite numbers of shape (nv, 3), got shape {self.points.shape}")
+        # C++ (cpp_ext/contact_setup3d.cpp), bit for bit the numpy computation of the
+        # attributes' descriptions (tests/test_copy_index.py keeps it and compares)
+        (self.on, self.group, self.face_key, self.key_order, self.incidence, self.area2, self.unit,
+         self.vertex_keys) = _ext.CopyIndexArrays(self.points, self.faces)
         self.point = np.full(len(self.points), -1, dtype=np.int64)
         self.point[self.on] = self.group
         self.copies = np.bincount(self.group, minlength=1)
-        self.face_key = face_point_keys(self.faces, self.point)
-        self.key_order = np.argsort(self.face_key, kind="stable")
         self.key_sorted = self.face_key[self.key_order]
-        flat = self.faces.ravel()
-        self.incidence = np.argsort(flat, kind="stable")
-        self.incident = flat[self.incidence]
-        p = self.points[self.faces]
-        self.area2 = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
-        self.unit = self.area2 / np.linalg.norm(self.area2, axis=1)[:, None]
-        nk = len(self.faces) + 1
-        # in the vertices' order (mostly sorted: the stable sort of unique_ints finds the runs)
-        self.vertex_keys = unique_ints((flat * nk + np.repeat(self.face_key, 3))[self.incidence])
+        self.incident = self.faces.ravel()[self.incidence]
 
 
 def partner_faces(points, faces, slave, copy, all_pairs, one_way=True, index=None):

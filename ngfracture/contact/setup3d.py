@@ -14,6 +14,7 @@ with one made afresh, bit for bit (``tests/test_contact3d_setup.py``).
 """
 import numpy as np
 
+from .. import _ngfracture as _ext
 from .active_set import RowKeys
 from .collision3d import PenetrationDetector3d
 from .junctions3d import covered_pairs, fragment_pair_rows
@@ -45,13 +46,11 @@ class FaceKeys:
         F = np.asarray(faces)
         if F.ndim != 2 or F.shape[1] != 3 or (F.size and (not np.issubdtype(F.dtype, np.integer) or F.min() < 0)):
             raise ValueError(f"faces must be vertex numbers >= 0 of shape (nf, 3), got {F.dtype} {F.shape}")
-        S = np.sort(F.astype(np.int64), axis=1)
-        order = np.lexsort((S[:, 2], S[:, 1], S[:, 0]))
-        S = S[order]
-        first = np.r_[True, np.any(S[1:] != S[:-1], axis=1)] if len(S) else np.zeros(0, dtype=bool)
-        self.triples = S[first]                 # the distinct vertex sets, sorted
-        self.face_set = np.empty(len(S), dtype=np.int64)
-        self.face_set[order] = np.cumsum(first) - 1
+        F = F.astype(np.int64)
+        # the distinct sorted triples in order and every face's number among them (C++,
+        # cpp_ext/contact_setup3d.cpp: np.sort, np.lexsort and a cumsum of the first of
+        # every run, bit for bit; tests/test_contact3d_setup_kernels.py compares)
+        _, self.face_set, self.triples = _ext.SortedTripleRanks(F, int(F.max(initial=-1)) + 1)
         self.n = max(len(self.triples), 1)
         self._lookup = None
 
