@@ -1,11 +1,14 @@
-"""A fragmented cube whose blocks overlap: the common body of the 3D contact tests.
+"""A fragmented cube whose blocks overlap: the common body of the 3D contact tests, and
+the bit-for-bit comparison of their node-to-face rows.
 
-Used by ``test_contact3d_keys.py`` (with noise) and ``test_active_set_settle.py``
-(without); import with ``PYTHONPATH=.:tests``.
+Used by ``test_contact3d_keys.py`` (with noise), ``test_active_set_settle.py`` (without),
+``test_contact3d_reuse.py`` and ``test_contact3d_setup.py``; import with
+``PYTHONPATH=.:tests``.
 """
 import numpy as np
 
 from ngfracture.contact.active_set import Geometry
+from ngfracture.contact.rows3d import NodeToFaceRows
 from ngfracture.geometry.pieces import fragmented_box
 
 
@@ -49,3 +52,14 @@ def overlapping_blocks(cells, pieces, expansion, noise=0.0, seed=0):
 def block_geometry(arrays, piece):
     """The ``active_set.Geometry`` of the blocks: no seams, no fixed vertex."""
     return Geometry(arrays=arrays, fragment=piece, seams=None, fixed=np.zeros(0, dtype=np.int64))
+
+
+def assert_same_rows(a, b):
+    """Two ``NodeToFaceRows`` equal bit for bit: their length, every field and the CSR arrays of C."""
+    assert len(a) == len(b)
+    for f in NodeToFaceRows.FIELDS:
+        assert np.array_equal(getattr(a, f), getattr(b, f)), f
+    ca, cb = a.C.tocsr(), b.C.tocsr()
+    assert ca.shape == cb.shape
+    for f in ("indptr", "indices", "data"):
+        assert np.array_equal(getattr(ca, f), getattr(cb, f)), f

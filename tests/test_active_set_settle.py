@@ -108,8 +108,7 @@ def test_a_row_the_complementarity_problem_released_stays_a_candidate():
         chosen = np.setdiff1d(kept, found[:5])                   # five found rows released
         round_number = active.pdas_rounds + 1 if exact else 1
         active.choose(cand, want, kept, round_number, lambda rows, idx: chosen)
-        if not exact:
-            active.exact = False
+        assert active.exact == exact                             # round 1: the update chooses
         active.record(cand.keys, chosen, -np.ones(len(chosen)), 1.0)
         cand = active.update(np.zeros_like(U), {"collision": 0.0})   # the blocks apart: nothing found
         now = set(cand.keys.codes.tolist())

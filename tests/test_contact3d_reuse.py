@@ -14,20 +14,10 @@ from ngfracture.contact.active_set3d import ActiveSet3d
 from ngfracture.contact.collision3d import detect_penetrations_3d
 from ngfracture.contact.rows3d import NodeToFaceRows, relinearise_node_to_face
 
-from blocks3d import block_geometry, overlapping_blocks
+from blocks3d import assert_same_rows, block_geometry, overlapping_blocks
 from detection3d_util import MasterReference, brute_force_pairs
 
 CELLS, PIECES = 4, 2
-
-
-def _same_rows(a, b):
-    """Every field and the CSR arrays of C equal, bit for bit."""
-    for f in NodeToFaceRows.FIELDS:
-        assert np.array_equal(getattr(a, f), getattr(b, f)), f
-    ca, cb = a.C.tocsr(), b.C.tocsr()
-    assert ca.shape == cb.shape
-    for f in ("indptr", "indices", "data"):
-        assert np.array_equal(getattr(ca, f), getattr(cb, f)), f
 
 
 def test_a_block_pushed_through_closed_lips_finds_every_pair():
@@ -69,7 +59,7 @@ def test_subset_and_stack_carry_the_gap_rows():
                             NodeToFaceRows.stack([plain.subset(pick), plain.subset(mask)])),
                            (NodeToFaceRows.stack([built.subset(mask)]), NodeToFaceRows.stack([plain.subset(mask)]))):
         assert "C" in carried.__dict__ and "C" not in fresh.__dict__
-        _same_rows(carried, fresh)
+        assert_same_rows(carried, fresh)
 
 
 def test_settling_takes_the_update_s_relinearisation():
@@ -84,4 +74,4 @@ def test_settling_takes_the_update_s_relinearisation():
     cand = active.update(U2, {"collision": 0.0})
     assert cand.relinearised is not None and 0 < len(cand.relinearised) < len(cand.rows)
     reused = active._fresh_rows(cand, U2)
-    _same_rows(reused, relinearise_node_to_face(cand.rows, arrays.points, U2))
+    assert_same_rows(reused, relinearise_node_to_face(cand.rows, arrays.points, U2))

@@ -17,7 +17,6 @@ import numpy as np
 import pytest
 
 from ngfracture.contact.active_set3d import ActiveSet3d
-from ngfracture.contact.rows3d import NodeToFaceRows
 from ngfracture.contact.setup3d import MeshSetup3d, MeshSetups
 from ngfracture.contact.solver import ContactSolver
 from ngfracture.geometry.solid import solid_mesh
@@ -25,20 +24,9 @@ from ngfracture.mechanics.materials import LinearElastic
 from ngfracture.mechanics.problem import ElasticProblem
 from ngfracture.scenes import two_blocks_mesh
 
-from blocks3d import block_geometry, overlapping_blocks
+from blocks3d import assert_same_rows, block_geometry, overlapping_blocks
 
 CELLS, PIECES = 4, 2
-
-
-def _same_rows(a, b):
-    """Every field and the CSR arrays of C equal, bit for bit."""
-    assert len(a) == len(b)
-    for f in NodeToFaceRows.FIELDS:
-        assert np.array_equal(getattr(a, f), getattr(b, f)), f
-    ca, cb = a.C.tocsr(), b.C.tocsr()
-    assert ca.shape == cb.shape
-    for f in ("indptr", "indices", "data"):
-        assert np.array_equal(getattr(ca, f), getattr(cb, f)), f
 
 
 def _blocks_problem(mesh, top):
@@ -66,7 +54,7 @@ def test_a_later_solve_on_the_mesh_takes_the_set_up_and_equals_a_fresh_one():
     assert len(fresh.active_keys) > 20 and cached.active_keys == fresh.active_keys
     assert cached.rounds == fresh.rounds
     assert np.array_equal(cached.multipliers, fresh.multipliers)
-    _same_rows(cached.constraints, fresh.constraints)
+    assert_same_rows(cached.constraints, fresh.constraints)
     assert np.array_equal(cached_prob.u.vec.FV().NumPy(), fresh_prob.u.vec.FV().NumPy())
 
 
@@ -98,14 +86,14 @@ def test_active_set_rounds_with_a_reused_set_up_equal_fresh_ones():
     assert setups.made == 1 and setups.setup(copy.points, copy.tets, copy.faces, piece) is setup
     assert len(fresh[0][0].keys) > 100 and first[1][4] and fresh[1][4]      # settled in round 2
     for a, b in zip(reused, fresh):
-        _same_rows(a[0].rows, b[0].rows)
+        assert_same_rows(a[0].rows, b[0].rows)
         assert np.array_equal(a[0].keys.codes, b[0].keys.codes)
         assert np.array_equal(a[0].gap, b[0].gap)
         for i in (1, 2, 3):
             assert np.array_equal(a[i], b[i])
         assert a[4:] == b[4:]
     assert mult_reused == mult_fresh
-    _same_rows(setup.rows, rows_before)                         # the solve left the set-up alone
+    assert_same_rows(setup.rows, rows_before)                         # the solve left the set-up alone
 
 
 @pytest.mark.parametrize("change", ["point", "negative_zero", "tet", "fragment", "dtype"])
