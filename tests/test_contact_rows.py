@@ -376,6 +376,35 @@ def test_rows_independent_of_dirichlet_rows():
     assert 0 not in keep.tolist()
 
 
+def test_a_large_component_with_hold_rows_takes_the_dense_qr(monkeypatch):
+    """A component of more rows than ``dense_limit``, joined by rows kept in any case (the
+    holds of a piece on its rigid modes, dense over its dofs), as a junction of the free
+    sphere has: LAPACK's pivoted QR on the dense block keeps a maximal independent set
+    (the rank of [G; C] less that of G, by the SVD), as the C++ QR on the supports does."""
+    rng = np.random.default_rng(11)
+    ndof, r, m = 240, 90, 400
+    base = np.zeros((r, ndof))
+    for i in range(r):
+        base[i, rng.choice(ndof, 9, replace=False)] = rng.uniform(-1, 1, 9)
+    rows = base[rng.integers(0, r, m)] * rng.choice([-2.0, 0.5, 1.0], (m, 1))
+    combo = rng.uniform(size=m) < 0.3
+    rows[combo] += base[rng.integers(0, r, combo.sum())]
+    rows[:r] = base
+    G = rng.standard_normal((6, ndof))
+    C = sp.csr_matrix(rows)
+    dense = []
+    original = redundancy._dense_pivoted_qr
+    monkeypatch.setattr(redundancy, "_dense_pivoted_qr", lambda *a: dense.append(1) or original(*a))
+    keep = contact.independent_rows(C, G=G, dense_limit=256)
+    assert dense == [1]
+    rank = np.linalg.matrix_rank(np.vstack([G, rows])) - np.linalg.matrix_rank(G)
+    assert len(keep) == rank
+    assert np.linalg.matrix_rank(np.vstack([G, rows[keep]])) == 6 + rank
+    assert len(contact.independent_rows(C, G=G, method="pivoted")) == rank
+    monkeypatch.setattr(redundancy, "DENSE_QR_MAX_ENTRIES", 0)       # too large a block: C++
+    assert len(contact.independent_rows(C, G=G, dense_limit=256)) == rank and dense == [1]
+
+
 def test_independent_rows_validation_and_empty():
     assert contact.independent_rows(sp.csr_matrix((0, 10))).shape == (0,)
     C = sp.csr_matrix(np.eye(3, 10))

@@ -4,7 +4,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from ngfracture.linalg.qp import Infeasible, QPError, convex_qp
+from ngfracture.linalg.qp import Infeasible, QPError, bound_qp, convex_qp
 
 
 def kuhn_tucker_error(H, c, A_eq, b_eq, A_in, b_in, x, u_eq, u_in):
@@ -86,3 +86,63 @@ def test_a_nearly_singular_h_is_an_error_not_a_huge_answer():
     data = np.load(Path(__file__).parent / "data" / "qp_nearly_singular.npz")
     with pytest.raises(QPError, match="nearly singular"):
         convex_qp(*(data[k] for k in ("H", "c", "A_eq", "b_eq", "A_in", "b_in")))
+
+
+def bounds_of(n, bounded):
+    """The rows -x_i >= 0 of the bounds x_i <= 0 (i in ``bounded``) as convex_qp takes them."""
+    return -np.eye(n)[bounded], np.zeros(len(bounded))
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_a_dual_method_started_from_any_working_set_ends_at_the_same_point(seed):
+    """Goldfarb-Idnani from a start set (right, wrong, dependent on the equalities): the
+    inequalities with negative multipliers or dependent vectors are dropped, the rest is
+    an S-pair, and the method ends at the unique Kuhn-Tucker point of the cold start."""
+    rng = np.random.default_rng(200 + seed)
+    n, p = 40, 3
+    B = rng.standard_normal((n, n))
+    H, c = B @ B.T + 1e-2 * np.eye(n), rng.standard_normal(n)
+    A_eq, b_eq = rng.standard_normal((p, n)), rng.standard_normal(p)
+    bounded = rng.choice(n, 30, replace=False)
+    A_in, b_in = bounds_of(n, bounded)
+    cold = convex_qp(H, c, A_eq, b_eq, A_in, b_in)
+    for start in (np.flatnonzero(cold[3]), np.arange(30), rng.choice(30, 12, replace=False), np.arange(0)):
+        x, u_eq, u_in, active = convex_qp(H, c, A_eq, b_eq, A_in, b_in, start=start)
+        assert kuhn_tucker_error(H, c, A_eq, b_eq, A_in, b_in, x, u_eq, u_in) < 1e-10
+        assert np.array_equal(active, cold[3])
+        assert np.abs(x - cold[0]).max() < 1e-10 * np.abs(cold[0]).max()
+
+
+def test_primal_dual_sweeps_alone_solve_an_m_matrix_problem():
+    """For an M-matrix (a 1D Laplacian plus a shift) the primal-dual sweeps converge
+    monotonically, in at most one sweep per bound (Hintermüller, Ito, Kunisch 2003): the
+    dual method is not needed, and the point is the Kuhn-Tucker point."""
+    n = 800
+    H = 2.1 * np.eye(n) - np.eye(n, k=1) - np.eye(n, k=-1)
+    c = np.sin(np.linspace(0.0, 25.0, n)) + 0.2
+    bounded = np.arange(n)
+    answer = bound_qp(H, c, np.zeros((0, n)), np.zeros(0), bounded, max_sweeps=n + 1)
+    assert not answer.dual_steps and answer.sweeps > 1
+    A_in, b_in = bounds_of(n, bounded)
+    assert kuhn_tucker_error(H, c, np.zeros((0, n)), np.zeros(0), A_in, b_in, answer.x, answer.u_eq,
+                             answer.u_bound) < 1e-10
+    assert np.array_equal(answer.held, convex_qp(H, c, np.zeros((0, n)), np.zeros(0), A_in, b_in)[3])
+
+
+@pytest.mark.parametrize("seed", range(2))
+def test_sweeps_that_do_not_settle_are_finished_by_the_dual_method(seed):
+    """Contact-sized, no M-matrix (dense mixed-sign coupling), six equalities for free
+    modes, two sweeps allowed (fewer than these problems need): the dual method finishes
+    from the sweeps' best guess, and the answer is the cold dual method's Kuhn-Tucker point
+    with its working set."""
+    rng = np.random.default_rng(300 + seed)
+    n = 500
+    B = rng.standard_normal((n, n)) / np.sqrt(n)
+    H, c = B @ B.T + 1e-2 * np.eye(n), rng.standard_normal(n)
+    A_eq, b_eq = rng.standard_normal((6, n)), rng.standard_normal(6)
+    bounded = np.arange(6, n)
+    answer = bound_qp(H, c, A_eq, b_eq, bounded, max_sweeps=2)
+    assert answer.dual_steps and answer.sweeps == 2
+    A_in, b_in = bounds_of(n, bounded)
+    assert kuhn_tucker_error(H, c, A_eq, b_eq, A_in, b_in, answer.x, answer.u_eq, answer.u_bound) < 1e-10
+    assert np.array_equal(answer.held, convex_qp(H, c, A_eq, b_eq, A_in, b_in)[3])

@@ -57,7 +57,7 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 
 from .factor import EliminatedFactor, SingularSystem
-from .qp import convex_qp
+from .qp import bound_qp
 
 
 class ConstrainedSolver:
@@ -334,8 +334,9 @@ class ConstrainedSolver:
 
             min 1/2 lam^T S lam - b^T lam   s.t.  G^T lam = R^T q,  lam_i <= 0 (i unilateral)
 
-        with b = C (du_fixed + K^+ q) - h, solved exactly by the dual active-set method
-        (:func:`ngfracture.linalg.qp.convex_qp`); S is positive definite on the null space of G^T
+        with b = C (du_fixed + K^+ q) - h, solved exactly by :func:`ngfracture.linalg.qp.bound_qp`
+        (the dual active-set method, from a primal-dual guess of the working set when
+        there are many candidate rows); S is positive definite on the null space of G^T
         when the rows are independent and the free modes held, as the constructor checks.
         With ``dependent_rows`` S is only semidefinite: 1e-10 (relative to its unit
         diagonal after equilibration) is added to it, which picks the smallest multipliers
@@ -383,9 +384,10 @@ class ConstrainedSolver:
         if self._coarse is None:
             H += 1e-10 * np.eye(self.m)
         e = gscale * (self._R.T @ q)
-        y, alpha, _, active = convex_qp(H, d * b + Gs @ e, Gs.T, e, -np.eye(self.m)[bounded], np.zeros(bounded.sum()))
+        answer = bound_qp(H, d * b + Gs @ e, Gs.T, e, np.flatnonzero(bounded))
+        y, alpha = answer.x, answer.u_eq
         released = np.zeros(self.m, dtype=bool)
-        released[np.flatnonzero(bounded)[active]] = True
+        released[np.flatnonzero(bounded)[answer.held]] = True
         y[released] = 0.0                        # released rows carry exactly nothing
         lam = d * y
         du -= self._correction(lam)

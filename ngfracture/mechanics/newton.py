@@ -351,7 +351,7 @@ class NewtonSolver:
         SingularSystem
             An unheld free mode or a singular stiffness.
         qp.QPError
-            If the dual active-set method fails (see :func:`ngfracture.linalg.qp.convex_qp`).
+            If the complementarity problem is not solved (see :func:`ngfracture.linalg.qp.bound_qp`).
         """
         prob = self.problem
         rows = prob.assemble_constraints()
