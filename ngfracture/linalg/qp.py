@@ -240,9 +240,10 @@ def bound_qp(H, c, A_eq, b_eq, bounded, tol=1e-12, max_sweeps=8):
     bounded : numpy.ndarray of int
         The variables bounded above by 0.
     tol : float
-        For the sweeps: a bound counts as violated when x_i exceeds tol times max |x|, a
-        multiplier when it is below -tol times the largest of |c| and |H x|; for the dual
-        method as in :func:`convex_qp`.
+        For the sweeps: a bound counts as violated when x_i exceeds tol times max |x| (a
+        multiplier when it is below -sqrt(n) eps times the largest of |c| and |H x|: to
+        rounding, as the dual method keeps them); for the dual method as in
+        :func:`convex_qp`.
     max_sweeps : int
 
     Returns
@@ -279,16 +280,18 @@ def _primal_dual_sweeps(H, c, E, e, bounded, tol, max_sweeps):
     is_bound = np.zeros(n, dtype=bool)
     is_bound[bounded] = True
     held = is_bound & (c > 0)
-    best, fewest = held, np.inf
+    best, fewest, sweep = held, np.inf, 0
     for sweep in range(1, max_sweeps + 1):
         x, u_eq = _minimiser_on(H, c, E, e, ~held)
         if x is None:
             break
         u = np.zeros(n)                  # H x - c = E^T u_eq - u on the held bounds
         u[held] = c[held] + E[:, held].T @ u_eq - H[held] @ x
+        # the dual test to rounding only (the dual method keeps u >= 0 exactly): in the
+        # nearly singular H of dependent rows a pull of 1e-11 |c| is a force of 1e-2 |x|
         force = max(np.abs(c).max(initial=0.0), np.abs(H @ x).max(initial=0.0), 1e-300)
         rises = ~held & is_bound & (x > tol * max(np.abs(x).max(initial=0.0), 1e-300))
-        pulls = held & (u < -tol * force)
+        pulls = held & (u < -np.sqrt(n) * np.finfo(float).eps * force)
         violations = int(rises.sum() + pulls.sum())
         if violations == 0:
             return (x, u_eq, u[bounded], held[bounded]), None, sweep
