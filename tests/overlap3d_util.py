@@ -21,3 +21,12 @@ def check_run_overlap(folder, tol=TOL):
         assert ov.volume <= tol * ov.body_volume, (name, ov.volume, ov.body_volume, ov.pairs[:5])
         out[name] = ov
     return out
+
+
+def check_step_overlap(folder, step, tol=TOL):
+    """Assert the overlap of the written ``step_NNNNNN.vtu`` of ``step`` at most ``tol`` of the
+    body's volume (a run's ``on_step``: a long run stops at its first violation)."""
+    name = f"step_{step:06d}.vtu"
+    ov = vtu_overlap_volume(Path(folder) / name)
+    assert ov.volume <= tol * ov.body_volume, (name, ov.volume / ov.body_volume, ov.pairs[:5])
+    return ov

@@ -26,7 +26,7 @@ import pytest
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
-from overlap3d_util import check_run_overlap
+from overlap3d_util import check_run_overlap, check_step_overlap
 
 from ngfracture.contact.solver import ContactSolver
 from ngfracture.fracture.strain import principal, vertex_displacement
@@ -188,6 +188,7 @@ def run_with_checks(scene, out):
         U = vertex_displacement(prob.u)
         steps.append((accepted.state.x, total_volume(a.points, a.tets), tet_volumes(a.points + U, a.tets).min(),
                       penetration_depth_3d(prob), crack_surfaces_from_hole(a), prob.fragments()[0]))
+        check_step_overlap(out, accepted.state.step)     # written before on_step: stop at a violation
 
     result = Simulation(scene, out=out, pictures="none").run(on_step=on_step)
     for step in steps:
