@@ -129,6 +129,33 @@ def test_contact_solver_holds_the_free_modes_of_3d_pieces(fix):
         assert abs(fz / area - sign * p) <= 1e-8 * p, (v, fz / area)
 
 
+def test_the_invariant_finds_faces_crossing_with_no_vertex_inside():
+    """Two unit cubes of one grid cell each, the upper turned 45 degrees about the vertical
+    axis and moved down by 0.01: no vertex of either lies inside the other (the turned
+    corners stick out past the lower cube's sides, the lower corners past the turned
+    square's edges), yet they share the octagon of the two squares (2 (sqrt 2 - 1) = 0.828)
+    times 0.01. check_state refuses it by the overlap volume."""
+    from ngfracture.geometry.solid import merge_bodies, solid_mesh
+    from ngfracture.geometry.structured import box_mesh
+    from ngfracture.mechanics.materials import LinearElastic
+    from ngfracture.mechanics.problem import ElasticProblem
+    from ngfracture.run.invariants import check_state, overlap_volume_3d
+    a = merge_bodies([("lower", box_mesh([0.0, 1.0], [0.0, 1.0], [0.0, 1.0])),
+                      ("upper", box_mesh([0.0, 1.0], [0.0, 1.0], [1.0, 2.0]))])
+    prob = ElasticProblem(solid_mesh(a), LinearElastic(E=3.0, nu=0.25))
+    n = prob.fes.ndof // 3
+    upper = np.unique(a.tets[a.regions == 2])
+    c, s = math.cos(math.pi / 4), math.sin(math.pi / 4)
+    x, y = a.points[upper, 0] - 0.5, a.points[upper, 1] - 0.5
+    u = prob.u.vec.FV().NumPy()
+    u[upper], u[n + upper], u[2 * n + upper] = c * x - s * y - x, s * x + c * y - y, -0.01
+    assert penetration_depth_3d(prob) == 0.0
+    assert overlap_volume_3d(prob) == pytest.approx(0.01 * 2 * (math.sqrt(2) - 1), rel=1e-12)
+    violation, depth = check_state(prob, total_volume(a.points, a.tets), True)
+    assert violation is not None and violation.invariant == "overlap" and depth == 0.0
+    assert "faces crossing" in violation.message
+
+
 def test_the_invariant_finds_a_penetrating_vertex():
     """Upper block moved down by 0.01 rigidly, no contact: its lower face is 0.01 deep in the
     lower block (and the lower block's top face 0.01 deep in it), which check_state refuses."""

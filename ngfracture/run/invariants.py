@@ -18,14 +18,17 @@ the step and the size of the violation in its reason.
   below 1e-10 of its detection threshold, a length; the overlap of the polygonal lips that
   remains is of second order in that (the scenes end with 1e-16 of the area or less,
   docs/verification.md). A run without contact (``contact="never"``) is held to the same
-  bound: pieces that only separate never overlap. In 3D the overlap volume is not
-  measured; what is checked is that no boundary vertex of a piece lies deeper than
-  :data:`OVERLAP_TOL` of the body's diameter (the diagonal of its bounding box) inside
-  another piece, or a lip vertex deeper in the other lip of its own crack, by
-  :func:`ngfracture.contact.collision3d.detect_penetrations_3d` (exact predicates), and
-  the largest depth is what the step records as its overlap. This is checked where a 3D
-  run solves with contact (bodies meshed apart, or cracks). The overlap volume itself is
-  measured from a run's written files by :func:`ngfracture.output.overlap3d.vtu_overlap_volume`.
+  bound: pieces that only separate never overlap. In 3D two things are checked: that no
+  boundary vertex of a piece lies deeper than :data:`OVERLAP_TOL` of the body's diameter
+  (the diagonal of its bounding box) inside another piece, or a lip vertex deeper in the
+  other lip of its own crack, by :func:`ngfracture.contact.collision3d.detect_penetrations_3d`
+  (exact predicates; the largest depth is what the step records as its overlap), and that
+  the volume shared by tetrahedra of different fragments is at most :data:`OVERLAP_TOL` of
+  the body's volume (:func:`overlap_volume_3d`, exact clipping): faces can cross with no
+  vertex inside another piece, which node-to-face rows do not hold (docs/solid.md,
+  "Overlap in the free run"). This is checked where a 3D run solves with contact (bodies
+  meshed apart, or cracks); the written files are measured the same way by
+  :func:`ngfracture.output.overlap3d.vtu_overlap_volume`.
 
 The checks cost a few percent of a run (docs/performance.md): the overlap is measured only
 where there are cracks or separate bodies.
@@ -36,10 +39,11 @@ import numpy as np
 
 from ..contact.collision3d import detect_penetrations_3d
 from ..contact.overlap import fragment_overlap_area
+from ..output.overlap3d import fragment_overlap_volume
 from ..fracture.strain import vertex_displacement
 from ..fracture.fragments import FragmentStatistics
 
-__all__ = ["OVERLAP_TOL", "Violation", "check_state", "penetration_depth_3d"]
+__all__ = ["OVERLAP_TOL", "Violation", "check_state", "penetration_depth_3d", "overlap_volume_3d"]
 
 #: overlap accepted between pieces, relative to the body's area
 OVERLAP_TOL = 1e-10
@@ -98,6 +102,12 @@ def check_state(problem, area_initial, with_overlap):
             return Violation("overlap", depth,
                              f"a vertex lies {depth:.3g} deep in another piece ({depth / diameter:.2g} of the "
                              f"body's diameter; at most {OVERLAP_TOL:g} of it is accepted)"), depth
+        volume = overlap_volume_3d(problem) if with_overlap else 0.0
+        if not volume <= OVERLAP_TOL * area_initial:
+            return Violation("overlap", volume,
+                             f"fragments overlap by {volume:.3g} ({volume / area_initial:.2g} of the volume; at "
+                             f"most {OVERLAP_TOL:g} of it is accepted) with no vertex inside another piece: "
+                             f"faces crossing"), depth
         return None, depth
     overlap = fragment_overlap_area(problem) if with_overlap else 0.0
     if not overlap <= OVERLAP_TOL * area_initial:
@@ -105,6 +115,26 @@ def check_state(problem, area_initial, with_overlap):
                          f"pieces overlap by {overlap:.3g} ({overlap / area_initial:.2g} of the area; "
                          f"at most {OVERLAP_TOL:g} of it is accepted)"), overlap
     return None, overlap
+
+
+def overlap_volume_3d(problem):
+    """The volume shared by tetrahedra of different fragments, in the deformed configuration.
+
+    Parameters
+    ----------
+    problem : ElasticProblem
+        A problem on a tetrahedral mesh, at its current displacement.
+
+    Returns
+    -------
+    float
+        :func:`ngfracture.output.overlap3d.fragment_overlap_volume` (exact clipping, C++),
+        the fragments being the mesh's connected pieces.
+    """
+    tets = problem.arrays.tets
+    _, piece = problem.fragments()
+    points = problem.arrays.points + vertex_displacement(problem.u)
+    return fragment_overlap_volume(points, tets, piece[tets[:, 0]], body_volume=0.0).volume
 
 
 def penetration_depth_3d(problem):
