@@ -198,9 +198,15 @@ def _dense_components(Ca, labels, dense_limit):
     large = np.flatnonzero(rows_per > dense_limit)
     if not len(large):
         return large
-    pairs = np.unique(np.repeat(labels, np.diff(Ca.indptr)).astype(np.int64) * Ca.shape[1] + Ca.indices)
-    columns_per = np.bincount(pairs // Ca.shape[1], minlength=len(rows_per))
+    columns_per = _columns_per_component(Ca, labels.astype(np.int64), len(rows_per))
     return large[rows_per[large] * columns_per[large] <= DENSE_QR_MAX_ENTRIES]
+
+
+def _columns_per_component(M, labels, components):
+    """The number of distinct columns the rows of each component touch (CSR ``M``, int64
+    ``labels`` per row)."""
+    pairs = np.unique(np.repeat(labels, np.diff(M.indptr)) * M.shape[1] + M.indices)
+    return np.bincount(pairs // M.shape[1], minlength=components)
 
 
 def _dense_pivoted_qr(Cc, Gc, rtol):
@@ -266,8 +272,7 @@ def _clearly_independent(C, G, rtol, labels_c, labels_g, limit=1500):
         return k == 0
     labels = np.concatenate([labels_g, labels_c]).astype(np.int64)
     rows_per = np.bincount(labels).astype(float)
-    pairs = np.unique(np.repeat(labels, np.diff(M.indptr)) * M.shape[1] + M.indices)
-    columns_per = np.bincount(pairs // M.shape[1], minlength=len(rows_per))
+    columns_per = _columns_per_component(M, labels, len(rows_per))
     if np.sum(rows_per ** 2 * columns_per) < float(k) ** 3:
         return False
     gram = (M @ M.T).toarray()

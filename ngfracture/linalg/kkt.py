@@ -384,10 +384,11 @@ class ConstrainedSolver:
         if self._coarse is None:
             H += 1e-10 * np.eye(self.m)
         e = gscale * (self._R.T @ q)
-        answer = bound_qp(H, d * b + Gs @ e, Gs.T, e, np.flatnonzero(bounded))
+        bounded_rows = np.flatnonzero(bounded)
+        answer = bound_qp(H, d * b + Gs @ e, Gs.T, e, bounded_rows)
         y, alpha = answer.x, answer.u_eq
         released = np.zeros(self.m, dtype=bool)
-        released[np.flatnonzero(bounded)[answer.held]] = True
+        released[bounded_rows[answer.held]] = True
         y[released] = 0.0                        # released rows carry exactly nothing
         lam = d * y
         du -= self._correction(lam)

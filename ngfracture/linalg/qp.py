@@ -226,9 +226,10 @@ def bound_qp(H, c, A_eq, b_eq, bounded, tol=1e-12, max_sweeps=8):
     1520 held bounds). Primal-dual active-set sweeps (Hintermüller, Ito, Kunisch, SIAM J.
     Optim. 13, 2003: the minimiser on the free variables, then hold the bounded ones that
     came out positive and free the held ones whose multiplier came out negative) guess the
-    working set; a sweep that changes nothing is the solution. These sweeps need not end when H is no M-matrix (nearly dependent
-    contact rows cycle), so after ``max_sweeps`` the dual method starts from the guess with
-    the fewest violations: finite, and a few steps from a good guess.
+    working set; a sweep that changes nothing is the solution. These sweeps need not end
+    when H is no M-matrix (nearly dependent contact rows cycle), so after ``max_sweeps``
+    the dual method starts from the guess with the fewest violations: finite, and a few
+    steps from a good guess.
 
     Parameters
     ----------

@@ -57,7 +57,8 @@ class Violation:
     ----------
     invariant : {"area", "inverted_element", "overlap"}
     size : float
-        How much: the area difference, the smallest det F, or the overlap area.
+        How much: the area difference, the smallest det F, or the overlap (the area in 2D;
+        in 3D the deepest vertex's depth or the overlap volume).
     message : str
         Says what, where and how much, against which tolerance.
     """
