@@ -16,10 +16,12 @@ best of three: "cholesky" (NGSolve's sparse Cholesky, then the columns K^+ C^T a
 "superlu" (SuperLU, then the sparse triangular solves of ``EliminatedFactor.schur``),
 "augmented" (SuperLU of the augmented matrix, ``EliminatedFactor.augmented``; no S).
 Reported per case: tets, factorised dofs, rows, each one's factorisation and Schur
-seconds, their sums and the ratios to "cholesky".
+seconds, their sums and the ratios to "cholesky". ``--hole-rows N`` adds one row (the x
+component) at each of the N free vertices nearest the hole (radius 0.25), as the contact
+rows of a cracked hole add to the stick rows.
 
-Usage: python benchmarks/schur.py [--factors 1 2 4 8 16] [--sphere FINE ... [--maxh H]]
-       [--json FILE [--force]]
+Usage: python benchmarks/schur.py [--factors 1 2 4 8 16] [--sphere FINE ... [--maxh H]
+       [--hole-rows N]] [--json FILE [--force]]
 """
 import argparse
 import time
@@ -70,8 +72,17 @@ def case(factor, repeat=3):
             "relative_difference": float(np.abs(S["sparse"] - S["columns"]).max() / np.abs(S["columns"]).max())}
 
 
-def sphere_case(fine, maxh=None, repeat=3):
-    """The three ways of a 3D factorisation with the sphere's stick rows (module docstring)."""
+def hole_rows(mesh, ndof, fixed_dofs, count):
+    """One row (the x component) at each of the ``count`` free vertices nearest the hole."""
+    X = np.array([v.point for v in mesh.vertices])
+    free = np.setdiff1d(np.arange(mesh.nv), fixed_dofs)       # x dofs are the vertex numbers
+    nearest = free[np.argsort(np.abs(np.linalg.norm(X[free], axis=1) - 0.25), kind="stable")[:count]]
+    return sp.csr_matrix((np.ones(len(nearest)), (np.arange(len(nearest)), nearest)), shape=(len(nearest), ndof))
+
+
+def sphere_case(fine, maxh=None, extra_rows=0, repeat=3):
+    """The three ways of a 3D factorisation with the sphere's stick rows and ``extra_rows``
+    rows at the hole (module docstring)."""
     from ngfracture.linalg.sparse import reproducible_threads
     kwargs = {"fine": fine} if maxh is None else {"fine": fine, "maxh": maxh}
     scene = scenes.sphere3d(**kwargs)
@@ -80,7 +91,9 @@ def sphere_case(fine, maxh=None, repeat=3):
     rows = prob.assemble_constraints()
     support = prob.support(rows)
     K, C = prob.tangent(), rows.C
-    out = {"fine": fine, "tets": scene.mesh.ne, "rows": C.shape[0]}
+    if extra_rows:
+        C = sp.vstack([C, hole_rows(scene.mesh, prob.fes.ndof, rows.fixed_dofs, extra_rows)]).tocsr()
+    out = {"fine": fine, "tets": scene.mesh.ne, "rows": C.shape[0], "hole_rows": extra_rows}
     for name in ("cholesky", "superlu", "augmented"):
         best = (np.inf, np.inf)
         for _ in range(repeat):
@@ -112,11 +125,13 @@ def main(argv=None):
     parser.add_argument("--sphere", nargs="+", type=float, default=None, metavar="FINE",
                         help="the sphere scene at these values of fine instead (3D ways)")
     parser.add_argument("--maxh", type=float, default=None, help="the sphere's maxh (with --sphere)")
+    parser.add_argument("--hole-rows", type=int, default=0,
+                        help="rows at this many vertices nearest the hole besides the stick rows (with --sphere)")
     benchmark_json.add_options(parser)
     args = parser.parse_args(argv)
     benchmark_json.refuse_existing(parser, args)
     if args.sphere:
-        cases = [sphere_case(fine, args.maxh) for fine in args.sphere]
+        cases = [sphere_case(fine, args.maxh, args.hole_rows) for fine in args.sphere]
         benchmark_json.write(args, {"sphere_cases": cases})
         return
     cases = [case(f) for f in args.factors]

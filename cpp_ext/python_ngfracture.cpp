@@ -286,6 +286,29 @@ perm : numpy.ndarray of int64
            }
            return x;
          }, py::arg("b"), "X = A^-1 B for a vector (n,) or a block (n, k); a new Fortran-ordered array.")
+    .def("forward_sparse", [] (const SupernodalLDL & self, I64 bp, I32 bi, F64 bx)
+         {
+           if (bp.ndim() != 1 || bp.shape(0) < 1 || bi.shape(0) < bp.data()[bp.shape(0) - 1]
+               || bx.shape(0) < bp.data()[bp.shape(0) - 1])
+             throw py::value_error("ngfracture.SupernodalLDL.forward_sparse: B must be CSC");
+           std::vector<int64_t> yp;
+           std::vector<int32_t> yi;
+           std::vector<double> yx;
+           {
+             py::gil_scoped_release release;
+             self.ForwardSparse(bp.shape(0) - 1, bp.data(), bi.data(), bx.data(), yp, yi, yx);
+           }
+           return py::make_tuple(py::array_t<int64_t>(yp.size(), yp.data()),
+                                 py::array_t<int32_t>(yi.size(), yi.data()),
+                                 py::array_t<double>(yx.size(), yx.data()));
+         }, py::arg("bp"), py::arg("bi"), py::arg("bx"),
+         R"doc(Y = L^-1 B for a sparse B (CSC, n rows, already permuted), through the supernodes
+its nonzeros reach only.
+
+Returns
+-------
+(yp, yi, yx)
+    CSC of Y: every row of every supernode a column reaches, increasing.)doc")
     .def_property_readonly("supernodes", &SupernodalLDL::Supernodes, "Number of supernodes.")
     .def_property_readonly("stored_entries", &SupernodalLDL::StoredEntries,
                            "Entries of the panels (the diagonal blocks' upper parts included).");

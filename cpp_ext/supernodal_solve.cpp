@@ -1,6 +1,8 @@
 // Triangular solves with a symmetric factorisation L D L^T kept in supernodes (see the header).
 #include "supernodal_solve.hpp"
+#include <algorithm>
 #include <cmath>
+#include <functional>
 #include <stdexcept>
 #include <string>
 
@@ -75,6 +77,86 @@ namespace ngfracture
           throw std::invalid_argument("SupernodalLDL: perm is not a permutation of 0 .. n-1");
         seen[perm_[i]] = 1;
       }
+    supernode_.resize(n);
+    for (int64_t t = 0; t < S; t++)
+      for (int64_t j = first_[t]; j < first_[t+1]; j++)
+        supernode_[j] = int32_t(t);
+  }
+
+  void SupernodalLDL::ForwardSupernode (int64_t s, double * z, double * acc) const
+  {
+    int64_t f = first_[s], c = first_[s+1] - f;
+    int64_t r = rowstart_[s+1] - rowstart_[s], m = r - c;
+    const int32_t * rows = rows_.data() + rowstart_[s] + c;
+    const double * P = values_.data() + valstart_[s];
+    double * zf = z + f;
+    for (int64_t t = 0; t < c; t++)
+      {
+        const double * pc = P + t * r;
+        double zt = zf[t];
+        for (int64_t i = t + 1; i < c; i++)
+          zf[i] -= pc[i] * zt;
+      }
+    for (int64_t i = 0; i < m; i++) acc[i] = 0.0;
+    for (int64_t t = 0; t < c; t++)
+      {
+        const double * pc = P + t * r + c;
+        double zt = zf[t];
+        for (int64_t i = 0; i < m; i++)
+          acc[i] += pc[i] * zt;
+      }
+    for (int64_t i = 0; i < m; i++)
+      z[rows[i]] -= acc[i];
+  }
+
+  void SupernodalLDL::ForwardSparse (int64_t m, const int64_t * bp, const int32_t * bi, const double * bx,
+                                     std::vector<int64_t> & yp, std::vector<int32_t> & yi,
+                                     std::vector<double> & yx) const
+  {
+    int64_t n = n_;
+    std::vector<double> z(n, 0.0), acc(n);
+    std::vector<int64_t> mark(first_.size(), -1);     // the column that last reached a supernode
+    std::vector<int32_t> next, done;                  // min-heap of supernodes to solve; solved
+    yp.assign(1, 0);
+    yi.clear();
+    yx.clear();
+    auto reach = [&] (int32_t s, int64_t k)
+      {
+        if (mark[s] == k) return;
+        mark[s] = k;
+        next.push_back(s);
+        std::push_heap(next.begin(), next.end(), std::greater<int32_t>());
+      };
+    for (int64_t k = 0; k < m; k++)
+      {
+        for (int64_t q = bp[k]; q < bp[k+1]; q++)
+          {
+            if (bi[q] < 0 || bi[q] >= n)
+              throw std::invalid_argument("SupernodalLDL.forward_sparse: right-hand side row out of range");
+            z[bi[q]] += bx[q];
+            reach(supernode_[bi[q]], k);
+          }
+        done.clear();
+        while (!next.empty())
+          {
+            std::pop_heap(next.begin(), next.end(), std::greater<int32_t>());
+            int32_t s = next.back();
+            next.pop_back();
+            done.push_back(s);
+            ForwardSupernode(s, z.data(), acc.data());
+            const int32_t * below = rows_.data() + rowstart_[s] + (first_[s+1] - first_[s]);
+            for (const int32_t * row = below; row < rows_.data() + rowstart_[s+1]; row++)
+              reach(supernode_[*row], k);
+          }
+        for (int32_t s : done)                        // increasing: popped from a min-heap
+          for (int64_t j = first_[s]; j < first_[s+1]; j++)
+            {
+              yi.push_back(int32_t(j));
+              yx.push_back(z[j]);
+              z[j] = 0.0;
+            }
+        yp.push_back(int64_t(yi.size()));
+      }
   }
 
   void SupernodalLDL::Solve (int64_t k, const double * B, double * X) const
@@ -94,31 +176,7 @@ namespace ngfracture
           z[perm_[i]] = b[i];
         // L y = P b, supernode by supernode
         for (int64_t s = 0; s < S; s++)
-          {
-            int64_t f = first_[s], c = first_[s+1] - f;
-            int64_t r = rowstart_[s+1] - rowstart_[s], m = r - c;
-            const int32_t * rows = rows_.data() + rowstart_[s] + c;
-            const double * P = values_.data() + valstart_[s];
-            double * zf = z.data() + f;
-            for (int64_t t = 0; t < c; t++)
-              {
-                const double * pc = P + t * r;
-                double zt = zf[t];
-                for (int64_t i = t + 1; i < c; i++)
-                  zf[i] -= pc[i] * zt;
-              }
-            double * acc = work.data();
-            for (int64_t i = 0; i < m; i++) acc[i] = 0.0;
-            for (int64_t t = 0; t < c; t++)
-              {
-                const double * pc = P + t * r + c;
-                double zt = zf[t];
-                for (int64_t i = 0; i < m; i++)
-                  acc[i] += pc[i] * zt;
-              }
-            for (int64_t i = 0; i < m; i++)
-              z[rows[i]] -= acc[i];
-          }
+          ForwardSupernode(s, z.data(), work.data());
         for (int64_t i = 0; i < n; i++)
           z[i] *= inv_d_[i];
         // L^T z = D^-1 y, supernodes in reverse

@@ -20,12 +20,21 @@ namespace ngfracture
                    const double * d, const int64_t * perm);
     // X = A^-1 B for k right-hand sides, B and X n x k column-major (may be the same array).
     void Solve (int64_t k, const double * B, double * X) const;
+    // Y = L^-1 B for a sparse B (n x m CSC, rows already permuted): per column, only the
+    // supernodes its nonzeros reach, in increasing order (the reach found supernode by
+    // supernode, a heap of the next ones). Output CSC (yp, yi, yx), every row of every
+    // supernode reached, rows increasing within a column.
+    void ForwardSparse (int64_t m, const int64_t * bp, const int32_t * bi, const double * bx,
+                        std::vector<int64_t> & yp, std::vector<int32_t> & yi, std::vector<double> & yx) const;
     int64_t Order () const { return n_; }
     int64_t Supernodes () const { return int64_t(first_.size()) - 1; }
     int64_t StoredEntries () const { return int64_t(values_.size()); }
 
   private:
     void SolveBlock (int64_t k, const double * B, double * X) const;
+    // L y = b on supernode s (z indexed by column): its diagonal block, then the rows
+    // below it; acc: room for the rows below
+    void ForwardSupernode (int64_t s, double * z, double * acc) const;
     int64_t n_;
     std::vector<int64_t> first_;     // first column of supernode s (first_[S] = n)
     std::vector<int64_t> rowstart_;  // its rows: rows_[rowstart_[s] .. rowstart_[s+1])
@@ -34,6 +43,7 @@ namespace ngfracture
     std::vector<double> values_;
     std::vector<double> inv_d_;
     std::vector<int64_t> perm_;
+    std::vector<int32_t> supernode_;  // the supernode of every column
   };
 }
 #endif

@@ -15,7 +15,7 @@ from ngfracture.geometry.solid import solid_mesh
 from ngfracture.geometry.structured import box_mesh
 from ngfracture.linalg import kept
 from ngfracture.linalg.factor import EliminatedFactor
-from ngfracture.linalg.iterative import ONCE_SUPERLU_MAX_DOFS, ONCE_SUPERLU_ROWS_PER_DOF, choose_inverse
+from ngfracture.linalg.iterative import SUPERLU_ROWS_MAX_DOFS, SUPERLU_ROWS_PER_DOF, choose_inverse
 from ngfracture.linalg.sparse import forget_thread_count, reproducible_threads
 from ngfracture.mechanics.materials import StVenantKirchhoff
 
@@ -100,18 +100,17 @@ def test_kept_columns_are_bounded(monkeypatch):
     assert count.columns == 16
 
 
-def test_a_one_use_3d_tangent_with_many_rows_takes_superlu():
-    n = ONCE_SUPERLU_MAX_DOFS
-    rows = int(np.ceil(ONCE_SUPERLU_ROWS_PER_DOF * n))
-    inverse, record = choose_inverse("auto", 3, n, budget=1e12, once_rows=rows)
-    assert inverse == "superlu" and record == {"solver": "superlu", "reason": "auto, one system with rows",
-                                               "dofs": n}
-    assert choose_inverse("auto", 3, n, budget=1e12, once_rows=rows - 1)[0] == "sparsecholesky"
-    assert choose_inverse("auto", 3, 100, budget=1e12, once_rows=1)[0] == "superlu"
-    assert choose_inverse("auto", 3, n + 1, budget=1e12, once_rows=10 ** 4)[0] == "sparsecholesky"
-    assert choose_inverse("auto", 3, n, budget=1e12)[0] == "sparsecholesky"        # a kept tangent
-    assert choose_inverse("auto", 2, n, once_rows=10 ** 4)[0] == "auto"             # 2D: its own rule
-    assert choose_inverse("sparsecholesky", 3, n, once_rows=10 ** 4)[0] == "sparsecholesky"
+def test_a_3d_tangent_with_many_rows_takes_superlu():
+    n = SUPERLU_ROWS_MAX_DOFS
+    rows = int(np.ceil(SUPERLU_ROWS_PER_DOF * n))
+    inverse, record = choose_inverse("auto", 3, n, budget=1e12, rows=rows)
+    assert inverse == "superlu" and record == {"solver": "superlu", "reason": "auto, many rows", "dofs": n}
+    assert choose_inverse("auto", 3, n, budget=1e12, rows=rows - 1)[0] == "sparsecholesky"
+    assert choose_inverse("auto", 3, 100, budget=1e12, rows=1)[0] == "superlu"
+    assert choose_inverse("auto", 3, n + 1, budget=1e12, rows=10 ** 4)[0] == "sparsecholesky"
+    assert choose_inverse("auto", 3, n, budget=1e12)[0] == "sparsecholesky"        # no general rows
+    assert choose_inverse("auto", 2, n, rows=10 ** 4)[0] == "auto"                  # 2D: its own rule
+    assert choose_inverse("sparsecholesky", 3, n, rows=10 ** 4)[0] == "sparsecholesky"
 
 
 def test_reproducible_threads_restores_the_count():

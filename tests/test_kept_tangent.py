@@ -6,6 +6,7 @@ factorisation less per step that starts from it, the same result after a resume,
 kept tangent that fails is replaced by a fresh one and recorded.
 """
 import json
+from dataclasses import replace
 
 import numpy as np
 import pyvista as pv
@@ -16,6 +17,8 @@ from ngfracture.linalg import factor as factor_module
 from ngfracture.run import tangents
 from ngfracture.linalg.factor import EliminatedFactor
 from ngfracture import Simulation, StepControl
+from ngfracture.mechanics.problem import ElasticProblem
+from ngfracture.run.state import load_state, save_state
 
 
 def counted_run(monkeypatch, scene, keep, **options):
@@ -108,3 +111,30 @@ def test_a_kept_tangent_that_fails_is_replaced_by_a_fresh_one_and_recorded(monke
     for key in ("n_steps", "n_split_vertices", "n_fragments", "crack_length", "fragment_areas"):
         assert result.summary[key] == fresh.summary[key], key
     assert np.array_equal(final_displacement(result), final_displacement(fresh))
+
+
+
+class _Timings:
+    def add(self, phase, seconds):
+        pass
+
+
+def test_a_kept_tangent_is_factorised_again_by_the_solver_that_made_it(tmp_path):
+    """3D "auto" takes SuperLU for a tangent with many general rows (linalg.iterative): a
+    kept tangent factorised with a solve's contact rows is factorised again, after a
+    resume, without them (the problem's own rows). The checkpoint names the solver, and
+    the tangent is factorised again by it, whichever the problem's own rows would choose."""
+    scene = scenes.blocks3d()
+    Simulation(scene, StepControl(max_steps=1), out=tmp_path, pictures="none").run()
+    state, _ = load_state(tmp_path)
+    prob = ElasticProblem(state.mesh, scene.material)
+    scene.apply_load(prob, state.x)
+    assert prob.assemble_constraints().C.shape[0] == 0            # no general rows of its own
+    state.tangent_state = state.u
+    assert tangents.kept_tangent(state, prob, _Timings()).factor.inverse == "sparsecholesky"
+    for inverse in ("superlu", "sparsecholesky"):
+        state.tangent, state.tangent_inverse = None, inverse
+        save_state(tmp_path, replace(state, step=state.step + 1), {})
+        again, _ = load_state(tmp_path)
+        assert again.tangent_inverse == inverse and again.tangent is None
+        assert tangents.kept_tangent(again, prob, _Timings()).factor.inverse == inverse

@@ -132,3 +132,93 @@ def test_bad_factors_are_refused():
     ldl = ext.SupernodalLDL(2, lp, li, L.data, np.ones(2), np.array([0, 1], dtype=np.int64))
     with pytest.raises(ValueError, match="rows"):
         ldl.solve(np.ones(3))
+
+
+@pytest.mark.parametrize("block_bytes", [triangular.PRODUCT_BLOCK_BYTES, 8 * 5])
+def test_the_product_of_sparse_columns_is_the_dense_product(block_bytes, monkeypatch):
+    """X^T Y from per-column (rows, values), in one block and in blocks of a few columns,
+    equals the dense product to rounding (1e-14 of the largest term): rows only one side
+    reaches, empty columns and columns of one entry included."""
+    monkeypatch.setattr(triangular, "PRODUCT_BLOCK_BYTES", block_bytes)
+    rng = np.random.default_rng(11)
+    n = 40
+
+    def columns(count, reach):
+        out = []
+        for j in range(count):
+            size = 0 if j == 3 else 1 if j == 4 else int(rng.integers(2, reach))
+            rows = rng.permutation(n)[:size]          # unsorted, as a reach solve leaves them
+            out.append((rows, rng.standard_normal(size)))
+        return out
+
+    xs, ys = columns(9, n), columns(7, n // 2)
+    dense = [np.zeros((n, len(c))) for c in (xs, ys)]
+    for D, cols in zip(dense, (xs, ys)):
+        for j, (r, v) in enumerate(cols):
+            D[r, j] = v
+    expected = dense[0].T @ dense[1]
+    scale = (np.abs(dense[0]).T @ np.abs(dense[1])).max()
+    S = triangular.column_products(xs, ys, n)
+    assert S.shape == (9, 7)
+    assert np.abs(S - expected).max() <= 1e-14 * scale
+    assert np.all(S[3] == 0.0)
+    assert triangular.column_products([], ys, n).shape == (0, 7)
+
+
+def test_the_supernodal_sparse_forward_solve_is_the_entrywise_one():
+    """Y = L^-1 B through the supernodes a sparse B reaches equals Gilbert-Peierls'
+    (SparseLowerSolve) and the dense solve to rounding (1e-13 of Y's largest entry), with
+    the rows of whole supernodes, increasing; a row out of range is refused."""
+    factor = plate_factor()
+    factor.solve(np.ones(factor.ndof))
+    ldl, (lower, _, _) = factor._ldl, factor._factor_arrays()
+    n = factor._lu.shape[0]
+    rng = np.random.default_rng(4)
+    k = 12
+    cols = np.concatenate([rng.choice(n, size=3, replace=False) for _ in range(k)])
+    B = sp.csc_matrix((rng.standard_normal(3 * k), (cols, np.repeat(np.arange(k), 3))), shape=(n, k))
+    B[:, 5] = 0.0                                               # an empty column
+    B.eliminate_zeros()
+    bp, bi = B.indptr.astype(np.int64), B.indices.astype(np.int32)
+    yp, yi, yx = ldl.forward_sparse(bp, bi, B.data)
+    gp = ext.SparseLowerSolve(n, *lower, True, bp, bi, B.data)
+    Y, Y_gp = (sp.csc_matrix((x, i, p), shape=(n, k)).toarray() for p, i, x in ((yp, yi, yx), gp))
+    L = sp.csc_matrix((lower[2], lower[1], lower[0]), shape=(n, n)).toarray()
+    np.fill_diagonal(L, 1.0)
+    Y_dense = np.linalg.solve(L, B.toarray())
+    assert np.abs(Y - Y_gp).max() <= 1e-13 * np.abs(Y_gp).max()
+    assert np.abs(Y - Y_dense).max() <= 1e-13 * np.abs(Y_dense).max()
+    assert yp[6] == yp[5]
+    for j in range(k):
+        rows = yi[yp[j]:yp[j + 1]]
+        assert np.all(np.diff(rows) > 0)
+        assert set(np.flatnonzero(Y_gp[:, j])) <= set(rows.tolist())
+    with pytest.raises(ValueError, match="out of range"):
+        ldl.forward_sparse(np.array([0, 1], dtype=np.int64), np.array([n], dtype=np.int32), np.ones(1))
+
+
+@pytest.mark.parametrize("case", ["syrk", "negative weight", "small blocks"])
+def test_the_weighted_product_of_sparse_columns_is_symmetric_and_the_dense_one(case, monkeypatch):
+    """Y^T diag(w) Y (the Schur complement where U = D L^T) equals the dense product to
+    rounding (1e-14 of the largest term) and is exactly symmetric: by the symmetric rank-k
+    product, and where a weight is not positive or the block too big by the general one."""
+    if case == "small blocks":
+        monkeypatch.setattr(triangular, "PRODUCT_BLOCK_BYTES", 8 * 5)
+    rng = np.random.default_rng(12)
+    n, m = 30, 8
+    ys = []
+    for j in range(m):
+        size = 0 if j == 2 else int(rng.integers(1, n))
+        ys.append((rng.permutation(n)[:size], rng.standard_normal(size)))
+    w = rng.uniform(0.5, 2.0, n)
+    if case == "negative weight":
+        w[ys[0][0][0]] = -1.0
+    Y = np.zeros((n, m))
+    for j, (r, v) in enumerate(ys):
+        Y[r, j] = v
+    expected = Y.T @ (w[:, None] * Y)
+    scale = (np.abs(Y).T @ (np.abs(w)[:, None] * np.abs(Y))).max()
+    S = triangular.weighted_products(ys, w, n)
+    assert np.array_equal(S, S.T)
+    assert np.abs(S - expected).max() <= 1e-14 * scale
+    assert np.all(S[2] == 0.0)

@@ -18,7 +18,7 @@ import scipy.sparse.linalg as spla
 
 from .kept import KeptColumns, row_keys
 from .sparse import reproducible_threads, to_ngsolve, to_scipy
-from .triangular import factor_arrays, reach_solves, sparse_columns, supernodal_solver
+from .triangular import factor_arrays, reach_solves, schur_product, supernodal_solver
 
 #: the linear solvers of the Newton step: a sparse direct factorisation, or the paper's
 #: ILU-preconditioned GMRES (slow; for comparison)
@@ -526,6 +526,11 @@ class EliminatedFactor(FactorBase):
     def _superlu_solve(self, b):
         """K_ff^-1 b with SuperLU's factors: through the supernodal L D L^T solver where it
         applies (``SUPERNODAL_MIN_DOFS``, every pivot diagonal), else SuperLU's own solve."""
+        ldl = self._supernodal()
+        return self._lu.solve(np.asfortranarray(b)) if ldl is None else ldl.solve(b)
+
+    def _supernodal(self):
+        """The factors' supernodal L D L^T solver (made at first need), or None (SUPERNODAL_MIN_DOFS)."""
         if self._ldl is None:
             ldl = None
             if self._lu.shape[0] >= SUPERNODAL_MIN_DOFS:
@@ -534,9 +539,7 @@ class EliminatedFactor(FactorBase):
                 except ValueError as err:      # a zero or non-finite pivot: K_ff is singular
                     raise SingularSystem(f"the sparse LU factors cannot be solved with: {err}") from None
             self._ldl = False if ldl is None else ldl
-        if self._ldl is False:
-            return self._lu.solve(np.asfortranarray(b))
-        return self._ldl.solve(b)
+        return None if self._ldl is False else self._ldl
 
     @property
     def sparse_schur(self):
@@ -547,7 +550,7 @@ class EliminatedFactor(FactorBase):
 
     def schur(self, C):
         """S = C K^+ C^T (m, m) by sparse triangular solves with SuperLU's factors, S = X^T Y
-        (:func:`linalg.triangular.reach_solves`); rows met in the last call are not solved
+        (:func:`linalg.triangular.reach_solves`, ``schur_product``); rows met in the last call are not solved
         again (recognised as in :meth:`columns`). Entries of C at fixed dofs and pins are
         ignored, as K^+ is zero there.
 
@@ -579,14 +582,12 @@ class EliminatedFactor(FactorBase):
             index = -np.ones(self.ndof, dtype=np.int64)
             index[self.factor_free] = np.arange(n)          # dof -> row of K_ff
             try:
-                solved = reach_solves(self._lu, self._factor_arrays(), index, C[new])
-            except RuntimeError as err:
+                solved = reach_solves(self._lu, self._factor_arrays(), index, C[new], self._supernodal())
+            except (RuntimeError, ValueError) as err:
                 raise SingularSystem(f"sparse triangular solve failed: {err}") from None
         fresh = dict(zip((keys[i] for i in new), solved)) if new else {}
         self._reach = {key: self._reach[key] if key in self._reach else fresh[key] for key in keys}
-        Y = sparse_columns([self._reach[key][0] for key in keys], n)
-        X = sparse_columns([self._reach[key][1] for key in keys], n)
-        S = (X.T @ Y).toarray()
+        S = schur_product([self._reach[key] for key in keys], self._factor_arrays()[2], n)
         if not np.all(np.isfinite(S)):
             raise SingularSystem("the sparse triangular solves produced NaN/inf: singular (a floating body?)")
         self.seconds += time.perf_counter() - t0

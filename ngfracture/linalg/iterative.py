@@ -61,16 +61,16 @@ MEMORY_BUDGET = 0.25
 CHOLESKY_BYTES_COEFFICIENT = 22.1
 CHOLESKY_BYTES_EXPONENT = 1.55
 
-#: in 3D, "auto" factorises a tangent made for one linear system (full Newton's iterate)
-#: with many general rows by SuperLU up to this many factorised dofs: its rows then take the
-#: augmented matrix or the sparse Schur complement instead of one Cholesky solve per row
-#: (linalg.factor). Measured up to here (26k dofs). docs/solvers.md, "One-use tangents in 3D"
-ONCE_SUPERLU_MAX_DOFS = 26000
+#: in 3D, "auto" factorises a tangent with many general rows (contact, ties) by SuperLU up
+#: to this many factorised dofs: its rows then take the augmented matrix or the sparse Schur
+#: complement instead of one Cholesky solve per row (linalg.factor). Measured up to here
+#: (26k dofs). docs/solvers.md, "Tangents with many rows in 3D"
+SUPERLU_ROWS_MAX_DOFS = 26000
 
 #: ... with at least this many general rows per factorised dof (fewer: SuperLU's slower
-#: factorisation does not pay back; break-even 0.0074 at 7554 dofs, 0.0048 at 25959).
-#: docs/solvers.md, "One-use tangents in 3D"
-ONCE_SUPERLU_ROWS_PER_DOF = 0.0075
+#: factorisation does not pay back; break-even about 0.004 at 7554 dofs, 0.0048 at 25959).
+#: docs/solvers.md, "Tangents with many rows in 3D"
+SUPERLU_ROWS_PER_DOF = 0.0075
 
 #: the inverses this module adds: "amg" (CG with AMG; see INVERSES of mechanics.newton)
 ITERATIVE_INVERSES = ("amg",)
@@ -138,14 +138,13 @@ def memory_budget(fraction=None):
     return fraction * os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
 
 
-def choose_inverse(inverse, dim, n, budget=None, once_rows=0):
+def choose_inverse(inverse, dim, n, budget=None, rows=0):
     """The linear solver of a problem and why: (inverse, record).
 
     In 3D, "auto" is "sparsecholesky" while :func:`cholesky_bytes` of ``n`` fits in
-    ``budget``, else "amg"; but "superlu" for a tangent made for one linear system with
-    ``once_rows`` >= ``ONCE_SUPERLU_ROWS_PER_DOF`` * n general rows and ``n`` <=
-    ``ONCE_SUPERLU_MAX_DOFS``. Any other choice, and "auto" in 2D, is
-    :func:`problem_inverse`'s.
+    ``budget``, else "amg"; but "superlu" for a tangent with ``rows`` >=
+    ``SUPERLU_ROWS_PER_DOF`` * n general rows and ``n`` <= ``SUPERLU_ROWS_MAX_DOFS``. Any
+    other choice, and "auto" in 2D, is :func:`problem_inverse`'s.
 
     Parameters
     ----------
@@ -157,22 +156,20 @@ def choose_inverse(inverse, dim, n, budget=None, once_rows=0):
         Factorised dofs.
     budget : float, optional
         Bytes; default :func:`memory_budget`.
-    once_rows : int
-        The general rows of the one linear system the tangent is factorised for (full
-        Newton), 0 for a tangent kept for several (modified Newton, contact rounds).
+    rows : int
+        The general rows of the first linear system the tangent is factorised for (the
+        later ones of a kept tangent, contact rounds and modified Newton, have about as many).
 
     Returns
     -------
     inverse : str
     record : dict
-        ``solver`` (the inverse), ``reason`` ("asked", "auto" or "auto, one system with
-        rows"), ``dofs`` (n) and, where "auto" chose by memory in 3D, ``predicted_bytes``
+        ``solver`` (the inverse), ``reason`` ("asked", "auto" or "auto, many rows"), ``dofs`` (n) and, where "auto" chose by memory in 3D, ``predicted_bytes``
         and ``budget_bytes``.
     """
     record = {"solver": inverse, "reason": "asked", "dofs": int(n)}
-    if (inverse == "auto" and dim == 3 and once_rows > 0 and once_rows >= ONCE_SUPERLU_ROWS_PER_DOF * n
-            and n <= ONCE_SUPERLU_MAX_DOFS):
-        record.update(solver="superlu", reason="auto, one system with rows")
+    if inverse == "auto" and dim == 3 and 0 < rows and SUPERLU_ROWS_PER_DOF * n <= rows and n <= SUPERLU_ROWS_MAX_DOFS:
+        record.update(solver="superlu", reason="auto, many rows")
         return "superlu", record
     if inverse == "auto" and dim == 3:
         budget = memory_budget() if budget is None else float(budget)
@@ -186,7 +183,7 @@ def choose_inverse(inverse, dim, n, budget=None, once_rows=0):
 
 
 def make_factor(K, fixed_dofs, pins, linear_solver="direct", inverse="auto", dim=2, points=None,
-                pattern=None, budget=None, once_rows=0):
+                pattern=None, budget=None, rows=0):
     """K^+ of a tangent: an :class:`AMGFactor` or a :class:`linalg.factor.EliminatedFactor`,
     as :func:`choose_inverse` decides (only for ``linear_solver="direct"``).
 
@@ -207,8 +204,8 @@ def make_factor(K, fixed_dofs, pins, linear_solver="direct", inverse="auto", dim
         For NGSolve's factorisation (EliminatedFactor).
     budget : float, optional
         Bytes, for "auto" (default :func:`memory_budget`).
-    once_rows : int
-        For "auto": the general rows of the one system a tangent is made for, or 0
+    rows : int
+        For "auto": the general rows of the first system the tangent is factorised for
         (:func:`choose_inverse`).
 
     Returns
@@ -225,7 +222,7 @@ def make_factor(K, fixed_dofs, pins, linear_solver="direct", inverse="auto", dim
         ndof = K.shape[0] if sp.issparse(K) else K.height
         left_out = np.union1d(np.asarray(fixed_dofs, dtype=np.int64),
                               np.zeros(0, dtype=np.int64) if pins is None else np.asarray(pins, dtype=np.int64))
-        inverse, record = choose_inverse(inverse, dim, ndof - left_out.size, budget, once_rows)
+        inverse, record = choose_inverse(inverse, dim, ndof - left_out.size, budget, rows)
     else:
         record = {"solver": linear_solver, "reason": "asked"}
     if inverse == "amg":

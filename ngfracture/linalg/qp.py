@@ -17,7 +17,7 @@ a factorisation per step; :func:`bound_qp` starts it from a working set guessed 
 primal-dual sweeps, so that it takes a few steps instead of one per active bound
 (docs/solvers.md, "The contact QP").
 """
-from typing import NamedTuple, Optional
+from typing import NamedTuple
 
 import numpy as np
 import scipy.linalg as sla

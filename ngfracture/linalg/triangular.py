@@ -16,6 +16,7 @@ Both read the factors as the arrays of :func:`factor_arrays`.
 """
 import numpy as np
 import scipy.sparse as sp
+from scipy.linalg import blas
 
 from .. import _ngfracture as _ext
 
@@ -71,8 +72,13 @@ def supernodal_solver(lu, arrays):
     return _ext.SupernodalLDL(lu.shape[0], *lower, pivots, lu.perm_r.astype(np.int64))
 
 
-def reach_solves(lu, arrays, index, C):
+def reach_solves(lu, arrays, index, C, supernodal=None):
     """Per row of C its column of Y = L^-1 Pr C^T and of X = U^-T Pc^T C^T.
+
+    Where every pivot was diagonal (U = D L^T, X = D^-1 Y) and a supernodal solver of the
+    factors is given, Y comes from its panels, supernode by supernode
+    (``SupernodalLDL.forward_sparse``: dense updates, one row index per panel row); else
+    from a Gilbert-Peierls solve entry by entry (``SparseLowerSolve``).
 
     Parameters
     ----------
@@ -84,6 +90,8 @@ def reach_solves(lu, arrays, index, C):
         are ignored).
     C : scipy.sparse matrix, shape (m, ndof)
         Constraint rows.
+    supernodal : _ngfracture.SupernodalLDL, optional
+        :func:`supernodal_solver` of the same factors.
 
     Returns
     -------
@@ -104,8 +112,10 @@ def reach_solves(lu, arrays, index, C):
     def solve(factor, perm, unit):
         lp, li, lx = factor
         rhs = sp.csc_matrix((B.data[keep], (perm[rows[keep]], B.row[keep])), shape=(n, C.shape[0]))
-        return _ext.SparseLowerSolve(n, lp, li, lx, unit, rhs.indptr.astype(np.int64),
-                                     rhs.indices.astype(np.int32), rhs.data)
+        pointers, indices = rhs.indptr.astype(np.int64), rhs.indices.astype(np.int32)
+        if unit and upper_t is None and supernodal is not None:
+            return supernodal.forward_sparse(pointers, indices, rhs.data)
+        return _ext.SparseLowerSolve(n, lp, li, lx, unit, pointers, indices, rhs.data)
 
     yp, yi, yx = solve(lower, lu.perm_r, True)
     if upper_t is None:
@@ -116,21 +126,112 @@ def reach_solves(lu, arrays, index, C):
             for j in range(C.shape[0])]
 
 
-def sparse_columns(columns, n):
-    """A CSC matrix from per-column (rows, values), as :func:`reach_solves` gives them.
+#: the dense blocks of :func:`column_products` take at most this many bytes each
+PRODUCT_BLOCK_BYTES = 2 ** 26
+
+
+def column_products(x_columns, y_columns, n):
+    """X^T Y of two matrices given by their sparse columns, as a dense array.
+
+    The columns of the Schur complement's solves reach a part of the rows each, the
+    separators of the ordering in all of them: a sparse product pays its index work on
+    every pair of entries, while a dense product (BLAS) on the rows both reach pays none.
+    The columns go in blocks whose dense copies take at most ``PRODUCT_BLOCK_BYTES``.
 
     Parameters
     ----------
-    columns : list of (numpy.ndarray of int, numpy.ndarray)
-        Row indices and values of every column.
+    x_columns, y_columns : list of (numpy.ndarray of int, numpy.ndarray)
+        Row indices (distinct within a column) and values of every column of X and of Y,
+        as :func:`reach_solves` gives them.
     n : int
-        Number of rows.
+        Number of rows of X and Y.
 
     Returns
     -------
-    scipy.sparse.csc_matrix, shape (n, len(columns))
+    numpy.ndarray, shape (len(x_columns), len(y_columns))
     """
-    lengths = np.array([len(r) for r, _ in columns], dtype=np.int64)
-    rows = np.concatenate([r for r, _ in columns]) if columns else np.zeros(0, np.int32)
-    values = np.concatenate([v for _, v in columns]) if columns else np.zeros(0)
-    return sp.csc_matrix((values, rows, np.concatenate([[0], np.cumsum(lengths)])), shape=(n, len(columns)))
+    x, y = _stacked(x_columns), _stacked(y_columns)
+    rows = np.intersect1d(x[0], y[0])
+    place = -np.ones(n, dtype=np.int64)
+    place[rows] = np.arange(len(rows))
+    width = max(1, PRODUCT_BLOCK_BYTES // (8 * max(len(rows), 1)))
+    S = np.zeros((len(x_columns), len(y_columns)))
+    for i in range(0, len(x_columns), width):
+        X = _dense_block(x, place, len(rows), i, i + width)
+        for j in range(0, len(y_columns), width):
+            S[i:i + width, j:j + width] = X.T @ _dense_block(y, place, len(rows), j, j + width)
+    return S
+
+
+def schur_product(solved, pivots, n):
+    """S = X^T Y of the columns :func:`reach_solves` gives, or Y^T D^-1 Y where U = D L^T.
+
+    Parameters
+    ----------
+    solved : list of ((numpy.ndarray, numpy.ndarray), (numpy.ndarray, numpy.ndarray))
+        Per row its column of Y and of X, as :func:`reach_solves` gives them.
+    pivots : numpy.ndarray or None
+        D where U = D L^T (:func:`factor_arrays`), else None.
+    n : int
+        Number of rows of X and Y.
+
+    Returns
+    -------
+    numpy.ndarray, shape (len(solved), len(solved))
+    """
+    if pivots is None:
+        return column_products([x for _, x in solved], [y for y, _ in solved], n)
+    return weighted_products([y for y, _ in solved], 1.0 / pivots, n)
+
+
+def weighted_products(y_columns, weights, n):
+    """Y^T diag(w) Y of a matrix given by its sparse columns (the Schur complement where
+    U = D L^T: X = D^-1 Y, w = 1 / D), exactly symmetric.
+
+    With every weight on the rows Y reaches positive and the dense copy within
+    ``PRODUCT_BLOCK_BYTES``, one symmetric rank-k product (BLAS syrk, half the work of
+    :func:`column_products`) of W = diag(sqrt(w)) Y; else :func:`column_products` of
+    diag(w) Y and Y, symmetrised.
+
+    Parameters
+    ----------
+    y_columns : list of (numpy.ndarray of int, numpy.ndarray)
+        As for :func:`column_products`.
+    weights : numpy.ndarray, shape (n,)
+    n : int
+
+    Returns
+    -------
+    numpy.ndarray, shape (len(y_columns), len(y_columns))
+    """
+    y = _stacked(y_columns)
+    rows = np.unique(y[0])
+    m = len(y_columns)
+    if len(rows) * m * 8 > PRODUCT_BLOCK_BYTES or np.any(weights[rows] <= 0):
+        S = column_products([(r, v * weights[r]) for r, v in y_columns], y_columns, n)
+        return 0.5 * (S + S.T)
+    place = -np.ones(n, dtype=np.int64)
+    place[rows] = np.arange(len(rows))
+    W = _dense_block(y, place, len(rows), 0, m) * np.sqrt(weights[rows])[:, None]
+    upper = blas.dsyrk(1.0, W.T) if m else np.zeros((0, 0))    # W.T is Fortran-ordered: no copy
+    return np.triu(upper) + np.triu(upper, 1).T
+
+
+def _stacked(columns):
+    """(rows, values, column, number of columns) of every entry of the columns."""
+    if not columns:
+        return np.zeros(0, dtype=np.int64), np.zeros(0), np.zeros(0, dtype=np.int64), 0
+    lengths = np.fromiter((len(r) for r, _ in columns), dtype=np.int64, count=len(columns))
+    return (np.concatenate([r for r, _ in columns]), np.concatenate([v for _, v in columns]),
+            np.repeat(np.arange(len(columns)), lengths), len(columns))
+
+
+def _dense_block(stacked, place, size, start, stop):
+    """Columns start .. stop - 1 of the stacked entries as a dense (size, count) array, row
+    r at place[r] (entries at rows with place -1 dropped: the other factor is zero there)."""
+    rows, values, column, m = stacked
+    block = np.zeros((size, max(min(stop, m) - start, 0)))
+    at = place[rows]
+    keep = (at >= 0) & (column >= start) & (column < stop)
+    block[at[keep], column[keep] - start] = values[keep]
+    return block

@@ -362,7 +362,7 @@ class NewtonSolver:
         support = saved.support if reuse else prob.support(rows)
         if self.fix_free_modes:
             rows = self._hold_free_modes(rows, support)
-        factor = saved.factor if reuse else self._factor(prob.tangent(), rows, support, once=True)
+        factor = saved.factor if reuse else self._factor(prob.tangent(), rows, support)
         kkt = ConstrainedSolver(None, rows.fixed_dofs, rows.C, modes=support.modes, pins=support.pins,
                                 factor=factor, dependent_rows=True)
         u = prob.u.vec.FV().NumPy()
@@ -474,20 +474,20 @@ class NewtonSolver:
                 K = self.problem.tangent()
             # not inside prob.threads(): the factorisation runs on one thread (linalg.factor)
             with _Timer(timings, "factorize"):
-                factor = self._factor(K, rows, support, once=self.method == "full")
+                factor = self._factor(K, rows, support)
         path = "auto" if self.method == "full" and given is None else "schur"
         with _Timer(timings, "factorize"):
             kkt = ConstrainedSolver(None, rows.fixed_dofs, rows.C, modes=support.modes, pins=support.pins,
                                     factor=factor, path=path, first=first)
         return kkt, factor
 
-    def _factor(self, K, rows, support, once=False):
-        """A fresh K^+ of the tangent K (linalg.iterative.make_factor); ``once``: made for
-        one linear system with ``rows`` (full Newton's iterate), not kept."""
+    def _factor(self, K, rows, support):
+        """A fresh K^+ of the tangent K for the general rows of ``rows``
+        (linalg.iterative.make_factor)."""
         prob = self.problem
         return make_factor(K, rows.fixed_dofs, support.pins, self.linear_solver, self.inverse, dim=prob.dim,
                            points=prob.arrays.points, pattern=prob.tangent_pattern(),
-                           once_rows=rows.C.shape[0] if once else 0)
+                           rows=rows.C.shape[0])
 
     def _converged(self, status, k, norm, prev, force_scale, r):
         """Whether iterate k (increment ``norm``, the one before ``prev``) ends the load step:

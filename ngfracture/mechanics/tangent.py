@@ -75,10 +75,10 @@ class SavedTangent:
         return other
 
     @classmethod
-    def assembled_at(cls, problem, state, rows):
+    def assembled_at(cls, problem, state, rows, inverse="auto"):
         """The factorised tangent of ``problem`` at the displacement ``state``, as a solve
         that started there with these rows would have made it (its support taken at
-        ``state``, the default direct solver): the same factorisation bit for bit.
+        ``state``, the direct solver ``inverse``): the same factorisation bit for bit.
 
         Parameters
         ----------
@@ -86,7 +86,10 @@ class SavedTangent:
         state : numpy.ndarray
             A displacement of the problem's space.
         rows : ConstraintRows
-            Constraints with the fixed dofs it is factorised for (only those are used).
+            Constraints with the fixed dofs it is factorised for (and, for "auto", as many
+            general rows as the solve had).
+        inverse : str
+            The direct solver (as for linalg.iterative.make_factor).
 
         Returns
         -------
@@ -100,8 +103,9 @@ class SavedTangent:
         support = problem.support(rows, state)
         saved = cls()
         saved.fixed_dofs, saved.support, saved.state = rows.fixed_dofs, support, np.array(state, dtype=float)
-        saved.factor = make_factor(problem.tangent(state), rows.fixed_dofs, support.pins, dim=problem.dim,
-                                   points=problem.arrays.points, pattern=problem.tangent_pattern())
+        saved.factor = make_factor(problem.tangent(state), rows.fixed_dofs, support.pins, inverse=inverse,
+                                   dim=problem.dim, points=problem.arrays.points,
+                                   pattern=problem.tangent_pattern(), rows=rows.C.shape[0])
         saved.factor.factorise()
         return saved
 

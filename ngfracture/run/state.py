@@ -51,6 +51,9 @@ class State:
     tangent : SavedTangent or None
         That factorisation, if this process made it (not in checkpoints: a resumed run
         makes it again from ``tangent_state``).
+    tangent_inverse : str or None
+        The direct solver that factorised it ("auto" chooses by the rows of the solve that
+        made it, which a resumed run does not have): the resumed run factorises with it.
     mesh : ngsolve.Mesh or None
         The mesh built from ``arrays`` (not in checkpoints: made again from the arrays).
     external : numpy.ndarray or None
@@ -75,6 +78,7 @@ class State:
     strength: np.ndarray = None
     contact_keys: list = field(default_factory=list)
     tangent_state: np.ndarray = None
+    tangent_inverse: str = None
     tangent: object = field(default=None, repr=False, compare=False)
     mesh: object = field(default=None, repr=False, compare=False)
     external: np.ndarray = None
@@ -177,7 +181,8 @@ def save_state(folder, state, run):
         arrays["external"] = state.external
     meta = {"x": state.x, "dx": state.dx, "step": state.step, "quiet": state.quiet, "work": state.work,
             "peak_energy": state.peak_energy, "history": state.history,
-            "contact_keys": [list(k) for k in state.contact_keys], "area": state.area, **run}
+            "contact_keys": [list(k) for k in state.contact_keys], "area": state.area,
+            "tangent_inverse": state.tangent_inverse, **run}
     return checkpoint.write(folder, state.step, arrays, meta)
 
 
@@ -210,6 +215,6 @@ def load_state(folder):
                   history=meta.pop("history"), strength=arrays.get("strength"),
                   contact_keys=[tuple(k) for k in meta.pop("contact_keys", [])],
                   tangent_state=arrays.get("tangent_state"), external=arrays.get("external"),
-                  area=meta.pop("area", None))
+                  area=meta.pop("area", None), tangent_inverse=meta.pop("tangent_inverse", None))
     state.mesh = mesh_from_arrays(state.arrays)
     return state, meta

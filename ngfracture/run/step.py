@@ -510,7 +510,7 @@ class LoadStep:
                     external=load_vector(prob) if prob.loads else None)
         kept = tangents.tangent_to_keep(attempt.tangent, log.method, new.fixed_dofs)
         if kept is not None:
-            new.tangent_state, new.tangent = kept.state, kept
+            new.tangent_state, new.tangent, new.tangent_inverse = kept.state, kept, kept.factor.inverse
         return AcceptedStep(new, record, prob, stats, attempt)
 
     @staticmethod

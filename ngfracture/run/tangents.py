@@ -59,7 +59,8 @@ def kept_tangent(state, problem, timings):
     if state.tangent is None:
         t0 = time.perf_counter()
         try:
-            state.tangent = SavedTangent.assembled_at(problem, state.tangent_state, rows)
+            state.tangent = SavedTangent.assembled_at(problem, state.tangent_state, rows,
+                                                      state.tangent_inverse or "auto")
         except SingularSystem as err:
             raise StepFailed("singular", "increment", f"the kept tangent: {err}", from_kept=True) from None
         finally:
