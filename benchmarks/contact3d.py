@@ -329,12 +329,12 @@ class LinalgCounts:
     Schur columns), ``factorise_seconds``. The wrappers are removed on leaving."""
 
     def __enter__(self):
-        from ngfracture.linalg import factor
+        from ngfracture.linalg import factor, sparse_schur
         self.factorisations = self.augmented = self.columns = 0
         self.schur_seconds = self.factorise_seconds = 0.0
         self._saved = [(factor.EliminatedFactor, "factorise"), (factor.EliminatedFactor, "augmented"),
                        (factor.FactorBase, "columns_and_solve"), (factor.EliminatedFactor, "schur"),
-                       (factor, "reach_solves")]
+                       (sparse_schur, "reach_solves")]
         self._saved = [(owner, name, getattr(owner, name)) for owner, name in self._saved]
         counts = self
         originals = {name: f for _, name, f in self._saved}
@@ -369,9 +369,9 @@ class LinalgCounts:
             counts.schur_seconds += time.perf_counter() - t0
             return S
 
-        def reach_solves(lu, arrays, index, C):
+        def reach_solves(lu, arrays, index, C, *supernodal):
             counts.columns += C.shape[0]
-            return originals["reach_solves"](lu, arrays, index, C)
+            return originals["reach_solves"](lu, arrays, index, C, *supernodal)
 
         solve = factor.EliminatedFactor.solve
 
@@ -385,7 +385,7 @@ class LinalgCounts:
         for owner, name, f in [(factor.EliminatedFactor, "factorise", factorise),
                                (factor.EliminatedFactor, "augmented", augmented),
                                (factor.FactorBase, "columns_and_solve", columns_and_solve),
-                               (factor.EliminatedFactor, "schur", schur), (factor, "reach_solves", reach_solves),
+                               (factor.EliminatedFactor, "schur", schur), (sparse_schur, "reach_solves", reach_solves),
                                (factor.EliminatedFactor, "solve", counted_solve)]:
             setattr(owner, name, f)
         return self
@@ -435,15 +435,16 @@ def run_scene(name, kwargs, repeat, steps=None, until_crack=False, inverse=None)
         try:
             result = simulation.run()
             reason, n_steps, wall = result.reason, result.summary["n_steps"], result.summary["timings"]["wall"]
+            message = result.message
         except FirstCrack:
-            reason, n_steps, wall = "first_crack", records[-1]["step"], time.perf_counter() - t0
+            reason, n_steps, wall, message = "first_crack", records[-1]["step"], time.perf_counter() - t0, None
     t_after, _ = solid.unit_solve(scene, repeat=repeat)
     t_unit = 0.5 * (t_before + t_after)
     timings = simulation.timings
     contact = timings["collision"] + timings["contact"]
     crack_step, crack_seconds = first_crack(records)
     return {"scene": name, **kwargs, "tets": scene.mesh.ne, "vertices": scene.mesh.nv, "reason": reason,
-            "steps": n_steps, "collision": timings["collision"], "contact": timings["contact"],
+            "message": message, "steps": n_steps, "collision": timings["collision"], "contact": timings["contact"],
             "solve": timings["solve"], "wall": wall, "t_unit": t_unit, "solver": solver,
             "solve_equivalents": wall / t_unit, "contact_ratio": contact / t_unit,
             "step_seconds": [r["seconds"] for r in records], "split_vertices": [r["split_vertices"] for r in records],

@@ -21,7 +21,7 @@ import scipy.sparse.linalg as spla
 
 import ngfracture as nf
 from ngfracture.contact.solver import ContactSolver
-from ngfracture.linalg import factor as factor_module
+from ngfracture.linalg import factor as factor_module, sparse_schur as sparse_schur_module
 from ngfracture.linalg.kkt import ConstrainedSolver
 from ngfracture.linalg.sparse import to_scipy
 from ngfracture.mechanics.newton import NewtonSolver
@@ -168,8 +168,8 @@ def test_sparse_schur_complement_and_complementarity_equal_the_columns(contact_s
         if sparse_schur:     # again, half of the rows known: no solve, the same matrix to rounding
             half = rows.C.shape[0] // 2
             solves = []
-            monkeypatch.setattr(factor_module, "reach_solves",
-                                lambda *a, _f=factor_module.reach_solves: solves.append(a[3].shape[0]) or _f(*a))
+            monkeypatch.setattr(sparse_schur_module, "reach_solves",
+                                lambda *a, _f=sparse_schur_module.reach_solves: solves.append(a[3].shape[0]) or _f(*a))
             again = factor.schur(rows.C[:half])
             assert solves == []
             whole = factor.schur(rows.C)

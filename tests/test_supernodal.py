@@ -12,7 +12,7 @@ import scipy.sparse.linalg as spla
 
 from ngfracture import _ngfracture as ext
 from ngfracture import scenes
-from ngfracture.linalg import factor as factor_module, triangular
+from ngfracture.linalg import factor as factor_module, sparse_schur as sparse_schur_module, triangular
 from ngfracture.mechanics.problem import ElasticProblem
 
 
@@ -222,3 +222,32 @@ def test_the_weighted_product_of_sparse_columns_is_symmetric_and_the_dense_one(c
     assert np.array_equal(S, S.T)
     assert np.abs(S - expected).max() <= 1e-14 * scale
     assert np.all(S[2] == 0.0)
+
+
+def test_the_schur_complement_of_rows_met_before_keeps_their_entries(monkeypatch):
+    """A call whose rows are partly the last call's (reordered) and partly new solves only
+    the new rows, takes the known entries from the last call (bit for bit) and equals
+    C K^+ C^T from full solves to rounding (1e-12), exactly symmetric."""
+    monkeypatch.setattr(factor_module, "SPARSE_SCHUR_MIN_DOFS", 0)
+    factor = plate_factor()
+    free = np.flatnonzero(factor.factor_free)
+    rng = np.random.default_rng(8)
+
+    def rows(k):
+        cols = rng.choice(free, size=(k, 3))
+        return sp.csr_matrix((rng.standard_normal(3 * k), (np.repeat(np.arange(k), 3), cols.ravel())),
+                             shape=(k, factor.ndof))
+
+    first = rows(12)
+    S1 = factor.schur(first)
+    keep = np.array([7, 2, 9, 0, 4])
+    second = sp.vstack([first[keep], rows(6)]).tocsr()
+    solves = []
+    monkeypatch.setattr(sparse_schur_module, "reach_solves",
+                        lambda *a, _f=sparse_schur_module.reach_solves: solves.append(a[3].shape[0]) or _f(*a))
+    S2 = factor.schur(second)
+    assert solves == [6]
+    assert np.array_equal(S2[:5, :5], S1[np.ix_(keep, keep)])
+    assert np.array_equal(S2, S2.T)
+    reference = second @ factor.solve(second.T.toarray())
+    assert np.abs(S2 - reference).max() <= 1e-12 * np.abs(reference).max()

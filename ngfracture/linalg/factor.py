@@ -18,7 +18,8 @@ import scipy.sparse.linalg as spla
 
 from .kept import KeptColumns, row_keys
 from .sparse import reproducible_threads, to_ngsolve, to_scipy
-from .triangular import factor_arrays, reach_solves, schur_product, supernodal_solver
+from .sparse_schur import SparseSchur
+from .triangular import factor_arrays, supernodal_solver
 
 #: the linear solvers of the Newton step: a sparse direct factorisation, or the paper's
 #: ILU-preconditioned GMRES (slow; for comparison)
@@ -282,7 +283,7 @@ class EliminatedFactor(FactorBase):
         self.linear_solver = linear_solver
         self.gmres_tol = gmres_tol
         self._tmp = ng.BaseVector(self.ndof)     # NGSolve's solvers work on its vectors
-        self._reach = {}          # row key -> its sparse triangular solves (schur), last rows
+        self._sparse = None       # the SparseSchur of schur (its last rows' solves and S)
         self._triangles = None    # the factors' arrays for the C++ triangular solves (factor_arrays)
         self._lu = None
         self._ldl = None          # the supernodal L D L^T solver of the factors (SUPERNODAL_MIN_DOFS)
@@ -316,7 +317,7 @@ class EliminatedFactor(FactorBase):
         """
         other = copy.copy(self)
         other._columns = self._columns.copy() if self.columns_independent else KeptColumns()
-        other._reach, other._augmented, other._checked = {}, None, False
+        other._sparse, other._augmented, other._checked = None, None, False
         other.__dict__.pop("_modes", None)
         return other
 
@@ -549,9 +550,9 @@ class EliminatedFactor(FactorBase):
                 and np.count_nonzero(self.factor_free) >= SPARSE_SCHUR_MIN_DOFS)
 
     def schur(self, C):
-        """S = C K^+ C^T (m, m) by sparse triangular solves with SuperLU's factors, S = X^T Y
-        (:func:`linalg.triangular.reach_solves`, ``schur_product``); rows met in the last call are not solved
-        again (recognised as in :meth:`columns`). Entries of C at fixed dofs and pins are
+        """S = C K^+ C^T (m, m) by sparse triangular solves with SuperLU's factors
+        (:class:`linalg.sparse_schur.SparseSchur`): the rows met in the last call are not
+        solved again (recognised as in :meth:`columns`), nor their entries of S computed again. Entries of C at fixed dofs and pins are
         ignored, as K^+ is zero there.
 
         Parameters
@@ -574,20 +575,14 @@ class EliminatedFactor(FactorBase):
             raise ValueError("EliminatedFactor.schur needs the SuperLU factorisation")
         self.factorise()
         t0 = time.perf_counter()
-        C = sp.csr_matrix(C)
-        keys = row_keys(C)
-        new = [i for i, key in enumerate(keys) if key not in self._reach]
-        n = self._lu.shape[0]
-        if new:
+        if self._sparse is None:
             index = -np.ones(self.ndof, dtype=np.int64)
-            index[self.factor_free] = np.arange(n)          # dof -> row of K_ff
-            try:
-                solved = reach_solves(self._lu, self._factor_arrays(), index, C[new], self._supernodal())
-            except (RuntimeError, ValueError) as err:
-                raise SingularSystem(f"sparse triangular solve failed: {err}") from None
-        fresh = dict(zip((keys[i] for i in new), solved)) if new else {}
-        self._reach = {key: self._reach[key] if key in self._reach else fresh[key] for key in keys}
-        S = schur_product([self._reach[key] for key in keys], self._factor_arrays()[2], n)
+            index[self.factor_free] = np.arange(self._lu.shape[0])          # dof -> row of K_ff
+            self._sparse = SparseSchur(self._lu, self._factor_arrays(), self._supernodal(), index)
+        try:
+            S = self._sparse.complement(C)
+        except (RuntimeError, ValueError) as err:
+            raise SingularSystem(f"sparse triangular solve failed: {err}") from None
         if not np.all(np.isfinite(S)):
             raise SingularSystem("the sparse triangular solves produced NaN/inf: singular (a floating body?)")
         self.seconds += time.perf_counter() - t0

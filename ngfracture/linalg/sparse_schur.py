@@ -1,0 +1,93 @@
+"""The Schur complement S = C K_ff^-1 C^T of constraint rows from SuperLU's factors, for a
+factorisation that meets mostly the same rows call after call (contact rounds, Newton
+iterations with a kept tangent).
+
+A row's triangular solves (:func:`linalg.triangular.reach_solves`) are kept from one call
+to the next, and so are the entries of S between rows met in the last call: where every
+pivot was diagonal (U = D L^T, S = Y^T D^-1 Y) a call computes only the entries of its new
+rows, against all rows. Rows are recognised by their stored indices and values, bitwise
+(:func:`linalg.kept.row_keys`). docs/solvers.md, "Sparse Schur complement".
+"""
+import numpy as np
+import scipy.sparse as sp
+
+from .kept import row_keys
+from .triangular import column_products, reach_solves, schur_product
+
+
+class SparseSchur:
+    """S = C K_ff^-1 C^T by sparse triangular solves with SuperLU's factors of K_ff.
+
+    Parameters
+    ----------
+    lu : scipy.sparse.linalg.SuperLU
+        The factorisation of K_ff.
+    arrays : tuple
+        :func:`linalg.triangular.factor_arrays` of ``lu``.
+    supernodal : _ngfracture.SupernodalLDL or None
+        The supernodal solver of the same factors (reach solves through its panels).
+    index : numpy.ndarray of int, shape (ndof,)
+        The row of K_ff of every dof, -1 where a dof is not factorised.
+    """
+
+    def __init__(self, lu, arrays, supernodal, index):
+        self._lu, self._arrays, self._supernodal, self._index = lu, arrays, supernodal, index
+        self._solved = {}         # row key -> its columns of Y and X, the last call's rows
+        self._last = ([], None)   # the last call's row keys and S
+
+    def complement(self, C):
+        """S for the rows C; the rows of the last call cost no solve, and their entries of S
+        are taken from it where U = D L^T.
+
+        Parameters
+        ----------
+        C : scipy.sparse matrix, shape (m, ndof)
+            Constraint rows (entries at dofs that are not factorised are ignored).
+
+        Returns
+        -------
+        numpy.ndarray, shape (m, m)
+
+        Raises
+        ------
+        RuntimeError, ValueError
+            From the triangular solves (a zero pivot, a row out of range).
+        """
+        C = sp.csr_matrix(C)
+        keys = row_keys(C)
+        new = [i for i, key in enumerate(keys) if key not in self._solved]
+        solved = dict(zip((keys[i] for i in new),
+                          reach_solves(self._lu, self._arrays, self._index, C[new], self._supernodal)
+                          if new else []))
+        self._solved = {key: self._solved[key] if key in self._solved else solved[key] for key in keys}
+        columns = [self._solved[key] for key in keys]
+        n, pivots = self._lu.shape[0], self._arrays[2]
+        last_keys, last_S = self._last
+        place = {key: i for i, key in enumerate(last_keys)}
+        known = [i for i, key in enumerate(keys) if key in place]
+        if pivots is None or not known:
+            S = schur_product(columns, pivots, n)
+        else:
+            S = self._updated(columns, keys, known, place, last_S, 1.0 / pivots)
+        self._last = (keys, S)
+        return S
+
+    def _updated(self, columns, keys, known, place, last_S, weights):
+        """S from the last call's entries between known rows, the new rows' entries computed:
+        among themselves symmetric (schur_product), against the known ones by one product."""
+        n = self._lu.shape[0]
+        fresh = np.setdiff1d(np.arange(len(keys)), known)
+        known = np.asarray(known)
+        at = np.array([place[keys[i]] for i in known])
+        S = np.empty((len(keys), len(keys)))
+        S[np.ix_(known, known)] = last_S[np.ix_(at, at)]
+        if len(fresh):
+            S[np.ix_(fresh, fresh)] = schur_product([columns[i] for i in fresh], 1.0 / weights, n)
+            weighted = [(y[0], y[1] * weights[y[0]]) for y, _ in (columns[i] for i in fresh)]
+            block = column_products(weighted, [columns[i][0] for i in known], n)
+            S[np.ix_(fresh, known)] = block
+            S[np.ix_(known, fresh)] = block.T
+        return S
+
+
+__all__ = ["SparseSchur"]
