@@ -16,6 +16,13 @@ from ngfracture.linalg import factor as factor_module, sparse_schur as sparse_sc
 from ngfracture.mechanics.problem import ElasticProblem
 
 
+def random_rows(factor, k, rng):
+    """k rows of three random entries each on the factorised dofs."""
+    cols = rng.choice(np.flatnonzero(factor.factor_free), size=(k, 3))
+    return sp.csr_matrix((rng.standard_normal(3 * k), (np.repeat(np.arange(k), 3), cols.ravel())),
+                         shape=(k, factor.ndof))
+
+
 def plate_factor():
     """The default plate's tangent at its first increment, factorised as the simulation does."""
     scene = scenes.plate()
@@ -88,13 +95,8 @@ def test_the_sparse_schur_complement_after_a_supernodal_solve_is_that_of_full_so
     equal C K^+ C^T from full solves to rounding."""
     monkeypatch.setattr(factor_module, "SPARSE_SCHUR_MIN_DOFS", 0)
     factor = plate_factor()
-    free = np.flatnonzero(factor.factor_free)
     rng = np.random.default_rng(2)
-
-    def rows(k):
-        cols = rng.choice(free, size=(k, 3))
-        return sp.csr_matrix((rng.standard_normal(3 * k), (np.repeat(np.arange(k), 3), cols.ravel())),
-                             shape=(k, factor.ndof))
+    rows = lambda k: random_rows(factor, k, rng)
 
     for C in (rows(5), rows(5)):
         S = factor.schur(C)
@@ -230,13 +232,8 @@ def test_the_schur_complement_of_rows_met_before_keeps_their_entries(monkeypatch
     C K^+ C^T from full solves to rounding (1e-12), exactly symmetric."""
     monkeypatch.setattr(factor_module, "SPARSE_SCHUR_MIN_DOFS", 0)
     factor = plate_factor()
-    free = np.flatnonzero(factor.factor_free)
     rng = np.random.default_rng(8)
-
-    def rows(k):
-        cols = rng.choice(free, size=(k, 3))
-        return sp.csr_matrix((rng.standard_normal(3 * k), (np.repeat(np.arange(k), 3), cols.ravel())),
-                             shape=(k, factor.ndof))
+    rows = lambda k: random_rows(factor, k, rng)
 
     first = rows(12)
     S1 = factor.schur(first)
