@@ -68,21 +68,21 @@ class SparseSchur:
         if pivots is None or not known:
             S = schur_product(columns, pivots, n)
         else:
-            S = self._updated(columns, keys, known, place, last_S, 1.0 / pivots)
+            S = self._updated(columns, keys, known, place, last_S, pivots)
         self._last = (keys, S)
         return S
 
-    def _updated(self, columns, keys, known, place, last_S, weights):
+    def _updated(self, columns, keys, known, place, last_S, pivots):
         """S from the last call's entries between known rows, the new rows' entries computed:
         among themselves symmetric (schur_product), against the known ones by one product."""
-        n = self._lu.shape[0]
+        n, weights = self._lu.shape[0], 1.0 / pivots
         fresh = np.setdiff1d(np.arange(len(keys)), known)
         known = np.asarray(known)
         at = np.array([place[keys[i]] for i in known])
         S = np.empty((len(keys), len(keys)))
         S[np.ix_(known, known)] = last_S[np.ix_(at, at)]
         if len(fresh):
-            S[np.ix_(fresh, fresh)] = schur_product([columns[i] for i in fresh], 1.0 / weights, n)
+            S[np.ix_(fresh, fresh)] = schur_product([columns[i] for i in fresh], pivots, n)
             weighted = [(y[0], y[1] * weights[y[0]]) for y, _ in (columns[i] for i in fresh)]
             block = column_products(weighted, [columns[i][0] for i in known], n)
             S[np.ix_(fresh, known)] = block
