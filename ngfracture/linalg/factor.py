@@ -552,8 +552,8 @@ class EliminatedFactor(FactorBase):
     def schur(self, C):
         """S = C K^+ C^T (m, m) by sparse triangular solves with SuperLU's factors
         (:class:`linalg.sparse_schur.SparseSchur`): the rows met in the last call are not
-        solved again (recognised as in :meth:`columns`), nor their entries of S computed again. Entries of C at fixed dofs and pins are
-        ignored, as K^+ is zero there.
+        solved again (recognised as in :meth:`columns`), nor their entries of S computed
+        again. Entries of C at fixed dofs and pins are ignored, as K^+ is zero there.
 
         Parameters
         ----------

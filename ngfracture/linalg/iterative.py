@@ -164,11 +164,13 @@ def choose_inverse(inverse, dim, n, budget=None, rows=0):
     -------
     inverse : str
     record : dict
-        ``solver`` (the inverse), ``reason`` ("asked", "auto" or "auto, many rows"), ``dofs`` (n) and, where "auto" chose by memory in 3D, ``predicted_bytes``
-        and ``budget_bytes``.
+        ``solver`` (the inverse), ``reason`` ("asked", "auto" or "auto, many rows"),
+        ``dofs`` (n) and, where "auto" chose by memory in 3D, ``predicted_bytes`` and
+        ``budget_bytes``.
     """
     record = {"solver": inverse, "reason": "asked", "dofs": int(n)}
-    if inverse == "auto" and dim == 3 and 0 < rows and SUPERLU_ROWS_PER_DOF * n <= rows and n <= SUPERLU_ROWS_MAX_DOFS:
+    many_rows = 0 < rows and SUPERLU_ROWS_PER_DOF * n <= rows and n <= SUPERLU_ROWS_MAX_DOFS
+    if inverse == "auto" and dim == 3 and many_rows:
         record.update(solver="superlu", reason="auto, many rows")
         return "superlu", record
     if inverse == "auto" and dim == 3:

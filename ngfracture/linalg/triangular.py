@@ -151,7 +151,7 @@ def column_products(x_columns, y_columns, n):
     numpy.ndarray, shape (len(x_columns), len(y_columns))
     """
     x, y = _stacked(x_columns), _stacked(y_columns)
-    rows = np.intersect1d(x[0], y[0])
+    rows = np.flatnonzero(_reached(x, n) & _reached(y, n))
     place = -np.ones(n, dtype=np.int64)
     place[rows] = np.arange(len(rows))
     width = max(1, PRODUCT_BLOCK_BYTES // (8 * max(len(rows), 1)))
@@ -205,7 +205,7 @@ def weighted_products(y_columns, weights, n):
     numpy.ndarray, shape (len(y_columns), len(y_columns))
     """
     y = _stacked(y_columns)
-    rows = np.unique(y[0])
+    rows = np.flatnonzero(_reached(y, n))
     m = len(y_columns)
     if len(rows) * m * 8 > PRODUCT_BLOCK_BYTES or np.any(weights[rows] <= 0):
         S = column_products([(r, v * weights[r]) for r, v in y_columns], y_columns, n)
@@ -224,6 +224,13 @@ def _stacked(columns):
     lengths = np.fromiter((len(r) for r, _ in columns), dtype=np.int64, count=len(columns))
     return (np.concatenate([r for r, _ in columns]), np.concatenate([v for _, v in columns]),
             np.repeat(np.arange(len(columns)), lengths), len(columns))
+
+
+def _reached(stacked, n):
+    """Mask of the rows where a stacked column has an entry (no sort of the entries)."""
+    mask = np.zeros(n, dtype=bool)
+    mask[stacked[0]] = True
+    return mask
 
 
 def _dense_block(stacked, place, size, start, stop):
