@@ -23,14 +23,15 @@ def random_rows(factor, k, rng):
                          shape=(k, factor.ndof))
 
 
-def plate_factor():
+def plate_factor(schur_by_dofs=False):
     """The default plate's tangent at its first increment, factorised as the simulation does."""
     scene = scenes.plate()
     prob = ElasticProblem(scene.mesh, scene.material)
     scene.apply_load(prob, scene.dx)
     rows = prob.assemble_constraints()
     support = prob.support(rows)
-    factor = factor_module.EliminatedFactor(prob.tangent(), rows.fixed_dofs, support.pins)
+    factor = factor_module.EliminatedFactor(prob.tangent(), rows.fixed_dofs, support.pins,
+                                            schur_by_dofs=schur_by_dofs)
     factor.factorise()
     return factor
 
@@ -248,3 +249,29 @@ def test_the_schur_complement_of_rows_met_before_keeps_their_entries(monkeypatch
     assert np.array_equal(S2, S2.T)
     reference = second @ factor.solve(second.T.toarray())
     assert np.abs(S2 - reference).max() <= 1e-12 * np.abs(reference).max()
+
+
+def test_the_schur_complement_by_dofs_solves_no_row_whose_dofs_were_met(monkeypatch):
+    """By dofs (3D contact rows, re-linearised every call): rows with new values on dofs met
+    before cost no triangular solve, rows on new dofs solve only those dofs; S equals
+    C K^+ C^T from full solves to rounding (1e-12) and is exactly symmetric; entries at
+    dofs that are not factorised are ignored."""
+    monkeypatch.setattr(factor_module, "SPARSE_SCHUR_MIN_DOFS", 0)
+    factor = plate_factor(schur_by_dofs=True)
+    rng = np.random.default_rng(9)
+    first = random_rows(factor, 10, rng)
+    solves = []
+    monkeypatch.setattr(sparse_schur_module, "reach_solves",
+                        lambda *a, _f=sparse_schur_module.reach_solves: solves.append(a[3].shape[0]) or _f(*a))
+    relinearised = first.copy()
+    relinearised.data = rng.standard_normal(relinearised.nnz)     # same dofs, other values
+    fixed = sp.csr_matrix(([1.0], ([0], [factor.fixed_dofs[0]])), shape=(1, factor.ndof))
+    more = random_rows(factor, 2, rng)
+    for C in (first, relinearised, sp.vstack([relinearised, fixed, more]).tocsr()):
+        S = factor.schur(C)
+        assert np.array_equal(S, S.T)
+        reference = C @ factor.solve(C.T.toarray())
+        assert np.abs(S - reference).max() <= 1e-12 * np.abs(reference).max()
+    dofs_first = len(np.unique(first.indices))
+    dofs_more = len(np.setdiff1d(more.indices, first.indices))
+    assert solves == [dofs_first, dofs_more]

@@ -250,6 +250,8 @@ class EliminatedFactor(FactorBase):
         relative residual GMRES must reach) only by "gmres".
     pattern : ngsolve.la.SparseMatrixd, optional
         An NGSolve matrix of K's sparsity pattern, for NGSolve's factorisation (to_ngsolve).
+    schur_by_dofs : bool
+        :meth:`schur` through K^-1 on the rows' dofs (``SparseSchur(by_dofs=True)``).
 
     Attributes
     ----------
@@ -266,7 +268,7 @@ class EliminatedFactor(FactorBase):
     """
 
     def __init__(self, K, fixed_dofs, pins=None, linear_solver="direct", inverse="auto",
-                 gmres_tol=1e-12, pattern=None):
+                 gmres_tol=1e-12, pattern=None, schur_by_dofs=False):
         if linear_solver not in LINEAR_SOLVERS:
             raise ValueError(f"linear_solver must be one of {LINEAR_SOLVERS}, got {linear_solver!r}")
         t0 = time.perf_counter()
@@ -283,7 +285,7 @@ class EliminatedFactor(FactorBase):
         self.linear_solver = linear_solver
         self.gmres_tol = gmres_tol
         self._tmp = ng.BaseVector(self.ndof)     # NGSolve's solvers work on its vectors
-        self._sparse = None       # the SparseSchur of schur (its last rows' solves and S)
+        self._sparse, self._schur_by_dofs = None, schur_by_dofs    # the SparseSchur of schur
         self._triangles = None    # the factors' arrays for the C++ triangular solves (factor_arrays)
         self._lu = None
         self._ldl = None          # the supernodal L D L^T solver of the factors (SUPERNODAL_MIN_DOFS)
@@ -578,7 +580,8 @@ class EliminatedFactor(FactorBase):
         if self._sparse is None:
             index = -np.ones(self.ndof, dtype=np.int64)
             index[self.factor_free] = np.arange(self._lu.shape[0])          # dof -> row of K_ff
-            self._sparse = SparseSchur(self._lu, self._factor_arrays(), self._supernodal(), index)
+            self._sparse = SparseSchur(self._lu, self._factor_arrays(), self._supernodal(), index,
+                                       by_dofs=self._schur_by_dofs)
         try:
             S = self._sparse.complement(C)
         except (RuntimeError, ValueError) as err:

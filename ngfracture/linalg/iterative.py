@@ -232,7 +232,9 @@ def make_factor(K, fixed_dofs, pins, linear_solver="direct", inverse="auto", dim
             raise ValueError("inverse='amg' needs the vertex positions (points) for the rigid modes")
         factor = AMGFactor(K, fixed_dofs, pins, points)
     else:
-        factor = EliminatedFactor(K, fixed_dofs, pins, linear_solver, inverse, pattern=pattern)
+        # 3D contact rows are re-linearised at every round: S from K^-1 on their dofs
+        factor = EliminatedFactor(K, fixed_dofs, pins, linear_solver, inverse, pattern=pattern,
+                                  schur_by_dofs=dim == 3)
     factor.choice = record
     return factor
 
