@@ -290,38 +290,29 @@ namespace ngfracture
         }
     }
 
-    // The mean largest extent of a tetrahedron in the reference configuration: the grid's
-    // cell size. The detection's results do not depend on the cell size (every search is
-    // exact whatever cells it visits), so it is taken from the reference points, once per
-    // mesh, instead of a pass over every tetrahedron at every detection.
-    double MeanTetExtent (const TetMesh3 & m)
-    {
-      double ext = 0;
-      for (int64_t t = 0; t < m.ne; t++)
-        {
-          double e = 0;
-          for (int d = 0; d < 3; d++)
-            {
-              double a = m.X[3*m.tets[4*t]+d], b = a;
-              for (int k = 1; k < 4; k++) { a = std::min(a, m.X[3*m.tets[4*t+k]+d]); b = std::max(b, m.X[3*m.tets[4*t+k]+d]); }
-              e = std::max(e, b - a);
-            }
-          ext += e;
-        }
-      return m.ne ? ext / double(m.ne) : 1.0;
-    }
-
-    // The grid geometry: origin at the low corner of the boundary vertices, cell size
-    // ``extent`` (MeanTetExtent; coarser if needed to keep 21 bits per axis).
-    void SetupGrid (const TetMesh3 & m, const Derived & D, double extent, HashGrid & g)
+    // The grid geometry: origin at the low corner of the boundary vertices, cell size the
+    // mean largest extent of a tetrahedron (coarser if needed to keep 21 bits per axis).
+    void SetupGrid (const TetMesh3 & m, const Derived & D, HashGrid & g)
     {
       double lo[3], hi[3];
       for (int d = 0; d < 3; d++) { lo[d] = std::numeric_limits<double>::infinity(); hi[d] = -lo[d]; }
       for (int32_t v : D.bverts)
         for (int d = 0; d < 3; d++)
           { lo[d] = std::min(lo[d], m.x[3*v+d]); hi[d] = std::max(hi[d], m.x[3*v+d]); }
+      double ext = 0;
+      for (int64_t t = 0; t < m.ne; t++)
+        {
+          double e = 0;
+          for (int d = 0; d < 3; d++)
+            {
+              double a = m.x[3*m.tets[4*t]+d], b = a;
+              for (int k = 1; k < 4; k++) { a = std::min(a, m.x[3*m.tets[4*t+k]+d]); b = std::max(b, m.x[3*m.tets[4*t+k]+d]); }
+              e = std::max(e, b - a);
+            }
+          ext += e;
+        }
       double range = std::max({ hi[0]-lo[0], hi[1]-lo[1], hi[2]-lo[2] });
-      g.h = extent;
+      g.h = m.ne ? ext / double(m.ne) : 1.0;
       if (!(g.h > 0)) g.h = range > 0 ? range : 1.0;
       g.h = std::max(g.h, range / double((1 << 20)));
       std::copy(lo, lo + 3, g.origin);
@@ -869,7 +860,7 @@ namespace ngfracture
     };
 
     // `incidence` the mesh's (made here, if there is a hit, when null)
-    std::vector<Penetration3> Detect (const TetMesh3 & m, const Topology & T, const Copies & copies, double extent,
+    std::vector<Penetration3> Detect (const TetMesh3 & m, const Topology & T, const Copies & copies,
                                       Collision3Stats * stats, const Incidence * incidence = nullptr)
     {
       Collision3Stats st;
@@ -879,7 +870,7 @@ namespace ngfracture
       std::vector<Penetration3> out;
       if (D.bverts.empty() || m.ne == 0) { if (stats) *stats = st; return out; }
       HashGrid vg;
-      SetupGrid(m, D, extent, vg);
+      SetupGrid(m, D, vg);
       st.cell = vg.h;
       std::vector<double> lo(3*D.bverts.size()), hi;
       for (size_t s = 0; s < D.bverts.size(); s++)
@@ -969,7 +960,7 @@ namespace ngfracture
     Topology T;
     Copies copies;
     MakeTopology(m, T, copies);
-    return Detect(m, T, copies, MeanTetExtent(m), stats);
+    return Detect(m, T, copies, stats);
   }
 
   struct PenetrationDetector3::Impl
@@ -980,7 +971,6 @@ namespace ngfracture
     Topology T;
     Copies copies;
     Incidence incidence;
-    double extent;           // MeanTetExtent
 
     TetMesh3 Mesh (const double * x) const
     { return TetMesh3 { X.data(), x, tets.data(), faces.data(), fragment.data(), nv, ne, nf }; }
@@ -997,7 +987,6 @@ namespace ngfracture
     I.nv = m.nv; I.ne = m.ne; I.nf = m.nf;
     MakeTopology(I.Mesh(I.X.data()), I.T, I.copies);
     I.incidence = Incidence { MakeVertexFaces(I.Mesh(I.X.data())) };
-    I.extent = MeanTetExtent(I.Mesh(I.X.data()));
   }
 
   PenetrationDetector3::~PenetrationDetector3 () = default;
@@ -1006,6 +995,6 @@ namespace ngfracture
 
   std::vector<Penetration3> PenetrationDetector3::Detect (const double * x, Collision3Stats * stats) const
   {
-    return ngfracture::Detect(impl_->Mesh(x), impl_->T, impl_->copies, impl_->extent, stats, &impl_->incidence);
+    return ngfracture::Detect(impl_->Mesh(x), impl_->T, impl_->copies, stats, &impl_->incidence);
   }
 }
