@@ -18,7 +18,7 @@ import scipy.sparse.linalg as spla
 
 from .kept import KeptColumns, row_keys
 from .sparse import reproducible_threads, to_ngsolve, to_scipy
-from .sparse_schur import SparseSchur
+from .sparse_schur import DofSchur, SparseSchur
 from .triangular import factor_arrays, supernodal_solver
 
 #: the linear solvers of the Newton step: a sparse direct factorisation, or the paper's
@@ -251,7 +251,7 @@ class EliminatedFactor(FactorBase):
     pattern : ngsolve.la.SparseMatrixd, optional
         An NGSolve matrix of K's sparsity pattern, for NGSolve's factorisation (to_ngsolve).
     schur_by_dofs : bool
-        :meth:`schur` through K^-1 on the rows' dofs (``SparseSchur(by_dofs=True)``).
+        :meth:`schur` through K^-1 on the rows' dofs (``linalg.sparse_schur.DofSchur``).
 
     Attributes
     ----------
@@ -555,7 +555,8 @@ class EliminatedFactor(FactorBase):
         """S = C K^+ C^T (m, m) by sparse triangular solves with SuperLU's factors
         (:class:`linalg.sparse_schur.SparseSchur`): the rows met in the last call are not
         solved again (recognised as in :meth:`columns`), nor their entries of S computed
-        again. Entries of C at fixed dofs and pins are ignored, as K^+ is zero there.
+        again; with ``schur_by_dofs`` from K^+ on the rows' dofs, kept (``DofSchur``).
+        Entries of C at fixed dofs and pins are ignored, as K^+ is zero there.
 
         Parameters
         ----------
@@ -580,8 +581,8 @@ class EliminatedFactor(FactorBase):
         if self._sparse is None:
             index = -np.ones(self.ndof, dtype=np.int64)
             index[self.factor_free] = np.arange(self._lu.shape[0])          # dof -> row of K_ff
-            self._sparse = SparseSchur(self._lu, self._factor_arrays(), self._supernodal(), index,
-                                       by_dofs=self._schur_by_dofs)
+            kind = DofSchur if self._schur_by_dofs else SparseSchur
+            self._sparse = kind(self._lu, self._factor_arrays(), self._supernodal(), index)
         try:
             S = self._sparse.complement(C)
         except (RuntimeError, ValueError) as err:

@@ -10,7 +10,7 @@ rows, against all rows. Rows are recognised by their stored indices and values, 
 
 Rows whose values change from call to call on the same dofs (3D contact rows, re-linearised
 at every round of the active set: a call meets a quarter of its rows with new values) are
-not recognised by their keys. For them S is built from the dofs instead (``by_dofs``):
+not recognised by their keys. For them S is built from the dofs instead (:class:`DofSchur`):
 G = E^T K_ff^-1 E on the factorised dofs the rows touch (E their unit columns), made row by
 row as above from the unit rows of those dofs, kept and grown with the dofs a call adds;
 then S = C_d G C_d^T costs a sparse product per call and no triangular solve.
@@ -35,20 +35,12 @@ class SparseSchur:
         The supernodal solver of the same factors (reach solves through its panels).
     index : numpy.ndarray of int, shape (ndof,)
         The row of K_ff of every dof, -1 where a dof is not factorised.
-    by_dofs : bool
-        Build S as C_d G C_d^T from G = K_ff^-1 on the dofs the rows touch (kept and grown
-        from call to call) instead of row by row: for rows re-linearised at every call
-        (3D contact: a call meets a quarter of its rows with new values), see the module
-        docstring.
     """
 
-    def __init__(self, lu, arrays, supernodal, index, by_dofs=False):
+    def __init__(self, lu, arrays, supernodal, index):
         self._lu, self._arrays, self._supernodal, self._index = lu, arrays, supernodal, index
         self._solved = {}         # row key -> its columns of Y and X, the last call's rows
         self._last = ([], None)   # the last call's row keys and S
-        # by dofs: the dofs of G in their order, and G (S of their unit rows, row by row)
-        self._units = SparseSchur(lu, arrays, supernodal, index) if by_dofs else None
-        self._dofs, self._G = np.zeros(0, dtype=np.int64), None
 
     def complement(self, C):
         """S for the rows C; the rows of the last call cost no solve, and their entries of S
@@ -69,8 +61,6 @@ class SparseSchur:
             From the triangular solves (a zero pivot, a row out of range).
         """
         C = sp.csr_matrix(C)
-        if self._units is not None:
-            return self._by_dofs(C)
         keys = row_keys(C)
         new = [i for i, key in enumerate(keys) if key not in self._solved]
         solved = dict(zip((keys[i] for i in new),
@@ -88,25 +78,6 @@ class SparseSchur:
             S = self._updated(columns, keys, known, place, last_S, pivots)
         self._last = (keys, S)
         return S
-
-    def _by_dofs(self, C):
-        """S = C_d G C_d^T, G = K_ff^-1 on the factorised dofs C touches (those met in an
-        earlier call keep their entries of G; new ones are solved and joined)."""
-        factorised = self._index[C.indices] >= 0
-        need = np.unique(C.indices[factorised])
-        fresh = need[~np.isin(need, self._dofs)]
-        if fresh.size or self._G is None:
-            self._dofs = np.concatenate([self._dofs, fresh])
-            p = len(self._dofs)
-            units = sp.csr_matrix((np.ones(p), (np.arange(p), self._dofs)), shape=(p, C.shape[1]))
-            self._G = self._units.complement(units)
-        order = np.argsort(self._dofs, kind="stable")
-        at = order[np.searchsorted(self._dofs, C.indices[factorised], sorter=order)]
-        rows = np.repeat(np.arange(C.shape[0]), np.diff(C.indptr))[factorised]
-        Cd = sp.csr_matrix((C.data[factorised], (rows, at)), shape=(C.shape[0], len(self._dofs)))
-        S = (Cd @ (Cd @ self._G).T).T
-        # G is symmetric where U = D L^T, and so is S: exactly, as the row-by-row product
-        return 0.5 * (S + S.T) if self._arrays[2] is not None else S
 
     def _updated(self, columns, keys, known, place, last_S, pivots):
         """S from the last call's entries between known rows, the new rows' entries computed:
@@ -126,4 +97,57 @@ class SparseSchur:
         return S
 
 
-__all__ = ["SparseSchur"]
+class DofSchur:
+    """S = C K_ff^-1 C^T as C_d G C_d^T, G = K_ff^-1 on the factorised dofs the rows touch.
+
+    For rows whose values change from call to call on the same dofs (see the module
+    docstring): G is the :class:`SparseSchur` of the dofs' unit rows, kept and grown by the
+    dofs a call adds; a call then costs a sparse product and no triangular solve.
+
+    Parameters
+    ----------
+    lu, arrays, supernodal, index
+        As for :class:`SparseSchur`.
+    """
+
+    def __init__(self, lu, arrays, supernodal, index):
+        self._units = SparseSchur(lu, arrays, supernodal, index)
+        self._index, self._symmetric = index, arrays[2] is not None     # U = D L^T: G symmetric
+        self._dofs, self._order, self._G = np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), None
+
+    def complement(self, C):
+        """S for the rows C (entries at dofs that are not factorised are ignored).
+
+        Parameters
+        ----------
+        C : scipy.sparse matrix, shape (m, ndof)
+
+        Returns
+        -------
+        numpy.ndarray, shape (m, m)
+            Exactly symmetric where U = D L^T, as :class:`SparseSchur`'s.
+
+        Raises
+        ------
+        RuntimeError, ValueError
+            From the triangular solves of new dofs.
+        """
+        C = sp.csr_matrix(C)
+        factorised = self._index[C.indices] >= 0
+        need = np.unique(C.indices[factorised])
+        fresh = need[~np.isin(need, self._dofs)]
+        if fresh.size or self._G is None:
+            # new dofs join at the end: the unit rows of the others are the last call's
+            self._dofs = np.concatenate([self._dofs, fresh])
+            self._order = np.argsort(self._dofs, kind="stable")
+            p = len(self._dofs)
+            units = sp.csr_matrix((np.ones(p), (np.arange(p), self._dofs)), shape=(p, C.shape[1]))
+            self._G = self._units.complement(units)
+        at = self._order[np.searchsorted(self._dofs, C.indices[factorised], sorter=self._order)]
+        rows = np.repeat(np.arange(C.shape[0]), np.diff(C.indptr))[factorised]
+        Cd = sp.csr_matrix((C.data[factorised], (rows, at)), shape=(C.shape[0], len(self._dofs)))
+        S = (Cd @ (Cd @ self._G).T).T
+        return 0.5 * (S + S.T) if self._symmetric else S
+
+
+__all__ = ["DofSchur", "SparseSchur"]
