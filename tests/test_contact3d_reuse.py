@@ -12,6 +12,7 @@ import numpy as np
 
 from ngfracture.contact.active_set3d import ActiveSet3d
 from ngfracture.contact.collision3d import detect_penetrations_3d
+from ngfracture.contact.copies3d import two_sided_rows
 from ngfracture.contact.rows3d import NodeToFaceRows, relinearise_node_to_face
 
 from blocks3d import assert_same_rows, block_geometry, overlapping_blocks
@@ -64,7 +65,8 @@ def test_subset_and_stack_carry_the_gap_rows():
 
 def test_settling_takes_the_update_s_relinearisation():
     """Round 2 at a displacement that moves every row (re-linearised by the update) and
-    finds new ones: the rows settle judges are those of re-linearising every candidate."""
+    finds new ones: the rows settle judges are those of re-linearising every candidate
+    (rows at a copy on the tighter side of their pair, copies3d.two_sided_rows)."""
     arrays, piece, _, U = overlapping_blocks(CELLS, PIECES, 0.2 / CELLS * PIECES, noise=0.05 / CELLS)
     active = ActiveSet3d(block_geometry(arrays, piece), 1e-12)
     cand = active.update(U, {"collision": 0.0})
@@ -74,4 +76,5 @@ def test_settling_takes_the_update_s_relinearisation():
     cand = active.update(U2, {"collision": 0.0})
     assert cand.relinearised is not None and 0 < len(cand.relinearised) < len(cand.rows)
     reused = active._fresh_rows(cand, U2)
-    assert_same_rows(reused, relinearise_node_to_face(cand.rows, arrays.points, U2))
+    fresh = relinearise_node_to_face(cand.rows, arrays.points, U2)
+    assert_same_rows(reused, two_sided_rows(fresh, arrays.points, U2, active.setup.copy_index))

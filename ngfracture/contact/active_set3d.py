@@ -44,7 +44,9 @@ Candidates, each identified by its key ("f", slave, master vertices sorted):
   solve (a row the problem released must stay visible to the next problem).
 
 Every round re-linearises all candidates at the configuration of the last solve
-(:func:`~ngfracture.contact.rows3d.relinearise_node_to_face`), and rows whose gap does not
+(:func:`~ngfracture.contact.rows3d.relinearise_node_to_face`; a row at a copy takes the
+normal of the tighter of its pair's two conditions,
+:func:`~ngfracture.contact.copies3d.two_sided_rows`), and rows whose gap does not
 change by more than a hundredth of ``penetration_tol`` keep their old linearisation bit for
 bit (:func:`~ngfracture.contact.active_set.refreshed`), as in 2D.
 
@@ -63,7 +65,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from .active_set import ActiveSet, Candidates, RowKeys, refreshed
-from .copies3d import folded_rows_at_copies, found_rows_at_copies
+from .copies3d import folded_rows_at_copies, found_rows_at_copies, two_sided_rows
 from .intsets import isin_ints, union_ints, unique_ints
 from .redundancy import holds_on_columns
 from .rows3d import NodeToFaceRows, no_face_rows, node_to_face_rows, relinearise_node_to_face
@@ -183,13 +185,12 @@ class ActiveSet3d(ActiveSet):
         -------
         ngfracture.contact.active_set.Candidates
         """
-        a = self.geometry.arrays
         relinearised = None
         if self.seam_rows is None:
             self.seam_rows, self.seam_keys = self.setup.rows, self.setup.keys
         elif self.moving:
             old = NodeToFaceRows.stack([self.seam_rows, self.n2s])
-            relinearised = relinearise_node_to_face(old, a.points, U)
+            relinearised = self._relinearise(old, U)
             self.seam_rows, self.n2s = self._split(refreshed(old, relinearised, U, 0.01 * self.penetration_tol))
         found, found_codes = self._node_to_face(U, timings)
         n2s_codes = self.n2s_keys.codes
@@ -232,9 +233,16 @@ class ActiveSet3d(ActiveSet):
         """
         done = candidates.relinearised
         if done is None:
-            return relinearise_node_to_face(candidates.rows, self.geometry.arrays.points, U)
+            return self._relinearise(candidates.rows, U)
         new = candidates.rows.subset(np.arange(len(done), len(candidates.rows)))
-        return NodeToFaceRows.stack([done, relinearise_node_to_face(new, self.geometry.arrays.points, U)])
+        return NodeToFaceRows.stack([done, self._relinearise(new, U)])
+
+    def _relinearise(self, rows, U):
+        """``rows`` re-linearised at X + U, those at a copy on the tighter side of their pair
+        (:func:`~ngfracture.contact.copies3d.two_sided_rows`)."""
+        X = self.geometry.arrays.points
+        return two_sided_rows(relinearise_node_to_face(rows, X, U), X, U, self.setup.copy_index,
+                              0.01 * self.penetration_tol)
 
     def _node_to_face(self, U, timings):
         """The pairs detected at X + U that no twin row covers, as rows with their key codes."""

@@ -45,14 +45,19 @@ slide along its face past the fold into t's side, and once s is deeper than the 
 detection's master face at t can be one whose plane s is in front of: its row does not
 hold s (the coarse confined sphere at x = 2.533e-3, a glass vertex of a piece being cut
 off 5.3e-5 deep in the copy it was split from).
+
+:func:`two_sided_rows` makes every row at a copy (fixed or found) hold both vertices of
+its pair: the row of s on face f at t and t's condition on the coincident face at s are
+rows on the same two vertices with normals that turn apart as the lips deform, and the
+row takes the tighter one (the coarse confined sphere at x = 3.012e-3: a vertex 3.5e-10
+behind a lip face at its copy, the pair's row holding only the other side).
 """
 import numpy as np
 
 from .kinks3d import KINK, CopyIndex, expand_ranges, isin_ints, partner_faces, unique_ints
 from .rows3d import NodeToFaceRows
 
-__all__ = ["found_rows_at_copies", "folded_rows_at_copies"]
-
+__all__ = ["found_rows_at_copies", "folded_rows_at_copies", "two_sided_rows"]
 
 
 def _partner_at(index, face, vertex):
@@ -193,3 +198,69 @@ def folded_rows_at_copies(points, faces, rows, pick, vertex_fragment, tied=None,
     zero = np.zeros(len(face))
     return NodeToFaceRows(slave=slave, master=master, face=face, bary=bary, normal=normal, dist=zero,
                           g=zero.copy(), nv=nv)
+
+
+def two_sided_rows(rows, points, displacement, index, margin=0.0):
+    """Rows at a copy with the normal of the tighter of the pair's two conditions.
+
+    A row of slave s on face f at its copy t (projected at t) is the condition
+    n_f . (x_s - x_t) >= 0: s out of f's plane. The coincident face f' at s gives the
+    reversed condition, t out of f''s plane: -n_f' . (x_s - x_t) >= 0, the same row while
+    the faces are parallel. Once the lips slide by d and the faces turn apart by an angle
+    a, the two differ by about |d| a, and a row on one face lets the copy of the other
+    side through its plane by that much. Both conditions are rows of the same vertices (s
+    and t), differing only in the normal: the row takes the normal whose gap is the
+    smaller, so that its one row holds both vertices (two rows on nearly parallel faces,
+    imposed together, would block the slip of the copies; docs/contact.md, "Crack lips
+    in 3D"). Only a reversed gap below the row's by more than ``margin`` counts: coincident
+    faces' normals differ by rounding even where nothing slid, and a difference the solve
+    does not see (the active set keeps a row's linearisation while its gap moves by less
+    than a hundredth of the penetration tolerance) should not change its rounding.
+
+    Parameters
+    ----------
+    rows : NodeToFaceRows
+        Rows re-linearised at X + U (:func:`~ngfracture.contact.rows3d.relinearise_node_to_face`).
+    points : numpy.ndarray, shape (nv, 3)
+        Reference coordinates X (copies bitwise equal).
+    displacement : numpy.ndarray, shape (nv, 3)
+        Displacements U.
+    index : ngfracture.contact.kinks3d.CopyIndex
+        The index of ``points`` and the boundary faces.
+    margin : float, optional
+        How much smaller (a length) the reversed gap must be to replace the row's.
+
+    Returns
+    -------
+    NodeToFaceRows
+        ``rows`` itself where no row changes; else the rows in their order, those at a
+        copy whose reversed condition is tighter with the normal -n_f' (unit, at X + U)
+        and its ``dist``; ``bary`` and ``g`` (0 at a copy) unchanged.
+    """
+    if len(rows) == 0:
+        return rows
+    X = np.asarray(points)
+    pid = index.point
+    top = np.argmax(rows.bary, axis=1)
+    corner = rows.master[np.arange(len(rows)), top]
+    at = np.flatnonzero((rows.bary[np.arange(len(rows)), top] == 1.0) & (pid[rows.slave] >= 0)
+                        & (pid[corner] == pid[rows.slave]) & (corner != rows.slave))
+    if len(at) == 0:
+        return rows
+    partner = _partner_at(index, rows.face[at], rows.slave[at])
+    at, partner = at[partner >= 0], partner[partner >= 0]
+    x = X + np.asarray(displacement)
+    tri = x[index.faces[partner]]
+    area = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    length = np.linalg.norm(area, axis=1)
+    ok = length > 1e-16 * np.linalg.norm(index.area2[partner], axis=1)      # not squeezed flat
+    reverse = -area / np.where(ok, length, 1.0)[:, None]
+    d = x[rows.slave[at]] - x[corner[at]]
+    gap = np.einsum("ij,ij->i", reverse, d)
+    tighter = ok & (gap < rows.dist[at] - margin)
+    if not tighter.any():
+        return rows
+    r = at[tighter]
+    normal, dist = rows.normal.copy(), rows.dist.copy()
+    normal[r], dist[r] = reverse[tighter], gap[tighter]
+    return NodeToFaceRows(rows.slave, rows.master, rows.face, rows.bary, normal, dist, rows.g, nv=rows.nv)
