@@ -59,6 +59,11 @@ def test_index_holds_the_plain_arrays():
     assert np.array_equal(index.incident, np.sort(faces.ravel()))
     p = points[faces]
     assert np.array_equal(index.area2, np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]))
+    # every face's run of its key in the sorted keys: what searchsorted finds
+    start = np.searchsorted(index.key_sorted, index.face_key)
+    assert np.array_equal(index.key_start, start)
+    assert np.array_equal(index.key_count, np.searchsorted(index.key_sorted, index.face_key, side="right") - start)
+    assert index.key_count.min() == 1 and index.key_count.max() == 2        # outer faces once, lips twice
     # its arrays are copies: changing the caller's arrays afterwards does not reach it
     before = index.faces.copy()
     faces[0] = faces[1]

@@ -62,9 +62,8 @@ __all__ = ["found_rows_at_copies", "folded_rows_at_copies", "two_sided_rows"]
 
 def _partner_at(index, face, vertex):
     """For every (face, vertex): the face on the same three points with ``vertex`` as a corner, or -1."""
-    F, key, order = index.faces, index.face_key, index.key_order
-    start = np.searchsorted(index.key_sorted, key[face])
-    count = np.searchsorted(index.key_sorted, key[face], side="right") - start
+    F, order = index.faces, index.key_order
+    start, count = index.key_start[face], index.key_count[face]
     out = np.full(len(face), -1, dtype=np.int64)
     for shift in range(int(count.max(initial=0))):            # the faces on the same points: a few at most
         slot = np.minimum(start + shift, len(order) - 1)

@@ -132,6 +132,9 @@ class CopyIndex:
     face_key : numpy.ndarray of int64, shape (nf,)
         :func:`face_point_keys`; ``key_order`` its stable argsort, ``key_sorted`` the keys
         in that order.
+    key_start, key_count : numpy.ndarray of int64, shape (nf,)
+        Where every face's key begins in ``key_sorted`` and how often it occurs there (the
+        faces on the same three points: ``key_order[key_start[f]:key_start[f] + key_count[f]]``).
     incidence : numpy.ndarray of int64, shape (3 nf,)
         ``faces.ravel()`` argsorted (stable); ``incident`` its vertices in that order.
     area2, unit : numpy.ndarray, shape (nf, 3)
@@ -159,7 +162,21 @@ class CopyIndex:
         self.point[self.on] = self.group
         self.copies = np.bincount(self.group, minlength=1)
         self.key_sorted = self.face_key[self.key_order]
+        self.key_start, self.key_count = _key_runs(self.key_sorted, self.key_order)
         self.incident = self.faces.ravel()[self.incidence]
+
+
+def _key_runs(key_sorted, key_order):
+    """For every face (``key_order`` sorts the faces by key): the start of its key's run in
+    ``key_sorted`` and the run's length, what two searchsorted calls per face give."""
+    first = np.ones(len(key_sorted), dtype=bool)
+    first[1:] = key_sorted[1:] != key_sorted[:-1]
+    starts = np.flatnonzero(first)
+    run = np.cumsum(first) - 1
+    counts = np.diff(np.append(starts, len(key_sorted)))
+    start, count = np.empty(len(key_order), dtype=np.int64), np.empty(len(key_order), dtype=np.int64)
+    start[key_order], count[key_order] = starts[run], counts[run]
+    return start, count
 
 
 def partner_faces(points, faces, slave, copy, all_pairs, one_way=True, index=None):
