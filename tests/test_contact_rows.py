@@ -175,6 +175,15 @@ def test_banded_and_pivoted_agree_on_long_chains():
         assert np.linalg.matrix_rank(C[keep].toarray()) == rank
 
 
+@pytest.mark.parametrize("method", ["pivoted", "banded", "auto"])
+def test_rows_on_fixed_dofs_only_are_all_dropped_beside_general_rows(method):
+    # every row of C vanishes on the fixed dofs; the Dirichlet-like rows G stay: no row is
+    # independent of them, whatever the method (no ordering of an empty set of rows)
+    C = sp.csr_matrix(np.array([[1.0, 0, 0], [0, 1.0, 0]]))
+    G = sp.csr_matrix(np.array([[0, 0, 1.0]]))
+    assert len(contact.independent_rows(C, fixed_dofs=[0, 1], G=G, method=method)) == 0
+
+
 @pytest.mark.parametrize("distance", [None, 0.5e-5, 2e-5, 1e-3])
 def test_gram_shortcut_agrees_with_the_pivoted_qr(monkeypatch, distance):
     """Rows that are clearly independent skip the pivoted QR (redundancy._clearly_independent)

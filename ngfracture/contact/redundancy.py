@@ -229,8 +229,8 @@ def _dense_pivoted_qr(Cc, Gc, rtol):
 def _supports_qr(Ca, Gn, lab_c, lab_g, rtol, method, dense_limit):
     """Rows of Ca kept by the C++ QR of :func:`independent_rows`, per component."""
     position = np.zeros(Ca.shape[0], dtype=np.int64)
-    largest = int(np.bincount(lab_c).max(initial=0)) if len(lab_c) else 0
-    if method == "banded" or (method == "auto" and largest >= min(GRAM_MIN_ROWS, dense_limit + 1)):
+    largest = np.bincount(lab_c).max(initial=0)
+    if Ca.shape[0] and (method == "banded" or (method == "auto" and largest >= min(GRAM_MIN_ROWS, dense_limit + 1))):
         # processing order of the rows of a component for the banded QR and the Gram test
         # (its envelope): reverse Cuthill-McKee of the row graph. Smaller components take
         # the pivoted QR in index order, whatever the positions (the C++ sorts them): the
