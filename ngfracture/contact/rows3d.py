@@ -528,7 +528,7 @@ def relinearise_node_to_face(rows, points, displacement):
     (negative weights set to 0 and the rest rescaled to sum 1); the normal keeps its
     side. A master face squeezed below 1e-16 of its reference area keeps its previous
     normal and barycentrics. A row projected at a copy of the slave (twin, lip and
-    partner-face rows; :func:`~ngfracture.contact.kinks3d.anchored_at_copies`) keeps its
+    partner-face rows: barycentric 1 at a corner whose reference point is the slave's) keeps its
     projection there: the rows of one slave on several faces at a copy t then all vanish
     where the copies meet (docs/contact.md, "Points of several copies").
 
