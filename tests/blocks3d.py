@@ -8,6 +8,7 @@ Used by ``test_contact3d_keys.py`` (with noise), ``test_active_set_settle.py`` (
 import numpy as np
 
 from ngfracture.contact.active_set import Geometry
+from ngfracture.contact.mixed_rows import MixedRows
 from ngfracture.contact.rows3d import NodeToFaceRows
 from ngfracture.geometry.pieces import fragmented_box
 
@@ -55,10 +56,18 @@ def block_geometry(arrays, piece):
 
 
 def assert_same_rows(a, b):
-    """Two ``NodeToFaceRows`` equal bit for bit: their length, every field and the CSR arrays of C."""
+    """Two ``NodeToFaceRows`` (or ``MixedRows`` of them and edge rows) equal bit for bit: their
+    length, every field and the CSR arrays of C."""
     assert len(a) == len(b)
-    for f in NodeToFaceRows.FIELDS:
-        assert np.array_equal(getattr(a, f), getattr(b, f)), f
+    if isinstance(a, MixedRows):
+        assert isinstance(b, MixedRows) and np.array_equal(a.kind, b.kind)
+        assert np.array_equal(a.g, b.g) and np.array_equal(a.dist, b.dist)
+        for pa, pb in zip(a.parts, b.parts):
+            for f in type(pa).FIELDS:
+                assert np.array_equal(getattr(pa, f), getattr(pb, f)), f
+    else:
+        for f in NodeToFaceRows.FIELDS:
+            assert np.array_equal(getattr(a, f), getattr(b, f)), f
     ca, cb = a.C.tocsr(), b.C.tocsr()
     assert ca.shape == cb.shape
     for f in ("indptr", "indices", "data"):

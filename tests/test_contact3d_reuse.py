@@ -47,7 +47,7 @@ def test_a_block_pushed_through_closed_lips_finds_every_pair():
 
 def test_subset_and_stack_carry_the_gap_rows():
     arrays, piece, _, U = overlapping_blocks(CELLS, PIECES, 0.2 / CELLS * PIECES, noise=0.05 / CELLS)
-    rows = ActiveSet3d(block_geometry(arrays, piece), 1e-12).update(U, {"collision": 0.0}).rows
+    rows = ActiveSet3d(block_geometry(arrays, piece), 1e-12).update(U, {"collision": 0.0}).rows.parts[0]
     assert len(rows) > 100
     plain = NodeToFaceRows(*(getattr(rows, f) for f in NodeToFaceRows.FIELDS), nv=rows.nv)
     built = NodeToFaceRows(*(getattr(rows, f) for f in NodeToFaceRows.FIELDS), nv=rows.nv)
@@ -76,5 +76,6 @@ def test_settling_takes_the_update_s_relinearisation():
     cand = active.update(U2, {"collision": 0.0})
     assert cand.relinearised is not None and 0 < len(cand.relinearised) < len(cand.rows)
     reused = active._fresh_rows(cand, U2)
-    fresh = relinearise_node_to_face(cand.rows, arrays.points, U2)
-    assert_same_rows(reused, two_sided_rows(fresh, arrays.points, U2, active.setup.copy_index))
+    assert not np.any(cand.rows.kind)                     # vertices deep inside: no edge rows
+    fresh = relinearise_node_to_face(cand.rows.parts[0], arrays.points, U2)
+    assert_same_rows(reused.parts[0], two_sided_rows(fresh, arrays.points, U2, active.setup.copy_index))

@@ -488,7 +488,7 @@ class ActiveSet:
         self.updates += 1
         # a geometric fixed point: the overlap falls from second to fourth order in the step
         rows = refreshed(candidates.rows, fresh, U, 0.01 * self.penetration_tol)
-        self.seam_rows, self.n2s = self._split(rows)
+        self._keep_rows(rows)
         return "update", penetration, Candidates(rows, candidates.keys, gap)
 
     def record(self, keys, kept, multipliers, support_force):
@@ -537,6 +537,10 @@ class ActiveSet:
     def _holds_for(self, C):
         """The rows kept in any case that the independence of the rows ``C`` is judged with."""
         return self.geometry.holds
+
+    def _keep_rows(self, rows):
+        """Keep the candidate rows ``rows`` (re-linearised) for the next update."""
+        self.seam_rows, self.n2s = self._split(rows)
 
     def _split(self, rows):
         """Candidate rows as (seam rows, node-to-segment rows)."""

@@ -6,7 +6,7 @@ node-to-segment rows. The choice of the set (primal-dual update, complementarity
 where it cycles), the redundancy removal and the records are the 2D ones, unchanged; only
 where the candidates come from and how they are re-linearised differ.
 
-Candidates, each identified by its key ("f", slave, master vertices sorted):
+Candidates, each identified by its key ("f", slave, master vertices sorted; "e", edge a, edge b):
 
 - *fixed* rows, made at the first update of a solve and kept (re-linearised) for the whole
   solve:
@@ -43,6 +43,14 @@ Candidates, each identified by its key ("f", slave, master vertices sorted):
   complementarity problem chooses the set, while it has been wanted or imposed in the
   solve (a row the problem released must stay visible to the next problem).
 
+- *edge* rows (:mod:`~ngfracture.contact.edge_rows3d`): pairs of boundary edges of two
+  fragments that cross at the configuration of the last solve with no vertex inside
+  (searched only in a round where no vertex lies deeper than ``penetration_tol`` in another
+  piece, :meth:`ActiveSet3d._edge_to_edge`), kept as found rows are.
+
+The candidates of a round are a :class:`~ngfracture.contact.mixed_rows.MixedRows` table:
+the node-to-face rows (fixed, then found), then the edge rows.
+
 Every round re-linearises all candidates at the configuration of the last solve
 (:func:`~ngfracture.contact.rows3d.relinearise_node_to_face`; a row at a copy takes the
 normal of the tighter of its pair's two conditions,
@@ -66,7 +74,9 @@ import scipy.sparse as sp
 
 from .active_set import ActiveSet, Candidates, RowKeys, refreshed
 from .copies3d import folded_rows_at_copies, found_rows_at_copies, two_sided_rows
+from .edge_rows3d import EdgeRows, edge_rows, no_edge_rows, relinearise_edge_rows
 from .intsets import isin_ints, union_ints, unique_ints
+from .mixed_rows import MixedRows
 from .redundancy import holds_on_columns
 from .rows3d import NodeToFaceRows, no_face_rows, node_to_face_rows, relinearise_node_to_face
 from .setup3d import FaceKeys, MeshSetup3d
@@ -166,6 +176,8 @@ class ActiveSet3d(ActiveSet):
         self.codec = self.setup.codec
         self.n2s = no_face_rows(len(a.points))
         self.n2s_keys = RowKeys(np.zeros(0, dtype=np.int64), self.codec)
+        self.edges = no_edge_rows(len(a.points))
+        self.edge_keys = RowKeys(np.zeros(0, dtype=np.int64), self.codec)
 
     def update(self, U, timings):
         """The candidate rows at X + U, the configuration of the last solve.
@@ -186,30 +198,47 @@ class ActiveSet3d(ActiveSet):
         ngfracture.contact.active_set.Candidates
         """
         relinearised = None
+        limit = 0.01 * self.penetration_tol
         if self.seam_rows is None:
             self.seam_rows, self.seam_keys = self.setup.rows, self.setup.keys
         elif self.moving:
             old = NodeToFaceRows.stack([self.seam_rows, self.n2s])
             relinearised = self._relinearise(old, U)
-            self.seam_rows, self.n2s = self._split(refreshed(old, relinearised, U, 0.01 * self.penetration_tol))
-        found, found_codes = self._node_to_face(U, timings)
+            self.seam_rows, self.n2s = self._split(refreshed(old, relinearised, U, limit))
+            self.edges = refreshed(self.edges, relinearise_edge_rows(self.edges, self.geometry.arrays.points, U),
+                                   U, limit)
+        t0 = time.perf_counter()
+        pen = self.setup.detector.detect(U)
+        timings["collision"] += time.perf_counter() - t0
+        found, found_codes = self._node_to_face(pen)
         n2s_codes = self.n2s_keys.codes
-        known = np.concatenate([n2s_codes, self.seam_keys.codes])
-        retain = self._has_multiplier(n2s_codes)[0] | isin_ints(n2s_codes, found_codes)
+        retained = self._retained(n2s_codes, found_codes)
+        new = np.flatnonzero(~isin_ints(found_codes, np.concatenate([n2s_codes, self.seam_keys.codes])))
+        self.n2s = NodeToFaceRows.stack([self.n2s.subset(retained), found.subset(new)])
+        self.n2s_keys = RowKeys(np.concatenate([n2s_codes[retained], found_codes[new]]), self.codec)
+        found, found_codes = self._edge_to_edge(U, pen, timings)
+        edge_codes = self.edge_keys.codes
+        kept = self._retained(edge_codes, found_codes)
+        fresh = np.flatnonzero(~isin_ints(found_codes, edge_codes))
+        self.edges = EdgeRows.stack([self.edges.subset(kept), found.subset(fresh)])
+        self.edge_keys = RowKeys(np.concatenate([edge_codes[kept], found_codes[fresh]]), self.codec)
+        rows = MixedRows([NodeToFaceRows.stack([self.seam_rows, self.n2s]), self.edges])
+        if relinearised is not None:
+            n_fixed = len(self.seam_keys)
+            relinearised = relinearised.subset(np.concatenate([np.arange(n_fixed), n_fixed + retained]))
+        return Candidates(rows, self.seam_keys + self.n2s_keys + self.edge_keys, rows.C @ U.T.ravel() + rows.g,
+                          relinearised)
+
+    def _retained(self, codes, found_codes):
+        """Which found rows of the last update (their ``codes``) stay candidates: those active,
+        found again (``found_codes``) or, once the complementarity problem chooses, tried."""
+        retain = self._has_multiplier(codes)[0] | isin_ints(codes, found_codes)
         if self.exact:
             # the complementarity problem chooses among the rows wanted or imposed in the
             # solve; one it released stays a candidate, or the next problem cannot see the
             # penetration that releasing it lets happen
-            retain |= isin_ints(n2s_codes, union_ints(self.tried, self.wanted))
-        retained = np.flatnonzero(retain)
-        new = np.flatnonzero(~isin_ints(found_codes, known))
-        self.n2s = NodeToFaceRows.stack([self.n2s.subset(retained), found.subset(new)])
-        self.n2s_keys = RowKeys(np.concatenate([n2s_codes[retained], found_codes[new]]), self.codec)
-        rows = NodeToFaceRows.stack([self.seam_rows, self.n2s])
-        if relinearised is not None:
-            n_fixed = len(self.seam_keys)
-            relinearised = relinearised.subset(np.concatenate([np.arange(n_fixed), n_fixed + retained]))
-        return Candidates(rows, self.seam_keys + self.n2s_keys, rows.C @ U.T.ravel() + rows.g, relinearised)
+            retain |= isin_ints(codes, union_ints(self.tried, self.wanted))
+        return np.flatnonzero(retain)
 
     def _key_codes(self, keys):
         """The codes of keys given as tuples (:meth:`FaceKeys.codes_of`)."""
@@ -231,11 +260,19 @@ class ActiveSet3d(ActiveSet):
         so re-linearising a row again at the same U gives it bit for bit. Only the rows
         found new in this round are re-linearised here.
         """
+        faces, edges = candidates.rows.parts
         done = candidates.relinearised
         if done is None:
-            return self._relinearise(candidates.rows, U)
-        new = candidates.rows.subset(np.arange(len(done), len(candidates.rows)))
-        return NodeToFaceRows.stack([done, self._relinearise(new, U)])
+            fresh = self._relinearise(faces, U)
+        else:
+            fresh = NodeToFaceRows.stack([done, self._relinearise(faces.subset(np.arange(len(done), len(faces))), U)])
+        edges = relinearise_edge_rows(edges, self.geometry.arrays.points, U)
+        return MixedRows([fresh, edges], candidates.rows.kind)
+
+    def _keep_rows(self, rows):
+        """Keep the candidate rows ``rows`` (re-linearised) for the next update."""
+        faces, self.edges = rows.parts
+        self.seam_rows, self.n2s = self._split(faces)
 
     def _relinearise(self, rows, U):
         """``rows`` re-linearised at X + U, those at a copy on the tighter side of their pair
@@ -244,13 +281,38 @@ class ActiveSet3d(ActiveSet):
         return two_sided_rows(relinearise_node_to_face(rows, X, U), X, U, self.setup.copy_index,
                               0.01 * self.penetration_tol)
 
-    def _node_to_face(self, U, timings):
-        """The pairs detected at X + U that no twin row covers, as rows with their key codes."""
-        a = self.geometry.arrays
+    def _edge_to_edge(self, U, pen, timings):
+        """The pairs of boundary edges interlocked at X + U and crossed deeper than
+        ``penetration_tol``, as rows with their key codes; none while a vertex lies deeper
+        than that in another piece (``pen``, the node-to-face detection at U).
+
+        Edges cross with no vertex inside only where the vertices are held: in a solve's
+        prediction whole lips pass through each other, their edges cross everywhere, and
+        rows linearised there hold lines far from the surface that the vertex rows bring
+        back. So the edges are searched once the vertices are out, which the rounds reach
+        before a set can settle.
+        """
+        X = self.geometry.arrays.points
+        if len(pen) and pen.gap.min() < -self.penetration_tol:
+            return no_edge_rows(len(X)), np.zeros(0, dtype=np.int64)
         t0 = time.perf_counter()
-        setup = self.setup
-        pen = setup.detector.detect(U)
+        detector = self.setup.edge_detector
+        pairs = detector.detect(U)
         timings["collision"] += time.perf_counter() - t0
+        vf = self.setup.vertex_fragment
+        edges = detector.edges
+        # pairs of two fragments: the lips of a crack inside one fragment are held by their
+        # vertices' rows only (docs/contact.md, "Edges that cross")
+        pairs = pairs[vf[edges[pairs[:, 0], 0]] != vf[edges[pairs[:, 1], 0]]]
+        rows, kept = edge_rows(X, self.geometry.arrays.faces, edges, self.setup.edge_faces, pairs, U)
+        deep = np.flatnonzero(rows.dist < -self.penetration_tol)
+        return rows.subset(deep), self.codec.edge_codes(pairs[kept[deep]])
+
+    def _node_to_face(self, pen):
+        """The pairs detected (``pen``, the detection at X + U) that no twin row covers, as
+        rows with their key codes."""
+        a = self.geometry.arrays
+        setup = self.setup
         rows, at_copy = found_rows_at_copies(a.points, a.faces, node_to_face_rows(a.points, a.faces, pen),
                                              setup.vertex_fragment, index=setup.copy_index)
         # a vertex with a twin on the master fragment talks to it through its twin row; a

@@ -3,8 +3,8 @@
 A run solves many times on one mesh (every load step without a new crack; the mesh changes
 only where a crack pass splits it), and every solve's active set
 (:class:`~ngfracture.contact.active_set3d.ActiveSet3d`) starts from the same work on the
-mesh alone: the keys' codec, the detector's set-up, the boundary's copy index, the
-vertices' fragments, and the fixed rows in the reference configuration (the touching
+mesh alone: the keys' codec, the set-ups of the detectors (vertices in other fragments,
+crossing edges), the boundary's copy index, the vertices' fragments, and the fixed rows in the reference configuration (the touching
 pairs of the reference detection, the twin rows, the lip rows and partner-face rows) with
 the (vertex, fragment) pairs they cover. :class:`MeshSetup3d` is that work, made from
 copies of the arrays; :class:`MeshSetups` keeps the one of the last mesh and gives it to a
@@ -17,6 +17,8 @@ import numpy as np
 from .. import _ngfracture as _ext
 from .active_set import RowKeys
 from .collision3d import PenetrationDetector3d
+from .edge_crossings3d import EdgeCrossingDetector
+from .edge_rows3d import edge_faces
 from .junctions3d import covered_pairs, fragment_pair_rows
 from .kinks3d import CopyIndex
 from .rows3d import NodeToFaceRows, lip_rows, node_to_face_rows
@@ -29,12 +31,17 @@ class FaceKeys:
 
     A row's key ("f", slave, master vertices sorted) is the code slave * n + i, with i the
     number of the master's vertex set among the distinct vertex sets of the boundary faces
-    (codes are equal exactly where keys are; :mod:`ngfracture.contact.active_set3d`).
+    (codes are equal exactly where keys are; :mod:`ngfracture.contact.active_set3d`). An
+    edge-to-edge row's key ("e", a0, a1, b0, b1) (:mod:`ngfracture.contact.edge_rows3d`) is
+    the negative code -1 - (i * nE + j), with i < j the numbers of its edges among the nE
+    sorted boundary edges: codes of the two kinds never meet, and -1 is no key.
 
     Parameters
     ----------
     faces : array_like of int, shape (nf, 3)
         The mesh's boundary faces.
+    edges : array_like of int, shape (nE, 2), optional
+        The mesh's sorted boundary edges, for edge keys.
 
     Raises
     ------
@@ -42,7 +49,7 @@ class FaceKeys:
         If ``faces`` is not of shape (nf, 3) with vertex numbers >= 0.
     """
 
-    def __init__(self, faces):
+    def __init__(self, faces, edges=None):
         F = np.asarray(faces)
         if F.ndim != 2 or F.shape[1] != 3 or (F.size and (not np.issubdtype(F.dtype, np.integer) or F.min() < 0)):
             raise ValueError(f"faces must be vertex numbers >= 0 of shape (nf, 3), got {F.dtype} {F.shape}")
@@ -53,6 +60,8 @@ class FaceKeys:
         _, self.face_set, self.triples = _ext.SortedTripleRanks(F, int(F.max(initial=-1)) + 1)
         self.n = max(len(self.triples), 1)
         self._lookup = None
+        self.edges = np.zeros((0, 2), dtype=np.int64) if edges is None else np.asarray(edges, dtype=np.int64)
+        self._edge_lookup = None
 
     def codes(self, rows):
         """The codes of the keys of some rows.
@@ -77,7 +86,8 @@ class FaceKeys:
         return np.asarray(rows.slave, dtype=np.int64) * self.n + sets
 
     def codes_of(self, keys):
-        """The codes of keys given as tuples ("f", slave, a, b, c); -1 for a key of no face.
+        """The codes of keys given as tuples ("f", slave, a, b, c) or ("e", a0, a1, b0, b1); -1 for
+        a key of no face or edges.
 
         Parameters
         ----------
@@ -89,12 +99,32 @@ class FaceKeys:
         """
         if self._lookup is None:
             self._lookup = {tuple(t): i for i, t in enumerate(self.triples.tolist())}
-        look = self._lookup
-        return np.fromiter(((k[1] * self.n + look[k[2:]]) if k[2:] in look else -1 for k in keys),
-                           dtype=np.int64, count=len(keys))
+            self._edge_lookup = {tuple(e): i for i, e in enumerate(self.edges.tolist())}
+        look, edge, ne = self._lookup, self._edge_lookup, len(self.edges)
+
+        def code(k):
+            if k[0] == "e":
+                i, j = edge.get(k[1:3], -1), edge.get(k[3:5], -1)
+                return -1 - (i * ne + j) if 0 <= i < j else -1
+            return (k[1] * self.n + look[k[2:]]) if k[2:] in look else -1
+        return np.fromiter((code(k) for k in keys), dtype=np.int64, count=len(keys))
+
+    def edge_codes(self, pairs):
+        """The codes of edge-to-edge keys given as pairs (i, j), i < j, of edge numbers.
+
+        Parameters
+        ----------
+        pairs : numpy.ndarray of int, shape (m, 2)
+
+        Returns
+        -------
+        numpy.ndarray of int64
+        """
+        pairs = np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
+        return -1 - (pairs[:, 0] * len(self.edges) + pairs[:, 1])
 
     def decode(self, codes):
-        """The key tuples ("f", slave, master vertices sorted) of codes.
+        """The key tuples ("f", slave, master vertices sorted; "e", edge a, edge b) of codes.
 
         Parameters
         ----------
@@ -104,8 +134,15 @@ class FaceKeys:
         -------
         list of tuple
         """
-        slave, sets = np.divmod(np.asarray(codes, dtype=np.int64), self.n)
-        return [("f", s, a, b, c) for s, (a, b, c) in zip(slave.tolist(), self.triples[sets].tolist())]
+        codes = np.asarray(codes, dtype=np.int64)
+        slave, sets = np.divmod(np.maximum(codes, 0), self.n)
+        keys = [("f", s, a, b, c) for s, (a, b, c) in zip(slave.tolist(), self.triples[sets].tolist())]
+        edge = np.flatnonzero(codes < 0)
+        if len(edge):
+            i, j = np.divmod(-1 - codes[edge], max(len(self.edges), 1))
+            for r, a, b in zip(edge.tolist(), self.edges[i].tolist(), self.edges[j].tolist()):
+                keys[r] = ("e", a[0], a[1], b[0], b[1])
+        return keys
 
 
 def vertex_fragments(nv, tets, fragment):
@@ -177,6 +214,9 @@ class MeshSetup3d:
         Copies of the arrays (their dtypes kept), which :meth:`fits` compares with.
     codec : FaceKeys
     detector : ngfracture.contact.collision3d.PenetrationDetector3d
+    edge_detector : ngfracture.contact.edge_crossings3d.EdgeCrossingDetector
+    edge_faces : numpy.ndarray of int64, shape (nE, 2)
+        The two faces at every boundary edge (:func:`~ngfracture.contact.edge_rows3d.edge_faces`).
     copy_index : ngfracture.contact.kinks3d.CopyIndex
     vertex_fragment : numpy.ndarray of int64
     rows : NodeToFaceRows
@@ -195,9 +235,12 @@ class MeshSetup3d:
     def __init__(self, points, tets, faces, fragment):
         self.points, self.tets, self.faces, self.fragment = (np.array(a) for a in (points, tets, faces, fragment))
         self.detector = PenetrationDetector3d(self.points, self.tets, self.faces, self.fragment)   # checks
-        self.codec = FaceKeys(self.faces)
-        self.copy_index = CopyIndex(self.points, self.faces)
         self.vertex_fragment = vertex_fragments(len(self.points), self.tets, self.fragment)
+        self.edge_detector = EdgeCrossingDetector(self.points, self.faces,
+                                                  self.vertex_fragment[np.asarray(self.faces, dtype=np.int64)[:, 0]])
+        self.edge_faces = edge_faces(self.faces, self.edge_detector.edges)
+        self.codec = FaceKeys(self.faces, self.edge_detector.edges)
+        self.copy_index = CopyIndex(self.points, self.faces)
         self.rows, self.keys = fixed_rows(self.points, self.faces, self.vertex_fragment, self.codec,
                                           self.detector, self.copy_index)
         self.covered = covered_pairs(self.points, self.rows, self.vertex_fragment)
