@@ -15,6 +15,7 @@ void ExportSplit3d (py::module & m);   // python_split3d.cpp
 void ExportCriterion3D (py::module & m);  // python_criterion3d.cpp
 void ExportOverlap3d (py::module & m);  // python_overlap3d.cpp
 void ExportSetup3d (py::module & m);  // python_setup3d.cpp
+void ExportEdges3d (py::module & m);  // python_edges3d.cpp
 
 using Doubles = py::array_t<double, py::array::c_style | py::array::forcecast>;
 using Ints = py::array_t<int, py::array::c_style | py::array::forcecast>;
@@ -329,4 +330,5 @@ PYBIND11_MODULE(_ngfracture, m)
   ExportCriterion3D(m);
   ExportOverlap3d(m);
   ExportSetup3d(m);
+  ExportEdges3d(m);
 }

@@ -1,0 +1,265 @@
+// Boundary edges of different fragments (or of the two lips of one crack) that cross.
+#include "edge_crossings3d.hpp"
+#include "predicates.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+namespace ngfracture
+{
+  namespace
+  {
+    // A spatial hash of boxes: the cells (i, j, k) of size h from origin that each box
+    // overlaps, bucketed by a hash of the cell (a counting sort). An entry holds its cell
+    // and its box's first cell, so that a scan of a bucket reads it alone: entries of
+    // other cells in the bucket (hash collisions) are told apart by their cell.
+    struct BoxHash
+    {
+      struct Entry
+      {
+        int32_t cell[3];               // the cell of this entry
+        int32_t item;
+        int32_t first[3];              // the item's first cell along x, y, z
+      };
+      double origin[3] = { 0, 0, 0 }, h = 0;
+      int shift = 64;
+      std::vector<int64_t> start;      // bucket b holds entries[start[b] .. start[b+1])
+      std::vector<Entry> entries;
+
+      int32_t Cell (double v, int d) const { return int32_t(std::floor((v - origin[d]) / h)); }
+      size_t Bucket (int64_t i, int64_t j, int64_t k) const
+      {
+        uint64_t m = uint64_t(i) * 0x9E3779B97F4A7C15ull ^ uint64_t(j) * 0xC2B2AE3D27D4EB4Full
+          ^ uint64_t(k) * 0x165667B19E3779F9ull;
+        return size_t((m * 0xD6E8FEB86659FD93ull) >> shift);
+      }
+      template <typename F> static void Cells (const int32_t * r, F && f)
+      {
+        for (int32_t i = r[0]; i <= r[3]; i++)
+          for (int32_t j = r[1]; j <= r[4]; j++)
+            for (int32_t k = r[2]; k <= r[5]; k++)
+              f(i, j, k);
+      }
+      // first and last cell along x, y, z of the box lo..hi
+      void Range (const double * lo, const double * hi, int32_t * r) const
+      {
+        for (int d = 0; d < 3; d++) { r[d] = Cell(lo[d], d); r[3+d] = Cell(hi[d], d); }
+      }
+
+      // cell size: the mean largest extent of a box, at least 2^-20 of the boxes' span,
+      // doubled while the boxes would fill more than 32 n + 2^20 cells; returns false
+      // (nothing hashed) when every box is a point
+      bool Build (const std::vector<double> & lo, const std::vector<double> & hi)
+      {
+        size_t n = lo.size() / 3;
+        double top[3] = { -INFINITY, -INFINITY, -INFINITY }, extent = 0;
+        std::fill(origin, origin + 3, INFINITY);
+        for (size_t t = 0; t < n; t++)
+          {
+            double m = 0;
+            for (int d = 0; d < 3; d++)
+              {
+                origin[d] = std::min(origin[d], lo[3*t+d]);
+                top[d] = std::max(top[d], hi[3*t+d]);
+                m = std::max(m, hi[3*t+d] - lo[3*t+d]);
+              }
+            extent += m;
+          }
+        h = n ? extent / double(n) : 0;
+        if (!(h > 0) || !std::isfinite(h)) { h = 0; return false; }
+        for (int d = 0; d < 3; d++) h = std::max(h, (top[d] - origin[d]) / double(1 << 20));
+        std::vector<int32_t> range(6 * n);
+        int64_t count = 0;
+        // boxes far larger than the mean would fill too many cells: coarser cells then
+        for (bool fits = false; !fits; h *= fits ? 1.0 : 2.0)
+          {
+            count = 0;
+            for (size_t t = 0; t < n; t++)
+              {
+                Range(&lo[3*t], &hi[3*t], &range[6*t]);
+                int32_t * r = &range[6*t];
+                count += int64_t(r[3] - r[0] + 1) * (r[4] - r[1] + 1) * (r[5] - r[2] + 1);
+              }
+            fits = count <= 32 * int64_t(n) + (int64_t(1) << 20);
+          }
+        int bits = 4;
+        while ((int64_t(1) << bits) < count) bits++;
+        shift = 64 - bits;
+        start.assign((size_t(1) << bits) + 1, 0);
+        for (size_t t = 0; t < n; t++)
+          Cells(&range[6*t], [&] (int32_t i, int32_t j, int32_t k) { start[Bucket(i, j, k) + 1]++; });
+        for (size_t b = 1; b < start.size(); b++) start[b] += start[b-1];
+        entries.resize(size_t(count));
+        std::vector<int64_t> fill(start.begin(), start.end() - 1);
+        for (size_t t = 0; t < n; t++)
+          {
+            const int32_t * r = &range[6*t];
+            Cells(r, [&] (int32_t i, int32_t j, int32_t k)
+              { entries[fill[Bucket(i, j, k)]++] = Entry { { i, j, k }, int32_t(t), { r[0], r[1], r[2] } }; });
+          }
+        return true;
+      }
+    };
+
+    bool Shares (const int32_t * f, int32_t v) { return f[0] == v || f[1] == v || f[2] == v; }
+  }
+
+  bool SegmentPiercesTriangle (const double * p, const double * q, const double * a, const double * b,
+                               const double * c)
+  {
+    // an endpoint at a corner (a closed lip's copy) lies on the plane: no exact predicate needed
+    for (const double * v : { a, b, c })
+      if ((p[0] == v[0] && p[1] == v[1] && p[2] == v[2]) || (q[0] == v[0] && q[1] == v[1] && q[2] == v[2]))
+        return false;
+    int o = Orient3dSign(a, b, c, p);
+    if (o == 0 || Orient3dSign(a, b, c, q) != -o) return false;
+    int s = Orient3dSign(p, q, a, b);
+    return s != 0 && Orient3dSign(p, q, b, c) == s && Orient3dSign(p, q, c, a) == s;
+  }
+
+  EdgeCrossingDetector3::EdgeCrossingDetector3 (int64_t nv, const int32_t * faces, int64_t nf,
+                                                const int32_t * face_fragment)
+    : nv_(nv), nf_(nf), faces_(faces, faces + 3 * nf), fragment_(face_fragment, face_fragment + nf)
+  {
+    std::vector<int32_t> owner(nv, -1);          // the face that first claimed every vertex
+    for (int64_t f = 0; f < nf; f++)
+      for (int k = 0; k < 3; k++)
+        {
+          int32_t v = faces[3*f+k];
+          if (v < 0 || v >= nv)
+            throw std::invalid_argument("faces: face " + std::to_string(f) + " has vertex number " + std::to_string(v)
+                                        + ", not in [0, " + std::to_string(nv) + ")");
+          if (v == faces[3*f+(k+1)%3])
+            throw std::invalid_argument("faces: face " + std::to_string(f) + " repeats vertex " + std::to_string(v));
+          int32_t o = owner[v];
+          if (o < 0) owner[v] = int32_t(f);
+          else if (face_fragment[o] != face_fragment[f])
+            throw std::invalid_argument("face_fragment: vertex " + std::to_string(v) + " is on face " + std::to_string(o)
+                                        + " of fragment " + std::to_string(face_fragment[o]) + " and on face "
+                                        + std::to_string(f) + " of fragment " + std::to_string(face_fragment[f]));
+        }
+    // every (edge key, face slot 3 f + k), sorted: the edges in lexicographic order, the
+    // faces at each edge increasing
+    std::vector<std::pair<uint64_t, int64_t>> slots(3 * nf);
+    for (int64_t f = 0; f < nf; f++)
+      for (int k = 0; k < 3; k++)
+        {
+          uint64_t u = uint32_t(faces[3*f+k]), w = uint32_t(faces[3*f+(k+1)%3]);
+          slots[3*f+k] = { (std::min(u, w) << 32) | std::max(u, w), 3*f+k };
+        }
+    std::sort(slots.begin(), slots.end());
+    face_edges_.resize(3 * nf);
+    edge_faces_.resize(3 * nf);
+    edge_face_ptr_.push_back(0);
+    for (size_t s = 0; s < slots.size(); s++)
+      {
+        if (s == 0 || slots[s].first != slots[s-1].first)
+          {
+            if (s) edge_face_ptr_.push_back(int64_t(s));
+            edges_.push_back(int32_t(slots[s].first >> 32));
+            edges_.push_back(int32_t(slots[s].first & 0xffffffffu));
+          }
+        face_edges_[slots[s].second] = int32_t(edges_.size() / 2 - 1);
+        edge_faces_[s] = int32_t(slots[s].second / 3);
+      }
+    if (!slots.empty()) edge_face_ptr_.push_back(int64_t(slots.size()));
+  }
+
+  bool EdgeCrossingDetector3::Pierces (const double * x, int32_t e, int32_t f) const
+  {
+    int32_t p = edges_[2*e], q = edges_[2*e+1];
+    const int32_t * t = &faces_[3*f];
+    if (Shares(t, p) || Shares(t, q)) return false;
+    return SegmentPiercesTriangle(x + 3*p, x + 3*q, x + 3*t[0], x + 3*t[1], x + 3*t[2]);
+  }
+
+  // a pierces f, an face at b: does b pierce a face g at a, g of another fragment than f or
+  // sharing no vertex with it
+  bool EdgeCrossingDetector3::Interlock (const double * x, int32_t a, int32_t f, int32_t b) const
+  {
+    const int32_t * tf = &faces_[3*f];
+    for (int64_t s = edge_face_ptr_[a]; s < edge_face_ptr_[a+1]; s++)
+      {
+        int32_t g = edge_faces_[s];
+        const int32_t * tg = &faces_[3*g];
+        bool apart = fragment_[g] != fragment_[f]
+          || !(Shares(tf, tg[0]) || Shares(tf, tg[1]) || Shares(tf, tg[2]));
+        if (apart && Pierces(x, b, g)) return true;
+      }
+    return false;
+  }
+
+  std::vector<int32_t> EdgeCrossingDetector3::Detect (const double * x, EdgeCrossingStats * stats) const
+  {
+    EdgeCrossingStats st;
+    std::vector<int32_t> out;
+    std::vector<double> lo(3 * nf_), hi(3 * nf_);
+    for (int64_t f = 0; f < nf_; f++)
+      for (int d = 0; d < 3; d++)
+        {
+          double a = x[3*faces_[3*f]+d], b = x[3*faces_[3*f+1]+d], c = x[3*faces_[3*f+2]+d];
+          lo[3*f+d] = std::min({ a, b, c });
+          hi[3*f+d] = std::max({ a, b, c });
+        }
+    BoxHash grid;
+    if (!grid.Build(lo, hi)) { if (stats) *stats = st; return out; }
+    st.cell = grid.h;
+    std::vector<std::pair<int32_t, int32_t>> pierces;   // (edge, face)
+    int64_t ne = int64_t(edges_.size() / 2);
+    for (int32_t e = 0; e < ne; e++)
+      {
+        const int32_t u = edges_[2*e], w = edges_[2*e+1];
+        const double * p = x + 3*u, * q = x + 3*w;
+        double elo[3], ehi[3];
+        int32_t r[6];
+        for (int d = 0; d < 3; d++) { elo[d] = std::min(p[d], q[d]); ehi[d] = std::max(p[d], q[d]); }
+        grid.Range(elo, ehi, r);
+        BoxHash::Cells(r, [&] (int32_t i, int32_t j, int32_t k)
+          {
+            size_t bucket = grid.Bucket(i, j, k);
+            for (int64_t s = grid.start[bucket]; s < grid.start[bucket+1]; s++)
+              {
+                const BoxHash::Entry & en = grid.entries[s];
+                // this cell, and the first cell both boxes' ranges share
+                if (en.cell[0] != i || en.cell[1] != j || en.cell[2] != k
+                    || std::max(r[0], en.first[0]) != i || std::max(r[1], en.first[1]) != j
+                    || std::max(r[2], en.first[2]) != k)
+                  continue;
+                int32_t f = en.item;
+                const int32_t * t = &faces_[3*f];
+                if (Shares(t, u) || Shares(t, w)) continue;
+                st.box_tests++;
+                bool overlap = true;              // strict: a pierce point lies inside both boxes
+                for (int d = 0; d < 3; d++)
+                  overlap &= elo[d] < hi[3*f+d] && lo[3*f+d] < ehi[d];
+                if (!overlap) continue;
+                st.exact_tests++;
+                if (SegmentPiercesTriangle(p, q, x + 3*t[0], x + 3*t[1], x + 3*t[2]))
+                  pierces.emplace_back(e, f);
+              }
+          });
+      }
+    st.pierces = int64_t(pierces.size());
+    std::vector<uint64_t> pairs;
+    for (auto [a, f] : pierces)
+      for (int k = 0; k < 3; k++)
+        {
+          int32_t b = face_edges_[3*f+k];
+          if (Interlock(x, a, f, b))
+            pairs.push_back((uint64_t(std::min(a, b)) << 32) | uint64_t(std::max(a, b)));
+        }
+    std::sort(pairs.begin(), pairs.end());
+    pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+    for (uint64_t c : pairs)
+      {
+        out.push_back(int32_t(c >> 32));
+        out.push_back(int32_t(c & 0xffffffffu));
+      }
+    if (stats) *stats = st;
+    return out;
+  }
+}
