@@ -16,7 +16,7 @@
 import numpy as np
 import pytest
 
-from ngfracture.contact.edge_rows3d import EdgeRows, edge_faces, edge_rows, relinearise_edge_rows
+from ngfracture.contact.edge_rows3d import EdgeRows, edge_rows, relinearise_edge_rows
 from ngfracture.contact.mixed_rows import MixedRows
 from ngfracture.contact.setup3d import MeshSetup3d
 from ngfracture.contact.solver import ContactSolver
@@ -164,7 +164,7 @@ def test_edge_faces_are_the_two_faces_of_every_edge():
     arrays = crossed_ridges()
     setup = MeshSetup3d(arrays.points, arrays.tets, arrays.faces, arrays.regions - 1)
     E, F = setup.edge_detector.edges, arrays.faces
-    at = edge_faces(F, E)
+    at = setup.faces_at_edge
     for e, (f, g) in zip(E, at):
         assert f < g and set(e) <= set(F[f]) and set(e) <= set(F[g])
     assert len(edge_rows(arrays.points, F, E, at, np.zeros((0, 2), dtype=np.int64), np.zeros_like(arrays.points))[0]) == 0

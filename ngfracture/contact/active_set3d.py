@@ -302,9 +302,9 @@ class ActiveSet3d(ActiveSet):
         vf = self.setup.vertex_fragment
         edges = detector.edges
         # pairs of two fragments: the lips of a crack inside one fragment are held by their
-        # vertices' rows only (docs/contact.md, "Edges that cross")
+        # vertices' rows only (docs/contact.md, "Edge-to-edge rows in 3D")
         pairs = pairs[vf[edges[pairs[:, 0], 0]] != vf[edges[pairs[:, 1], 0]]]
-        rows, kept = edge_rows(X, self.geometry.arrays.faces, edges, self.setup.edge_faces, pairs, U)
+        rows, kept = edge_rows(X, self.geometry.arrays.faces, edges, self.setup.faces_at_edge, pairs, U)
         deep = np.flatnonzero(rows.dist < -self.penetration_tol)
         return rows.subset(deep), self.codec.edge_codes(pairs[kept[deep]])
 

@@ -40,7 +40,7 @@ import scipy.sparse as sp
 
 from .rows import RowTable
 
-__all__ = ["EdgeRows", "PARALLEL", "no_edge_rows", "edge_faces", "edge_rows", "relinearise_edge_rows"]
+__all__ = ["EdgeRows", "PARALLEL", "no_edge_rows", "two_faces", "edge_rows", "relinearise_edge_rows"]
 
 #: edges whose directions' sine is below this have no common normal to rely on
 PARALLEL = 1e-6
@@ -148,35 +148,27 @@ def _gaps(X, x, edge_a, edge_b, st, normal):
     return dist, g
 
 
-def edge_faces(faces, edges):
-    """The two boundary faces at every boundary edge.
+def two_faces(edge_face_ptr, edge_faces):
+    """The two boundary faces at every boundary edge, from the faces at each edge.
 
     Parameters
     ----------
-    faces : numpy.ndarray of int, shape (nf, 3)
-        Boundary faces, outward.
-    edges : numpy.ndarray of int, shape (nE, 2)
-        The distinct sorted edges of the faces, in lexicographic order.
+    edge_face_ptr, edge_faces : numpy.ndarray of int
+        The faces at edge e are ``edge_faces[edge_face_ptr[e]:edge_face_ptr[e + 1]]``
+        (:class:`~ngfracture.contact.edge_crossings3d.EdgeCrossingDetector`).
 
     Returns
     -------
     numpy.ndarray of int64, shape (nE, 2)
-        The faces at each edge in increasing order; -1 and -1 at an edge with other than
-        two faces (where lips of several cracks meet on an edge).
+        The two faces at each edge in increasing order; -1 and -1 at an edge with other
+        than two faces.
     """
-    F = np.asarray(faces, dtype=np.int64)
-    E = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
-    nv = int(max(F.max(initial=-1), E.max(initial=-1))) + 1
-    sides = np.sort(np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]]), axis=1)
-    code = sides[:, 0] * nv + sides[:, 1]
-    face = np.tile(np.arange(len(F), dtype=np.int64), 3)
-    order = np.lexsort((face, code))
-    code, face = code[order], face[order]
-    edge_code = E[:, 0] * nv + E[:, 1]
-    start, stop = np.searchsorted(code, edge_code), np.searchsorted(code, edge_code, side="right")
-    out = np.full((len(E), 2), -1, dtype=np.int64)
-    two = stop - start == 2
-    out[two, 0], out[two, 1] = face[start[two]], face[start[two] + 1]
+    ptr = np.asarray(edge_face_ptr, dtype=np.int64)
+    faces = np.asarray(edge_faces, dtype=np.int64)
+    out = np.full((len(ptr) - 1, 2), -1, dtype=np.int64)
+    two = np.flatnonzero(np.diff(ptr) == 2)
+    pair = np.sort(np.stack([faces[ptr[two]], faces[ptr[two] + 1]], axis=1), axis=1)
+    out[two] = pair
     return out
 
 
@@ -214,7 +206,7 @@ def edge_rows(points, faces, edges, at_edge, pairs, displacement):
     edges : numpy.ndarray of int, shape (nE, 2)
         The mesh's sorted boundary edges.
     at_edge : numpy.ndarray of int, shape (nE, 2)
-        :func:`edge_faces`.
+        :func:`two_faces`.
     pairs : numpy.ndarray of int, shape (m, 2)
         Interlocked pairs (i, j), i < j, of edge numbers
         (:meth:`~ngfracture.contact.edge_crossings3d.EdgeCrossingDetector.detect`).

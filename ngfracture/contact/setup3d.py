@@ -18,7 +18,7 @@ from .. import _ngfracture as _ext
 from .active_set import RowKeys
 from .collision3d import PenetrationDetector3d
 from .edge_crossings3d import EdgeCrossingDetector
-from .edge_rows3d import edge_faces
+from .edge_rows3d import two_faces
 from .junctions3d import covered_pairs, fragment_pair_rows
 from .kinks3d import CopyIndex
 from .rows3d import NodeToFaceRows, lip_rows, node_to_face_rows
@@ -215,8 +215,8 @@ class MeshSetup3d:
     codec : FaceKeys
     detector : ngfracture.contact.collision3d.PenetrationDetector3d
     edge_detector : ngfracture.contact.edge_crossings3d.EdgeCrossingDetector
-    edge_faces : numpy.ndarray of int64, shape (nE, 2)
-        The two faces at every boundary edge (:func:`~ngfracture.contact.edge_rows3d.edge_faces`).
+    faces_at_edge : numpy.ndarray of int64, shape (nE, 2)
+        The two faces at every boundary edge (:func:`~ngfracture.contact.edge_rows3d.two_faces`).
     copy_index : ngfracture.contact.kinks3d.CopyIndex
     vertex_fragment : numpy.ndarray of int64
     rows : NodeToFaceRows
@@ -238,7 +238,7 @@ class MeshSetup3d:
         self.vertex_fragment = vertex_fragments(len(self.points), self.tets, self.fragment)
         self.edge_detector = EdgeCrossingDetector(self.points, self.faces,
                                                   self.vertex_fragment[np.asarray(self.faces, dtype=np.int64)[:, 0]])
-        self.edge_faces = edge_faces(self.faces, self.edge_detector.edges)
+        self.faces_at_edge = two_faces(self.edge_detector.edge_face_ptr, self.edge_detector.edge_faces)
         self.codec = FaceKeys(self.faces, self.edge_detector.edges)
         self.copy_index = CopyIndex(self.points, self.faces)
         self.rows, self.keys = fixed_rows(self.points, self.faces, self.vertex_fragment, self.codec,
