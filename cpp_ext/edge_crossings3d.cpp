@@ -105,7 +105,12 @@ namespace ngfracture
       }
     };
 
-    bool Shares (const int32_t * f, int32_t v) { return f[0] == v || f[1] == v || f[2] == v; }
+  }
+
+  bool EdgeCrossingDetector3::Shares (const int32_t * f, int32_t v) const
+  {
+    int32_t p = point_[v];
+    return point_[f[0]] == p || point_[f[1]] == p || point_[f[2]] == p;
   }
 
   bool SegmentPiercesTriangle (const double * p, const double * q, const double * a, const double * b,
@@ -122,8 +127,10 @@ namespace ngfracture
   }
 
   EdgeCrossingDetector3::EdgeCrossingDetector3 (int64_t nv, const int32_t * faces, int64_t nf,
-                                                const int32_t * face_fragment)
-    : nv_(nv), nf_(nf), faces_(faces, faces + 3 * nf), fragment_(face_fragment, face_fragment + nf)
+                                                const int32_t * face_fragment, const int32_t * point,
+                                                bool across)
+    : nv_(nv), nf_(nf), across_(across), faces_(faces, faces + 3 * nf),
+      fragment_(face_fragment, face_fragment + nf), point_(point, point + nv)
   {
     std::vector<int32_t> owner(nv, -1);          // the face that first claimed every vertex
     for (int64_t f = 0; f < nf; f++)
@@ -167,6 +174,30 @@ namespace ngfracture
         edge_faces_[s] = int32_t(slots[s].second / 3);
       }
     if (!slots.empty()) edge_face_ptr_.push_back(int64_t(slots.size()));
+    // the vertices of every point (copies together), by a counting sort of the point ids
+    int32_t np = 0;
+    for (int32_t p : point_) np = std::max(np, p + 1);
+    point_start_.assign(np + 1, 0);
+    for (int32_t p : point_) if (p >= 0) point_start_[p + 1]++;
+    for (int32_t p = 0; p < np; p++) point_start_[p + 1] += point_start_[p];
+    point_vertices_.resize(point_start_[np]);
+    std::vector<int64_t> fill(point_start_.begin(), point_start_.end() - 1);
+    for (int64_t v = 0; v < nv_; v++) if (point_[v] >= 0) point_vertices_[fill[point_[v]]++] = int32_t(v);
+  }
+
+  std::vector<char> EdgeCrossingDetector3::Closed (const double * x) const
+  {
+    // a vertex at the current position of another vertex of its point, bitwise: a closed lip
+    std::vector<char> closed(nv_, 0);
+    for (size_t p = 0; p + 1 < point_start_.size(); p++)
+      for (int64_t i = point_start_[p]; i < point_start_[p+1]; i++)
+        for (int64_t j = i + 1; j < point_start_[p+1]; j++)
+          {
+            const double * a = x + 3 * point_vertices_[i], * b = x + 3 * point_vertices_[j];
+            if (a[0] == b[0] && a[1] == b[1] && a[2] == b[2])
+              closed[point_vertices_[i]] = closed[point_vertices_[j]] = 1;
+          }
+    return closed;
   }
 
   bool EdgeCrossingDetector3::Pierces (const double * x, int32_t e, int32_t f) const
@@ -193,7 +224,8 @@ namespace ngfracture
     return false;
   }
 
-  std::vector<int32_t> EdgeCrossingDetector3::Detect (const double * x, EdgeCrossingStats * stats) const
+  std::vector<int32_t> EdgeCrossingDetector3::Detect (const double * x, EdgeCrossingStats * stats,
+                                                      const uint8_t * skip) const
   {
     EdgeCrossingStats st;
     std::vector<int32_t> out;
@@ -210,9 +242,15 @@ namespace ngfracture
     st.cell = grid.h;
     std::vector<std::pair<int32_t, int32_t>> pierces;   // (edge, face)
     int64_t ne = int64_t(edges_.size() / 2);
+    // an interlocking pair is found from the sweep of either edge (a pierces a face at b and
+    // b one at a): an edge whose two ends lie on closed lips is left to the other edge
+    std::vector<char> closed = Closed(x);
     for (int32_t e = 0; e < ne; e++)
       {
         const int32_t u = edges_[2*e], w = edges_[2*e+1];
+        if (closed[u] && closed[w]) { st.closed_edges++; continue; }
+        if (skip && (skip[u] || skip[w])) { st.skipped_edges++; continue; }
+        const int32_t own = fragment_[edge_faces_[edge_face_ptr_[e]]];
         const double * p = x + 3*u, * q = x + 3*w;
         double elo[3], ehi[3];
         int32_t r[6];
@@ -231,7 +269,7 @@ namespace ngfracture
                   continue;
                 int32_t f = en.item;
                 const int32_t * t = &faces_[3*f];
-                if (Shares(t, u) || Shares(t, w)) continue;
+                if (Shares(t, u) || Shares(t, w) || (across_ && fragment_[f] == own)) continue;
                 st.box_tests++;
                 bool overlap = true;              // strict: a pierce point lies inside both boxes
                 for (int d = 0; d < 3; d++)

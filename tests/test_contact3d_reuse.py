@@ -13,6 +13,8 @@ import numpy as np
 from ngfracture.contact.active_set3d import ActiveSet3d
 from ngfracture.contact.collision3d import detect_penetrations_3d
 from ngfracture.contact.copies3d import two_sided_rows
+from ngfracture.contact.edge_rows3d import relinearise_edge_rows
+from ngfracture.contact.mixed_rows import MixedRows
 from ngfracture.contact.rows3d import NodeToFaceRows, relinearise_node_to_face
 
 from blocks3d import assert_same_rows, block_geometry, overlapping_blocks
@@ -76,6 +78,7 @@ def test_settling_takes_the_update_s_relinearisation():
     cand = active.update(U2, {"collision": 0.0})
     assert cand.relinearised is not None and 0 < len(cand.relinearised) < len(cand.rows)
     reused = active._fresh_rows(cand, U2)
-    assert not np.any(cand.rows.kind)                     # vertices deep inside: no edge rows
-    fresh = relinearise_node_to_face(cand.rows.parts[0], arrays.points, U2)
-    assert_same_rows(reused.parts[0], two_sided_rows(fresh, arrays.points, U2, active.setup.copy_index))
+    faces, edges = cand.rows.parts
+    fresh = relinearise_node_to_face(faces, arrays.points, U2)
+    assert_same_rows(reused, MixedRows([two_sided_rows(fresh, arrays.points, U2, active.setup.copy_index),
+                                        relinearise_edge_rows(edges, arrays.points, U2)], cand.rows.kind))

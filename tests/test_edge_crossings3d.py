@@ -11,6 +11,7 @@ import pytest
 
 from ngfracture.contact.collision3d import detect_penetrations_3d, orient3d
 from ngfracture.contact.edge_crossings3d import EdgeCrossingDetector, segment_pierces_triangle
+from ngfracture.contact.kinks3d import point_ids
 from ngfracture.geometry.pieces import fragmented_box
 
 # outward faces of a positively oriented tetrahedron (0, 1, 2, 3)
@@ -113,7 +114,8 @@ def brute_force_pairs(X, faces, ff, edges, U):
     E, F = np.repeat(np.arange(len(edges)), len(faces)), np.tile(np.arange(len(faces)), len(edges))
     p, q = x[edges[E, 0]], x[edges[E, 1]]
     a, b, c = (x[faces[F, k]] for k in range(3))
-    shared = (faces[F][:, :, None] == edges[E][:, None, :]).any(axis=(1, 2))
+    pid = point_ids(X, faces)                             # copies of a point count as that point
+    shared = (pid[faces[F]][:, :, None] == pid[edges[E]][:, None, :]).any(axis=(1, 2))
     o_p, o_q = orient3d(a, b, c, p), orient3d(a, b, c, q)
     s = [orient3d(p, q, u, v) for u, v in ((a, b), (b, c), (c, a))]
     pierce = ~shared & (o_p * o_q < 0) & (s[0] != 0) & (s[0] == s[1]) & (s[1] == s[2])
@@ -128,7 +130,8 @@ def brute_force_pairs(X, faces, ff, edges, U):
         t = faces[f].tolist()
         for k in range(3):
             other = key[tuple(sorted((t[k], t[(k + 1) % 3])))]
-            if any((other, g) in pierced and (ff[g] != ff[f] or not set(faces[g]) & set(t)) for g in at_edge[e]):
+            if any((other, g) in pierced and (ff[g] != ff[f] or not set(pid[faces[g]]) & set(pid[t]))
+                   for g in at_edge[e]):
                 found.add((min(e, other), max(e, other)))
     return np.array(sorted(found), dtype=np.int64).reshape(-1, 2)
 
@@ -140,21 +143,26 @@ def rotation(axis, angle):
     return np.eye(3) + np.sin(angle) * K + (1 - np.cos(angle)) * K @ K
 
 
-@pytest.mark.parametrize("seed, merged", [(0, False), (1, False), (2, False), (3, False), (4, True), (5, True)])
+def block_moved(X, tets, piece, seed):
+    """Displacements moving one random block rigidly: turned 0.05 to 0.15 rad, shifted about 0.2."""
+    rng = np.random.default_rng(seed)
+    moved = np.unique(tets[piece == rng.integers(4)])
+    centre = X[moved].mean(axis=0)
+    R = rotation(rng.normal(size=3), rng.uniform(0.05, 0.15))
+    U = np.zeros_like(X)
+    U[moved] = (X[moved] - centre) @ R.T + centre + rng.normal(scale=0.2, size=3) - X[moved]
+    return U
+
+
+@pytest.mark.parametrize("seed, merged", [(1, False), (2, False), (3, False), (6, False), (3, True), (7, True)])
 def test_rigid_motion_of_a_block_matches_brute_force(seed, merged):
     X, tets, faces, piece, ff = blocks(4, (2, 2, 1))      # 4 blocks, 384 tets
     if merged:                                            # blocks 0, 1 and 2, 3: the lip between is a crack
         ff = ff // 2
-    rng = np.random.default_rng(seed)
-    block = rng.integers(4)
-    moved = np.unique(tets[piece == block])
-    centre = X[moved].mean(axis=0)
-    R = rotation(rng.normal(size=3), rng.uniform(0.05, 0.15))
-    U = np.zeros_like(X)
-    U[moved] = (X[moved] - centre) @ R.T + centre + rng.normal(scale=0.02, size=3) - X[moved]
+    U = block_moved(X, tets, piece, seed)
     det = EdgeCrossingDetector(X, faces, ff)
     expected = brute_force_pairs(X, faces, ff, det.edges, U)
-    assert len(faces) > 200 and len(expected) > 0         # the motion makes ridges cross
+    assert len(faces) > 200 and len(expected) > 0         # edges cross away from copies of a point
     if merged:                                            # some pairs on one fragment (its crack's lips)
         first = ff[det.edge_faces[det.edge_face_ptr[expected[:, 0]]]]
         assert (first == ff[det.edge_faces[det.edge_face_ptr[expected[:, 1]]]]).any()
@@ -178,7 +186,7 @@ def test_same_answer_twice_and_from_a_second_detector():
     X, tets, faces, piece, ff = blocks(3, (2, 2, 1))
     U = np.zeros_like(X)
     moved = np.unique(tets[piece == 0])
-    U[moved] = (X[moved] - 0.25) @ (rotation((1, 2, 3), 0.1).T - np.eye(3))
+    U[moved] = (X[moved] - 0.25) @ (rotation((1, 2, 3), 0.4).T - np.eye(3)) + 0.15
     first = EdgeCrossingDetector(X, faces, ff)
     a, b = first.detect(U), first.detect(U)
     c = EdgeCrossingDetector(X.copy(), faces.copy(), ff.copy()).detect(U)
@@ -208,3 +216,49 @@ def test_bad_displacement_is_named(U):
     points, _, faces, ff = two_tets(RIDGE_A, ridge_b(0.0))
     with pytest.raises(ValueError, match="displacement"):
         EdgeCrossingDetector(points, faces, ff).detect(U)
+
+
+def test_across_leaves_out_the_lips_of_one_fragment():
+    X, tets, faces, piece, ff = blocks(4, (2, 2, 1))
+    ff = ff // 2                                          # blocks 0, 1 and 2, 3: one fragment each
+    U = block_moved(X, tets, piece, 3)
+    every = EdgeCrossingDetector(X, faces, ff)
+    pairs = every.detect(U)
+    fragment_of = ff[every.edge_faces[every.edge_face_ptr[:-1]]]
+    apart = fragment_of[pairs[:, 0]] != fragment_of[pairs[:, 1]]
+    assert apart.any() and not apart.all()
+    np.testing.assert_array_equal(EdgeCrossingDetector(X, faces, ff, across=True).detect(U), pairs[apart])
+
+
+def test_edges_at_copies_of_a_point_are_no_pair():
+    """Two ridges from one point P, of two fragments (P a copy on each), one slid sideways
+    by 1e-3 and pushed 1e-3 into the other: they cross 2.5e-3 from P, next to the copies,
+    which the rows at copies hold. Started 1e-3 apart instead, the same ridges are a pair."""
+    def ridges(start_b):
+        A = [(0.0, 0.0, 0.0), (1.0, 0.2, 0.0), (0.5, -1.0, -1.0), (0.5, 1.0, -1.0)]   # ridge on top
+        B = [start_b, (1.0, -0.2, 0.0), (0.5, -1.0, 1.0), (0.5, 1.0, 1.0)]            # ridge below
+        X, tets, faces, ff = two_tets(A, B)
+        U = np.zeros_like(X)
+        U[4:] = (0.0, 1e-3, -1e-3)
+        return EdgeCrossingDetector(X, faces, ff), U
+    det, U = ridges((0.0, 0.0, 0.0))
+    assert len(det.detect(np.zeros_like(U))) == 0 and len(det.detect(U)) == 0
+    det, U = ridges((-1e-3, 0.0, 0.0))
+    pairs = det.detect(U).tolist()                        # B's ridge with A's edges at P
+    ridge_b = edge_row(det, 4, 5)
+    assert [edge_row(det, 0, 1), ridge_b] in pairs and all(b == ridge_b for _, b in pairs)
+
+
+def test_skipped_vertices_leave_a_pair_to_the_other_edge():
+    X, tets, faces, ff = two_tets(RIDGE_A, ridge_b(-2e-12))
+    det = EdgeCrossingDetector(X, faces, ff)
+    U = np.zeros_like(X)
+    expected = [[edge_row(det, 0, 1), edge_row(det, 4, 5)]]
+    one, both = np.zeros(len(X), dtype=bool), np.zeros(len(X), dtype=bool)
+    one[[0, 1]] = True                                    # A's ridge not swept: found from B's
+    both[[0, 1, 4, 5]] = True                             # neither swept: not found
+    assert det.detect(U).tolist() == expected and det.detect(U, one).tolist() == expected
+    pairs, stats = det.detect_counted(U, both)
+    assert len(pairs) == 0 and stats["skipped_edges"] > 0
+    with pytest.raises(ValueError, match="skip"):
+        det.detect(U, np.zeros(3, dtype=bool))

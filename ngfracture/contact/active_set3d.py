@@ -44,9 +44,9 @@ Candidates, each identified by its key ("f", slave, master vertices sorted; "e",
   solve (a row the problem released must stay visible to the next problem).
 
 - *edge* rows (:mod:`~ngfracture.contact.edge_rows3d`): pairs of boundary edges of two
-  fragments that cross at the configuration of the last solve with no vertex inside
-  (searched only in a round where no vertex lies deeper than ``penetration_tol`` in another
-  piece, :meth:`ActiveSet3d._edge_to_edge`), kept as found rows are.
+  fragments that cross at the configuration of the last solve deeper than ``edge_tol``
+  where no end of either edge lies inside the other's fragment
+  (:meth:`ActiveSet3d._edge_to_edge`), kept as found rows are.
 
 The candidates of a round are a :class:`~ngfracture.contact.mixed_rows.MixedRows` table:
 the node-to-face rows (fixed, then found), then the edge rows.
@@ -161,13 +161,17 @@ class ActiveSet3d(ActiveSet):
     setups : ngfracture.contact.setup3d.MeshSetups, optional
         Where to take the work on the mesh alone from (the set-up of an earlier solve on
         these arrays, bitwise); without it that work is done here. The results are the same.
+    edge_tol : float, optional
+        Depth (a length) of a crossing of two edges that makes an edge-to-edge row
+        (default ``penetration_tol``); once a row, it is judged by ``penetration_tol``.
     **options
         ``rank_tol``, ``pdas_rounds``, ``max_updates``, ``warm`` of ActiveSet (``tol`` and
         ``kink_angle`` have no role in 3D).
     """
 
-    def __init__(self, geometry, penetration_tol, setups=None, **options):
+    def __init__(self, geometry, penetration_tol, setups=None, edge_tol=None, **options):
         super().__init__(geometry, 0.0, penetration_tol, **options)
+        self.edge_tol = penetration_tol if edge_tol is None else edge_tol
         a = geometry.arrays
         # the work on the mesh alone (codec, detector, copy index, fixed rows): made here or
         # taken from the set-up of the solve before on the same mesh
@@ -282,30 +286,45 @@ class ActiveSet3d(ActiveSet):
                               0.01 * self.penetration_tol)
 
     def _edge_to_edge(self, U, pen, timings):
-        """The pairs of boundary edges interlocked at X + U and crossed deeper than
-        ``penetration_tol``, as rows with their key codes; none while a vertex lies deeper
-        than that in another piece (``pen``, the node-to-face detection at U).
+        """The pairs of boundary edges of two fragments crossed at X + U deeper than
+        ``edge_tol``, whose crossing no vertex explains, as rows with their key codes.
 
-        Edges cross with no vertex inside only where the vertices are held: in a solve's
-        prediction whole lips pass through each other, their edges cross everywhere, and
-        rows linearised there hold lines far from the surface that the vertex rows bring
-        back. So the edges are searched once the vertices are out, which the rounds reach
-        before a set can settle.
+        The detector of the set-up searches pairs of different fragments that share no
+        point (:class:`~ngfracture.contact.edge_crossings3d.EdgeCrossingDetector`, copies
+        of a point counting as that point).
+
+        A pair where an end of one edge lies deeper than ``penetration_tol`` in the other
+        edge's fragment (``pen``, the node-to-face detection at U) gets no row: that
+        vertex's row holds it. In a solve's prediction whole lips pass through each other
+        and their edges cross everywhere; a row linearised there would hold a line far
+        from the surface that the vertex rows bring back. At copies of a point the rows at
+        copies hold the pieces: an edge row beside them, nearly parallel to a copy's row on
+        the same vertices, turns a small difference of their gaps into a large motion. The
+        lips of a crack inside one fragment are held by their vertices' rows only
+        (docs/contact.md, "Edge-to-edge rows in 3D").
         """
         X = self.geometry.arrays.points
-        if len(pen) and pen.gap.min() < -self.penetration_tol:
-            return no_edge_rows(len(X)), np.zeros(0, dtype=np.int64)
         t0 = time.perf_counter()
         detector = self.setup.edge_detector
-        pairs = detector.detect(U)
+        deep = pen.gap < -self.penetration_tol
+        # edges at a deep vertex are not swept: their pairs with the piece it lies in are
+        # dropped below, their others are found from the other edge (pairs of two such
+        # edges are not: vertex rows move both)
+        skip = np.zeros(len(X), dtype=bool)
+        skip[np.asarray(pen.vertex)[deep]] = True
+        pairs = detector.detect(U, skip)
         timings["collision"] += time.perf_counter() - t0
-        vf = self.setup.vertex_fragment
-        edges = detector.edges
-        # pairs of two fragments: the lips of a crack inside one fragment are held by their
-        # vertices' rows only (docs/contact.md, "Edge-to-edge rows in 3D")
-        pairs = pairs[vf[edges[pairs[:, 0], 0]] != vf[edges[pairs[:, 1], 0]]]
+        vf, edges = self.setup.vertex_fragment, detector.edges
+        if len(pairs):
+            n = np.int64(vf.max() + 1)
+            inside = unique_ints(np.asarray(pen.vertex, dtype=np.int64)[deep] * n
+                                 + np.asarray(pen.fragment, dtype=np.int64)[deep])
+            a, b = edges[pairs[:, 0]], edges[pairs[:, 1]]
+            explained = (isin_ints(a * n + vf[b[:, :1]], inside).any(axis=1)
+                         | isin_ints(b * n + vf[a[:, :1]], inside).any(axis=1))
+            pairs = pairs[~explained]
         rows, kept = edge_rows(X, self.geometry.arrays.faces, edges, self.setup.faces_at_edge, pairs, U)
-        deep = np.flatnonzero(rows.dist < -self.penetration_tol)
+        deep = np.flatnonzero(rows.dist < -self.edge_tol)
         return rows.subset(deep), self.codec.edge_codes(pairs[kept[deep]])
 
     def _node_to_face(self, pen):

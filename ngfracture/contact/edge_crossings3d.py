@@ -11,12 +11,19 @@ face. Fragments share no vertex (a vertex on faces of two fragments is refused).
 
 Definitions (exact ``orient3d``, no tolerance):
 
-- Edge e *pierces* face f when f shares no vertex with e, e's endpoints lie strictly on
-  opposite sides of f's plane, and e's line passes strictly inside the triangle:
-  ``orient3d(e0, e1, f_k, f_k+1)`` has the same nonzero sign for the three edges of f.
+- Edge e *pierces* face f when f shares no point with e (a vertex, or a copy of one at the
+  bitwise-equal reference point), e's endpoints lie strictly on opposite sides of f's
+  plane, and e's line passes strictly inside the triangle: ``orient3d(e0, e1, f_k,
+  f_k+1)`` has the same nonzero sign for the three edges of f.
 - Edges a and b *interlock* when a pierces a face f that has b as an edge, b pierces a
   face g that has a as an edge, and f and g are of different fragments or, on one fragment
-  (the two lips of a crack that does not cut its fragment through), share no vertex.
+  (the two lips of a crack that does not cut its fragment through), share no point.
+  With ``across``, only pairs of different fragments are searched.
+
+Copies of a point count as one point: an edge and a face at copies of one point meet there
+as an edge and a face at one vertex do, and where the lips slid along each other their
+crossing next to that point is the business of the rows at copies, not of edge rows
+(docs/contact.md, "Edge-to-edge rows in 3D").
 
 Two convex ridges that crossed pierce the faces at each other; a flat face pushed onto a
 ridge: the ridge's edge and an edge of the face interlock. A fragment's corner poked into
@@ -38,6 +45,7 @@ per mesh. Output: sorted, unique pairs, deterministic.
 import numpy as np
 
 from .. import _ngfracture as _ext
+from .kinks3d import point_ids
 
 __all__ = ["EdgeCrossingDetector", "segment_pierces_triangle"]
 
@@ -107,6 +115,11 @@ class EdgeCrossingDetector:
         Boundary triangles, outward (outer boundary and crack lips).
     face_fragment : array_like of int, shape (nf,)
         The fragment of every face.
+    across : bool
+        Only pairs of edges of different fragments (no lips of one fragment's crack).
+    point : array_like of int, shape (nv,), optional
+        :func:`~ngfracture.contact.kinks3d.point_ids` of these points and faces, where the
+        caller has them.
 
     Attributes
     ----------
@@ -125,24 +138,30 @@ class EdgeCrossingDetector:
         range, a face that repeats a vertex, a vertex on faces of two fragments.
     """
 
-    def __init__(self, points, faces, face_fragment):
+    def __init__(self, points, faces, face_fragment, across=False, point=None):
         X = _coordinates(points, "points")
         F = _integers(faces, "faces", (None, 3))
         frag = _integers(face_fragment, "face_fragment", (len(F),))
         self._points = X.copy()
-        self._kernel = _ext.EdgeCrossingDetector3d(len(X), F, frag)
+        if len(F) and (F.min() < 0 or F.max() >= len(X)):
+            raise ValueError(f"faces holds vertex numbers outside [0, {len(X)})")
+        # copies of a point count as that point
+        point = (point_ids(X, F) if point is None else _integers(point, "point", (len(X),))).astype(np.int32)
+        self._kernel = _ext.EdgeCrossingDetector3d(len(X), F, frag, point, bool(across))
         self.edges = self._kernel.edges
         self.edge_face_ptr = self._kernel.edge_face_ptr
         self.edge_faces = self._kernel.edge_faces
         self.face_edges = self._kernel.face_edges
 
-    def detect_counted(self, displacement=None):
+    def detect_counted(self, displacement=None, skip=None):
         """The interlocking pairs at points + displacement, with the search's counts.
 
         Parameters
         ----------
         displacement : array_like, shape (nv, 3), optional
             Zero if omitted.
+        skip : array_like of bool, shape (nv,), optional
+            As for :meth:`detect`.
 
         Returns
         -------
@@ -151,7 +170,9 @@ class EdgeCrossingDetector:
         stats : dict
             ``cell`` (grid cell size), ``box_tests`` (pairs (edge, face) without a shared
             vertex in a common cell), ``exact_tests`` (past the strict box test),
-            ``pierces`` (pairs (edge, face) that pierce).
+            ``pierces`` (pairs (edge, face) that pierce), ``closed_edges`` (edges not swept:
+            both ends bitwise at the current position of a copy), ``skipped_edges`` (not
+            swept: an end in ``skip``).
 
         Raises
         ------
@@ -163,15 +184,25 @@ class EdgeCrossingDetector:
             x = np.ascontiguousarray(x + _coordinates(displacement, "displacement", len(x)))
             if not np.isfinite(x).all():
                 raise ValueError("points + displacement overflows")
-        return self._kernel.detect(x)
+        if skip is not None:
+            skip = np.asarray(skip)
+            if skip.shape != (len(x),) or skip.dtype != bool:
+                raise ValueError(f"skip must be booleans of shape ({len(x)},), got {skip.dtype} {skip.shape}")
+            skip = skip.view(np.uint8)
+        return self._kernel.detect(x, skip)
 
-    def detect(self, displacement=None):
+    def detect(self, displacement=None, skip=None):
         """The pairs of edges that interlock at points + displacement.
 
         Parameters
         ----------
         displacement : array_like, shape (nv, 3), optional
             Zero if omitted.
+        skip : array_like of bool, shape (nv,), optional
+            Vertices whose edges are not swept: a pair with such an edge is found only from
+            its other edge (a pair of two such edges is not found). Every pair is found
+            from either edge's sweep, and an edge whose two ends lie bitwise at the
+            current position of a copy (a closed lip) is never swept.
 
         Returns
         -------
@@ -183,4 +214,4 @@ class EdgeCrossingDetector:
         ValueError
             On a displacement of the wrong shape or with non-finite entries.
         """
-        return self.detect_counted(displacement)[0]
+        return self.detect_counted(displacement, skip)[0]

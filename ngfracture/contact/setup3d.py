@@ -236,11 +236,12 @@ class MeshSetup3d:
         self.points, self.tets, self.faces, self.fragment = (np.array(a) for a in (points, tets, faces, fragment))
         self.detector = PenetrationDetector3d(self.points, self.tets, self.faces, self.fragment)   # checks
         self.vertex_fragment = vertex_fragments(len(self.points), self.tets, self.fragment)
+        self.copy_index = CopyIndex(self.points, self.faces)
         self.edge_detector = EdgeCrossingDetector(self.points, self.faces,
-                                                  self.vertex_fragment[np.asarray(self.faces, dtype=np.int64)[:, 0]])
+                                                  self.vertex_fragment[np.asarray(self.faces, dtype=np.int64)[:, 0]],
+                                                  across=True, point=self.copy_index.point)
         self.faces_at_edge = two_faces(self.edge_detector.edge_face_ptr, self.edge_detector.edge_faces)
         self.codec = FaceKeys(self.faces, self.edge_detector.edges)
-        self.copy_index = CopyIndex(self.points, self.faces)
         self.rows, self.keys = fixed_rows(self.points, self.faces, self.vertex_fragment, self.codec,
                                           self.detector, self.copy_index)
         self.covered = covered_pairs(self.points, self.rows, self.vertex_fragment)

@@ -50,6 +50,10 @@ from ..mechanics.tangent import SavedTangent
 
 __all__ = ["ContactResult", "ContactSolver", "space_columns", "space_columns_3d", "LABEL"]
 
+#: edges crossing by less than this fraction of ``tol`` get no edge-to-edge row (3D; docs/contact.md,
+#: "Edge-to-edge rows in 3D")
+EDGE_TOL = 1e-3
+
 #: label of the problem's constraint rows that the contact solve owns
 LABEL = "contact"
 
@@ -282,7 +286,8 @@ class ContactSolver:
         """The active set of a solve: ActiveSet on triangles, ActiveSet3d on tetrahedra."""
         options = dict(rank_tol=self.rank_tol, pdas_rounds=self.pdas_rounds, max_updates=self.max_updates, warm=warm)
         if self.problem.dim == 3:
-            return ActiveSet3d(geometry, self.penetration_tol, setups=self.setups, **options)
+            return ActiveSet3d(geometry, self.penetration_tol, setups=self.setups,
+                               edge_tol=max(EDGE_TOL * self.tol, self.penetration_tol), **options)
         return ActiveSet(geometry, self.tol, self.penetration_tol, kink_angle=self.kink_angle, **options)
 
     def _columns(self, C):
