@@ -204,8 +204,9 @@ def run_with_checks(scene, out):
 @pytest.mark.xfail(strict=True, reason="run from the start, the coarse confined sphere ends at step 35 (x = 3.484e-3 "
                    "of 3.56e-3, 5 fragments): at step 36 two tetrahedra of the glass and of a piece broken off, which "
                    "shared an edge in the reference, cross with no vertex inside the other (overlap volume 4.2e-10, "
-                   "1.1e-10 of the volume), at every cut: node-to-face rows do not see edges crossing (docs/solid.md, "
-                   "'The sphere scenes')")
+                   "1.1e-10 of the volume), at every cut: edges crossing next to copies of a point where the lips slid "
+                   "over a kink, which neither the rows at copies nor edge-to-edge rows hold (docs/contact.md, "
+                   "'Edge-to-edge rows in 3D')")
 def test_run_confined(tmp_path):
     steps, result = run_with_checks(sphere3d(**COARSE), tmp_path)
     assert result.ok and result.reason == "load_max", result.message
@@ -215,8 +216,9 @@ def test_run_confined(tmp_path):
 @pytest.mark.slow
 @pytest.mark.xfail(strict=True, reason="the coarse free run does not reach the end of its load range (4.14e-3): "
                    "it has five fragments at x = 2.604e-3 (step 37, 539 s) and step 38 fails at every cut, the "
-                   "fragments overlapping by 1.6e-10 of the volume with faces crossing at edges, which node-to-face "
-                   "rows do not hold (docs/solid.md, 'The sphere scenes')")
+                   "fragments overlapping by 1.6e-10 of the volume with edges crossing next to copies of a point where "
+                   "the lips slid over a kink, which neither the rows at copies nor edge-to-edge rows hold "
+                   "(docs/contact.md, 'Edge-to-edge rows in 3D')")
 def test_run_free(tmp_path):
     """sphere3d_free on the coarse mesh: the same invariants per step, and it falls apart
     (the core and at least two glass pieces), as the 2D disintegration."""
