@@ -208,8 +208,8 @@ namespace ngfracture
     return SegmentPiercesTriangle(x + 3*p, x + 3*q, x + 3*t[0], x + 3*t[1], x + 3*t[2]);
   }
 
-  // a pierces f, an face at b: does b pierce a face g at a, g of another fragment than f or
-  // sharing no vertex with it
+  // a pierces f, a face at b: does b pierce a face g at a, g of another fragment than f or
+  // sharing no point with it
   bool EdgeCrossingDetector3::Interlock (const double * x, int32_t a, int32_t f, int32_t b) const
   {
     const int32_t * tf = &faces_[3*f];

@@ -14,7 +14,8 @@
 // in the first grid cell the two boxes share, after a strict box test; then the exact
 // pierce test; for every piercing (a, f), the three edges b of f against the faces at a.
 // An interlocking pair is found from the sweep of either of its edges, so an edge whose
-// two ends lie bitwise at the current position of a copy (on closed lips) is not swept.
+// two ends lie bitwise at the current position of a copy (on closed lips) is not swept: a
+// pair of two such edges (two closed lips crossing each other) is not found.
 
 #include <cstdint>
 #include <vector>
@@ -60,9 +61,9 @@ namespace ngfracture
     const std::vector<int32_t> & FaceEdges () const { return face_edges_; }
 
     // m x 2 edge numbers (i < j) of the interlocking pairs at current coordinates x
-    // (nv x 3), unique, in lexicographic order
-    // (nv x 3); skip (nv, or null): vertices whose edges are not swept (their pairs are
-    // found from the other edge only)
+    // (nv x 3), unique, in lexicographic order; skip (nv, or null): vertices whose edges
+    // are not swept. A pair is found from either edge's sweep; one of two edges not swept
+    // (at skip vertices, or with both ends on closed lips) is not found.
     std::vector<int32_t> Detect (const double * x, EdgeCrossingStats * stats, const uint8_t * skip = nullptr) const;
 
   private:

@@ -168,3 +168,17 @@ def test_edge_faces_are_the_two_faces_of_every_edge():
     for e, (f, g) in zip(E, at):
         assert f < g and set(e) <= set(F[f]) and set(e) <= set(F[g])
     assert len(edge_rows(arrays.points, F, E, at, np.zeros((0, 2), dtype=np.int64), np.zeros_like(arrays.points))[0]) == 0
+
+
+def test_no_key_and_a_wrong_mask_are_refused():
+    arrays = crossed_ridges()
+    setup = MeshSetup3d(arrays.points, arrays.tets, arrays.faces, arrays.regions - 1)
+    with pytest.raises(ValueError, match="no pair of edges"):
+        setup.codec.decode(np.array([-1]))
+    E = setup.edge_detector.edges
+    edges = EdgeRows(E[:3], E[3:6], np.full((3, 2), 0.5), np.tile([0.0, 0.0, 1.0], (3, 1)), np.zeros(3), np.zeros(3),
+                     nv=len(arrays.points))
+    mixed = MixedRows([setup.rows, edges])
+    assert len(mixed) == 3 + len(setup.rows)
+    with pytest.raises(ValueError, match="mask"):
+        mixed.subset(np.ones(len(mixed) - 1, dtype=bool))

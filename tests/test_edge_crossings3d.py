@@ -143,10 +143,12 @@ def rotation(axis, angle):
     return np.eye(3) + np.sin(angle) * K + (1 - np.cos(angle)) * K @ K
 
 
-def block_moved(X, tets, piece, seed):
-    """Displacements moving one random block rigidly: turned 0.05 to 0.15 rad, shifted about 0.2."""
+def block_moved(X, tets, piece, seed, which=None):
+    """Displacements moving one random block (or the blocks ``which``) rigidly: turned 0.05
+    to 0.15 rad, shifted about 0.2."""
     rng = np.random.default_rng(seed)
-    moved = np.unique(tets[piece == rng.integers(4)])
+    block = rng.integers(4)
+    moved = np.unique(tets[np.isin(piece, [block] if which is None else which)])
     centre = X[moved].mean(axis=0)
     R = rotation(rng.normal(size=3), rng.uniform(0.05, 0.15))
     U = np.zeros_like(X)
@@ -262,3 +264,21 @@ def test_skipped_vertices_leave_a_pair_to_the_other_edge():
     assert len(pairs) == 0 and stats["skipped_edges"] > 0
     with pytest.raises(ValueError, match="skip"):
         det.detect(U, np.zeros(3, dtype=bool))
+
+
+def test_two_edges_on_closed_lips_are_no_pair():
+    """Blocks 0 and 1 moved together keep their lip closed (copies bitwise together) and push
+    into blocks 2 and 3, whose lip is closed too: the detection is the definition's pairs but
+    those of two edges each with both ends on closed lips, which no sweep visits."""
+    X, tets, faces, piece, ff = blocks(4, (2, 2, 1))
+    U = block_moved(X, tets, piece, 14, which=(0, 1))
+    det = EdgeCrossingDetector(X, faces, ff)
+    expected = brute_force_pairs(X, faces, ff, det.edges, U)
+    x, pid = X + U, point_ids(X, faces)
+    closed = np.zeros(len(X), dtype=bool)
+    for v in np.flatnonzero(pid >= 0):
+        closed[v] = any((x[w] == x[v]).all() for w in np.flatnonzero(pid == pid[v]) if w != v)
+    on_closed = closed[det.edges].all(axis=1)
+    both = on_closed[expected[:, 0]] & on_closed[expected[:, 1]]
+    assert both.any() and not both.all()
+    np.testing.assert_array_equal(det.detect(U), expected[~both])

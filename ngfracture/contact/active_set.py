@@ -138,18 +138,18 @@ class Candidates:
 
     Parameters
     ----------
-    rows : ngfracture.contact.rows.ContactConstraints
-        Seam rows first, then node-to-segment rows.
+    rows : ngfracture.contact.rows.ContactConstraints or ngfracture.contact.mixed_rows.MixedRows
+        Seam rows first, then node-to-segment rows (3D: node-to-face rows, then edge rows).
     keys : list of tuple or RowKeys
         The key of every row: ("s", lower twin, higher twin, kind) for seam rows,
         ("n", slave, a, c) for node-to-segment rows (3D: ("f", slave, master vertices
-        sorted), as :class:`RowKeys`).
+        sorted) and ("e", edge a, edge b), as :class:`RowKeys`).
     gap : numpy.ndarray, shape (len(rows),)
         The linearised gaps C u + g at the configuration of the round.
     relinearised : ngfracture.contact.rows.ContactConstraints or None
         The leading rows of ``rows`` (all but the node-to-segment rows found new in this
-        round) linearised at the configuration of the round, where that was done when the
-        round began; None where it was not.
+        round; 3D: of its node-to-face rows) linearised at the configuration of the round,
+        where that was done when the round began; None where it was not.
     """
     rows: ContactConstraints
     keys: list
@@ -185,7 +185,7 @@ def refreshed(old, fresh, U, limit):
 
     Parameters
     ----------
-    old, fresh : ngfracture.contact.rows.ContactConstraints or ngfracture.contact.rows3d.NodeToFaceRows
+    old, fresh : ContactConstraints, NodeToFaceRows, EdgeRows or MixedRows (contact.rows, rows3d, ...)
         The same rows (same order, same keys) in two linearisations.
     U : numpy.ndarray, shape (nv, 2) or (nv, 3)
         Vertex displacements.

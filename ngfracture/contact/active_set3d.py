@@ -1,8 +1,8 @@
 """The active set of a contact solve on a tetrahedral mesh: the 3D candidates.
 
 :class:`ActiveSet3d` is :class:`~ngfracture.contact.active_set.ActiveSet` with the candidate
-rows of 3D: node-to-face rows (:mod:`ngfracture.contact.rows3d`) instead of seam and
-node-to-segment rows. The choice of the set (primal-dual update, complementarity problem
+rows of 3D: node-to-face rows (:mod:`ngfracture.contact.rows3d`) and edge-to-edge rows
+(:mod:`ngfracture.contact.edge_rows3d`) instead of seam and node-to-segment rows. The choice of the set (primal-dual update, complementarity problem
 where it cycles), the redundancy removal and the records are the 2D ones, unchanged; only
 where the candidates come from and how they are re-linearised differ.
 
@@ -45,7 +45,7 @@ Candidates, each identified by its key ("f", slave, master vertices sorted; "e",
 
 - *edge* rows (:mod:`~ngfracture.contact.edge_rows3d`): pairs of boundary edges of two
   fragments that cross at the configuration of the last solve deeper than ``edge_tol``
-  where no end of either edge lies inside the other's fragment
+  where no end of either edge lies deeper than ``penetration_tol`` in the other's fragment
   (:meth:`ActiveSet3d._edge_to_edge`), kept as found rows are.
 
 The candidates of a round are a :class:`~ngfracture.contact.mixed_rows.MixedRows` table:
@@ -61,7 +61,8 @@ bit (:func:`~ngfracture.contact.active_set.refreshed`), as in 2D.
 Keys as codes. A row's key ("f", slave, master vertices sorted) is held as the int64 code
 slave * n + i, with i the number of the master's vertex set among the distinct vertex sets
 of the boundary faces (:class:`FaceKeys`; a row's master is the vertices of its face, which
-the code checks). Codes are equal exactly where keys are, so the candidate bookkeeping
+the code checks); an edge row's key ("e", edge a, edge b) as the negative code
+-1 - (i nE + j) of its edges' numbers i < j among the nE boundary edges. Codes are equal exactly where keys are, so the candidate bookkeeping
 (which found rows are new, which stay, which vertices a twin row covers) and the choice of
 the set (:class:`~ngfracture.contact.active_set.ActiveSet`) are array operations
 (``numpy.isin``, sorting), with the same results as with tuples; the tuples are made only

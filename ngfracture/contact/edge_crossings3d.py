@@ -25,7 +25,8 @@ as an edge and a face at one vertex do, and where the lips slid along each other
 crossing next to that point is the business of the rows at copies, not of edge rows
 (docs/contact.md, "Edge-to-edge rows in 3D").
 
-Two convex ridges that crossed pierce the faces at each other; a flat face pushed onto a
+The pairs reported are these, but those of two edges that are not swept (below). Two
+convex ridges that crossed pierce the faces at each other; a flat face pushed onto a
 ridge: the ridge's edge and an edge of the face interlock. A fragment's corner poked into
 the interior of another's face is no such pair (its edges pierce the face, but the face's
 edges pierce none of the corner's faces): node-to-face rows hold it. Coincident lips never
@@ -35,12 +36,16 @@ nor do faces that slide over each other in their common plane.
 Search, O(n) expected (``cpp_ext/edge_crossings3d.cpp``). The faces' bounding boxes are
 hashed into cells of the mean largest extent of a box (a spatial hash: a counting sort of
 the cells' hashes; the cell is doubled while the boxes would fill more than 32 n + 2^20
-cells, so that a few huge faces among small ones cost time, not memory); every edge sweeps the cells its box overlaps, and a pair (edge, face)
-is tested once, in the first cell the two boxes share, when they share no vertex and
-their boxes overlap strictly (a pierce point lies strictly inside both: boxes that only
-touch cannot hold one). Then the exact pierce test, and for every piercing (a, f) the
-three edges b of f against the faces at a. The edges and the faces at each are made once
-per mesh. Output: sorted, unique pairs, deterministic.
+cells, so that a few huge faces among small ones cost time, not memory); every edge
+sweeps the cells its box overlaps, and a pair (edge, face) is tested once, in the first
+cell the two boxes share, when they share no point and their boxes overlap strictly (a
+pierce point lies strictly inside both: boxes that only touch cannot hold one). Then the
+exact pierce test, and for every piercing (a, f) the three edges b of f against the faces
+at a. A pair is found from the sweep of either of its edges (a pierces a face at b and b
+one at a), so edges whose two ends lie bitwise at the current position of a copy (closed
+lips) and edges at ``skip`` vertices are not swept; a pair of two such edges is not found.
+The edges and the faces at each are made once per mesh. Output: sorted, unique pairs,
+deterministic.
 """
 import numpy as np
 
@@ -199,10 +204,10 @@ class EdgeCrossingDetector:
         displacement : array_like, shape (nv, 3), optional
             Zero if omitted.
         skip : array_like of bool, shape (nv,), optional
-            Vertices whose edges are not swept: a pair with such an edge is found only from
-            its other edge (a pair of two such edges is not found). Every pair is found
-            from either edge's sweep, and an edge whose two ends lie bitwise at the
-            current position of a copy (a closed lip) is never swept.
+            Vertices whose edges are not swept. Every pair is found from either edge's
+            sweep, and an edge whose two ends lie bitwise at the current position of a copy
+            (a closed lip) is never swept: a pair of two edges not swept (at ``skip``
+            vertices or on closed lips) is not found.
 
         Returns
         -------

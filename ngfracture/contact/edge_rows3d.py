@@ -217,7 +217,8 @@ def edge_rows(points, faces, edges, at_edge, pairs, displacement):
     -------
     rows : EdgeRows
         One row per crossing, a = edges[i], b = edges[j], n on the side of the negative
-        gap; pairs of nearly parallel edges (sine below :data:`PARALLEL`) left out.
+        gap; pairs of nearly parallel edges (sine below :data:`PARALLEL`) and pairs with an
+        edge of other than two faces left out.
     kept : numpy.ndarray of int
         The pairs that have a row (indices into ``pairs``).
     """

@@ -33,7 +33,7 @@ class MixedRows:
     kind : numpy.ndarray of int8
     g, dist : numpy.ndarray
         The rows' constant parts and distances, in the table's order (``dist`` can be
-        replaced, as a table's field can).
+        replaced, as a table's field can; the parts keep the distances they were made with).
     nv : int
 
     Raises
@@ -105,8 +105,15 @@ class MixedRows:
         Returns
         -------
         MixedRows
+
+        Raises
+        ------
+        ValueError
+            On a mask of another length than the table's.
         """
         rows = np.asarray(rows)
+        if rows.dtype == bool and rows.shape != (len(self),):
+            raise ValueError(f"MixedRows.subset: a mask of shape {rows.shape} for {len(self)} rows")
         rows = np.flatnonzero(rows) if rows.dtype == bool else rows.astype(np.int64)
         kind = self.kind[rows]
         rank = np.empty(len(self.kind), dtype=np.int64)        # a row's place among its kind

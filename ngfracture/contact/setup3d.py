@@ -133,6 +133,11 @@ class FaceKeys:
         Returns
         -------
         list of tuple
+
+        Raises
+        ------
+        ValueError
+            On a negative code that is no pair of edges i < j (such as -1, no key).
         """
         codes = np.asarray(codes, dtype=np.int64)
         slave, sets = np.divmod(np.maximum(codes, 0), self.n)
@@ -140,6 +145,8 @@ class FaceKeys:
         edge = np.flatnonzero(codes < 0)
         if len(edge):
             i, j = np.divmod(-1 - codes[edge], max(len(self.edges), 1))
+            if not np.all((i < j) & (j < len(self.edges))):
+                raise ValueError("FaceKeys.decode: a negative code that is no pair of edges (-1 is no key)")
             for r, a, b in zip(edge.tolist(), self.edges[i].tolist(), self.edges[j].tolist()):
                 keys[r] = ("e", a[0], a[1], b[0], b[1])
         return keys

@@ -24,9 +24,11 @@ measurements behind these choices are in ``docs/contact.md``.
 
 On a tetrahedral mesh (``problem.dim == 3``) the same rounds run with
 :class:`~ngfracture.contact.active_set3d.ActiveSet3d` (node-to-face rows,
-:mod:`ngfracture.contact.rows3d`), rows in the three-component layout and six held rigid
-modes per free piece; ``tol`` then only sets the default ``penetration_tol`` and
-``kink_angle`` has no role (docs/contact.md, "Contact in 3D runs").
+:mod:`ngfracture.contact.rows3d`, and edge-to-edge rows, :mod:`ngfracture.contact.edge_rows3d`),
+rows in the three-component layout and six held rigid modes per free piece; ``tol`` then
+only sets the default ``penetration_tol`` and the depth of a crossing of two edges that
+makes an edge row, max(``EDGE_TOL`` tol, ``penetration_tol``), and ``kink_angle`` has no
+role (docs/contact.md, "Contact in 3D runs", "Edge-to-edge rows in 3D").
 """
 import functools
 import math
@@ -50,8 +52,8 @@ from ..mechanics.tangent import SavedTangent
 
 __all__ = ["ContactResult", "ContactSolver", "space_columns", "space_columns_3d", "LABEL"]
 
-#: edges crossing by less than this fraction of ``tol`` get no edge-to-edge row (3D; docs/contact.md,
-#: "Edge-to-edge rows in 3D")
+#: edges crossing by less than this fraction of ``tol`` (or ``penetration_tol``, the larger) get
+#: no edge-to-edge row (3D; docs/contact.md, "Edge-to-edge rows in 3D")
 EDGE_TOL = 1e-3
 
 #: label of the problem's constraint rows that the contact solve owns
@@ -89,7 +91,8 @@ class ContactResult:
         Detect-and-solve rounds.
     constraints : ngfracture.contact.rows.ContactConstraints
         The active constraints at the end: seam rows (master_tri = -1, a = c the master
-        twin, slave its twin) and node-to-segment rows.
+        twin, slave its twin) and node-to-segment rows (3D: a
+        :class:`~ngfracture.contact.mixed_rows.MixedRows` of node-to-face and edge rows).
     multipliers : numpy.ndarray
         Their multipliers (<= 0: compressive).
     released : int
