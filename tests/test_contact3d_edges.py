@@ -134,7 +134,9 @@ def test_edge_keys_round_trip():
     pairs = np.array([[0, 5], [3, 17], [2, len(E) - 1]])
     codes = codec.edge_codes(pairs)
     keys = codec.decode(codes)
-    assert keys == [("e", *E[i], *E[j]) for i, j in pairs]
+    rows = EdgeRows(E[pairs[:, 0]], E[pairs[:, 1]], np.zeros((3, 2)), np.zeros((3, 3)), np.zeros(3), np.zeros(3),
+                    nv=len(arrays.points))
+    assert keys == [("e", *E[i], *E[j]) for i, j in pairs] == rows.keys()
     assert np.array_equal(codec.codes_of(keys), codes) and np.all(codes < -1)
     assert codec.codes_of([("e", -5, -4, 0, 1)])[0] == -1               # no such edges
 

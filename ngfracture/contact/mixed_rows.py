@@ -82,19 +82,6 @@ class MixedRows:
             self._C = C if identity else C[self._place]
         return self._C
 
-    def positions(self, k):
-        """The rows of kind k: their indices in the table, in order.
-
-        Parameters
-        ----------
-        k : int
-
-        Returns
-        -------
-        numpy.ndarray of int64
-        """
-        return np.flatnonzero(self.kind == k)
-
     def subset(self, rows):
         """The rows ``rows`` (an index array or a boolean mask), in that order.
 
