@@ -236,9 +236,9 @@ def edge_rows(points, faces, edges, at_edge, pairs, displacement):
     crossing = (two & (sine >= PARALLEL) & (s > 0) & (s < 1) & (t > 0) & (t < 1)
                 & _locally_inside(x, F, b, at_b, pa) & _locally_inside(x, F, a, at_a, pb))
     st = np.stack([s, t], axis=1)
-    dist, _ = _gaps(X, x, a, b, st, n)
-    n = np.where((dist > 0)[:, None], -n, n)                     # crossed: the gap is negative
     dist, g = _gaps(X, x, a, b, st, n)
+    side = np.where(dist > 0, -1.0, 1.0)                         # crossed: the gap is negative
+    n, dist, g = n * side[:, None], dist * side, g * side         # negation is exact
     kept = np.flatnonzero(crossing & (dist < 0))
     return EdgeRows(a[kept], b[kept], st[kept], n[kept], dist[kept], g[kept], nv=len(X)), kept
 

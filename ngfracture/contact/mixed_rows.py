@@ -54,20 +54,15 @@ class MixedRows:
         if not np.array_equal(np.bincount(self.kind, minlength=len(sizes)), sizes):
             raise ValueError(f"MixedRows: kind counts {np.bincount(self.kind, minlength=len(sizes)).tolist()} "
                              f"rows of each kind, the parts have {sizes}")
-        # row i of the table is row place[i] of the parts stacked in order
-        self._place = self._stacked_place(sizes)
+        # a row's place among the rows of its kind, and in the parts stacked in order
+        self._rank = np.empty(len(self.kind), dtype=np.int64)
+        for k, size in enumerate(sizes):
+            self._rank[self.kind == k] = np.arange(size)
+        start = np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.int64)
+        self._place = start[self.kind] + self._rank
         self.g = np.concatenate([p.g for p in self.parts])[self._place]
         self.dist = np.concatenate([p.dist for p in self.parts])[self._place]
         self._C = None
-
-    def _stacked_place(self, sizes):
-        """For every row, its position in the parts stacked in order."""
-        start = np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.int64)
-        place = np.empty(len(self.kind), dtype=np.int64)
-        for k in range(len(sizes)):
-            mine = self.kind == k
-            place[mine] = start[k] + np.arange(sizes[k])
-        return place
 
     def __len__(self):
         return len(self.kind)
@@ -103,11 +98,7 @@ class MixedRows:
             raise ValueError(f"MixedRows.subset: a mask of shape {rows.shape} for {len(self)} rows")
         rows = np.flatnonzero(rows) if rows.dtype == bool else rows.astype(np.int64)
         kind = self.kind[rows]
-        rank = np.empty(len(self.kind), dtype=np.int64)        # a row's place among its kind
-        for k in range(len(self.parts)):
-            mine = self.kind == k
-            rank[mine] = np.arange(np.count_nonzero(mine))
-        parts = [p.subset(rank[rows[kind == k]]) for k, p in enumerate(self.parts)]
+        parts = [p.subset(self._rank[rows[kind == k]]) for k, p in enumerate(self.parts)]
         out = MixedRows(parts, kind)
         out.dist = self.dist[rows]
         return out
