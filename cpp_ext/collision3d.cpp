@@ -639,15 +639,17 @@ namespace ngfracture
     // `depth` gets max(0, -signed distance). Faces of t elsewhere are not candidates: t's
     // wedge can be reflex, and v outside one of its planes may still be inside it.
     // With `lips_of` (the copies), the candidates are instead the lips among those faces
-    // (IsLip), and only one that v is behind is returned (see the caller).
+    // (IsLip), and only one that v is behind is returned (see the caller). With `tet`
+    // null, the candidates are the boundary faces at t that v is behind (see the caller).
     int32_t SeparatingFace (const TetMesh3 & m, const VertexFaces & vfaces, const Topology & topo,
                             int32_t v, int32_t t, const int32_t * tet, double & depth,
                             const Copies * lips_of = nullptr)
     {
       bool lips_only = lips_of != nullptr;
+      bool behind_only = lips_only || tet == nullptr;
       int32_t best = -1;
       double best_s = -std::numeric_limits<double>::infinity();
-      auto in_tet = [&] (int32_t w) { return tet[0] == w || tet[1] == w || tet[2] == w || tet[3] == w; };
+      auto in_tet = [&] (int32_t w) { return !tet || tet[0] == w || tet[1] == w || tet[2] == w || tet[3] == w; };
       for (int64_t i = vfaces.start[t]; i < vfaces.start[t+1]; i++)
         {
           int32_t f = vfaces.at[i];
@@ -658,18 +660,31 @@ namespace ngfracture
           double len = std::sqrt(Dot(n, n));
           if (!(len > 0)) continue;
           for (int d = 0; d < 3; d++) n[d] /= len;
-          if (lips_only ? !IsLip(m, *lips_of, vfaces, f) : !StarOnSide(m, topo, v, n, 1.0)) continue;
+          if (lips_only ? !IsLip(m, *lips_of, vfaces, f) : (tet && !StarOnSide(m, topo, v, n, 1.0))) continue;
           Sub(m.x + 3*T[1], m.x + 3*T[0], e0); Sub(m.x + 3*T[2], m.x + 3*T[0], e1); Cross(e0, e1, n);
           len = std::sqrt(Dot(n, n));
           if (!(len > 0)) continue;
           double r[3];
           Sub(m.x + 3*v, m.x + 3*t, r);
           double s = Dot(n, r) / len;
+          if (!tet && !(s < 0)) continue;              // the whole star: faces v is behind
           if (s > best_s || (s == best_s && f < best)) { best_s = s; best = f; }
         }
-      if (lips_only && !(best_s < 0)) best = -1;
+      if (behind_only && !(best_s < 0)) best = -1;
       depth = best >= 0 ? std::max(0.0, -best_s) : 0.0;
       return best;
+    }
+
+    // Whether tetrahedron `tet` has a boundary face at vertex t.
+    bool HasBoundaryFaceAt (const TetMesh3 & m, const VertexFaces & vfaces, int32_t t, const int32_t * tet)
+    {
+      auto in_tet = [&] (int32_t w) { return tet[0] == w || tet[1] == w || tet[2] == w || tet[3] == w; };
+      for (int64_t i = vfaces.start[t]; i < vfaces.start[t+1]; i++)
+        {
+          const int32_t * T = m.faces + 3*vfaces.at[i];
+          if (in_tet(T[0]) && in_tet(T[1]) && in_tet(T[2])) return true;
+        }
+      return false;
     }
 
     inline bool IsPartner (const std::vector<int32_t> & partners, int32_t f)
@@ -933,6 +948,12 @@ namespace ngfracture
           // lip of another copy, v in front of it)
           if (sep < 0 && t_copy >= 0 && copies.CountOn(D.vfrag, v, F) >= 3)
             sep = SeparatingFace(m, vfaces, T, v, t_copy, m.tets + 4*t, depth, &copies);
+          // none, and the holding tetrahedron has no face on the boundary at t: v slid past
+          // the faces of the tetrahedra at t deeper into t's star (where several cracks
+          // meet); the face at t that v is least deep behind (the nearest face of F may be
+          // one v is in front of, whose row does not hold it)
+          if (sep < 0 && t_copy >= 0 && !HasBoundaryFaceAt(m, vfaces, t_copy, m.tets + 4*t))
+            sep = SeparatingFace(m, vfaces, T, v, t_copy, nullptr, depth);
           if (sep >= 0)
             {
               const int32_t * T = m.faces + 3*sep;

@@ -8,9 +8,10 @@ holding tetrahedron of a pair is the smallest. Master faces (collision3d's docst
 a tetrahedron at a copy t of the vertex, the face of that tetrahedron at t with the
 vertex's reference star outside its plane that the vertex is least deep behind; if none
 passes and three copies of the point lie on the fragment, the lip of that tetrahedron at
-t the vertex is least deep behind if it is behind one; else the nearest face of the
-fragment opposing the vertex's normal or coincident with one of its faces (partner
-faces). Import with ``PYTHONPATH=.:tests``.
+t the vertex is least deep behind if it is behind one; else, where that tetrahedron has no
+boundary face at t, the face at t (any boundary face there) that the vertex is least deep
+behind; else the nearest face of the fragment
+opposing the vertex's normal or coincident with one of its faces (partner faces). Import with ``PYTHONPATH=.:tests``.
 """
 from collections import Counter, defaultdict
 
@@ -148,6 +149,14 @@ class MasterReference:
             on_block = int(np.count_nonzero(np.all(X == X[a], axis=1) & (self.vf == f)))
             if len(lips) and on_block >= 3 and self.signed(a, t[0], lips).max() < 0:
                 sep, by_lip = lips, True
+        if not len(sep) and not len(at):
+            # a tetrahedron with no boundary face at the copy: every boundary face at the
+            # copy that a is behind, least deep
+            star = np.flatnonzero(np.any(F == t[0], axis=1))
+            behind_of = self.signed(a, t[0], star) < 0
+            if not behind_of.any():
+                return None
+            sep = star[behind_of]
         if not len(sep):
             return None
         signed = self.signed(a, t[0], sep)

@@ -13,6 +13,10 @@ without the lip fallback) is another one, on the plane x = 1/2 (at z = 3/4 half 
 at the top the free face is nearer than the lip (a rule over every face of the
 tetrahedron would take it). The whole detection must equal the brute-force reference of
 ``detection3d_util`` (the rules of collision3d's docstring).
+
+Deeper in the star: the copy moved into a tetrahedron at t with no face on the boundary
+gets the boundary face at t it is least deep behind, where the nearest face rule takes
+one it is deeper behind.
 """
 from fractions import Fraction
 
@@ -118,3 +122,45 @@ def test_the_master_is_the_lip_the_vertex_is_least_deep_behind(case):
     assert key == ("f", v, *sorted(F[lip].tolist()))
     print(f"\n{case}: {len(pen)} pairs, {crossed} at a copy, {behind} by the lip rule; depth {depth:.6g} "
           f"(detected - exact {-pen.gap[i] - depth:.3g}), nearest face {d.min():.6g}, {closed} closed seams")
+
+
+def test_deep_in_the_star_the_master_is_the_face_at_the_copy_least_deep_behind():
+    """The copy of W0 at the inner point moved into a tetrahedron of W2 at the copy t there
+    with no face on the boundary (past the faces of the tetrahedra the rules above look
+    at): the master is the boundary face at t that the vertex is least deep behind, here
+    W2's lip on y = 1/2 (the vertex nearer to it than to W2's lip on x = 1/2). The nearest
+    face rule takes only faces opposing the vertex's normal or coincident with its faces
+    (the lips on x = 1/2): a face the vertex is deeper behind."""
+    a = junction_cube()
+    X, T, F = a.points, a.tets, a.faces
+    labels = wedge_labels(a)
+    copies = copies_of(X, 0.75)
+    side = [set(labels[np.any(T == c, axis=1)].tolist()) for c in copies]
+    v, t = (int(copies[side.index({w})]) for w in (0, 2))
+    found = None
+    for k in np.flatnonzero(np.any(T == t, axis=1) & (labels == 2)):
+        if len(faces_at(F, T[k], t)):
+            continue
+        direction = sum(X[u] - X[t] for u in T[k] if u != t)
+        if abs(direction[1]) < abs(direction[0]):              # nearer to y = 1/2 than to x = 1/2
+            found = int(k), direction
+            break
+    assert found is not None
+    k, direction = found
+    U = np.zeros_like(X)
+    U[v] = EPS * 0.2 * direction
+    x = X + U
+    at_t = np.flatnonzero(np.any(F == t, axis=1))
+    signed = np.array([exact_signed(x, F[f], x[v]) for f in at_t])
+    behind = at_t[signed < 0]
+    best = behind[np.argmax(signed[signed < 0])]
+    assert np.all(np.abs(X[F[best], 1] - 0.5) == 0) and np.any(np.abs(X[F[behind], 0] - 0.5) == 0)
+
+    pen = detect_penetrations_3d(X, T, F, np.zeros(len(T), np.int64), displacement=U)
+    i = int(np.flatnonzero(pen.vertex == v)[0])
+    assert pen.tet[i] == k and pen.face[i] == best
+    assert abs(pen.gap[i] - signed[at_t == best][0]) <= 1e-15 * abs(pen.gap[i])
+    ref = MasterReference(X, U, T, F, np.zeros(len(T), np.int64))
+    cand, d = ref.nearest(v, 0)
+    assert best not in cand                                   # the rule without it takes another face
+    ref.check(pen, 1e-15)

@@ -16,8 +16,8 @@ the core's inside moved by x, the outside held):
   tilt) widened by the measured displacement error at the hole;
 * runs, confined and free: volume to the last bit, no inverted tetrahedron, no penetration
   after every step, and the written steps' overlap between fragments at most 1e-10 of the
-  volume; confined, at least two crack surfaces from the hole; free, at least three
-  fragments at the end (slow).
+  volume; confined, cracks from the hole inside an intact outer shell (the 2D Fig. 9's
+  intact ring); free, at least three fragments at the end (slow).
 """
 import math
 
@@ -176,9 +176,10 @@ def crack_surfaces_from_hole(arrays):
     return len(set(comp[:n][np.abs(r - HOLE) < 1e-9]))
 
 
-def run_with_checks(scene, out):
+def run_with_checks(scene, out, last=None):
     """Run ``scene`` into ``out``; per accepted step (x, volume, smallest deformed tet volume,
-    deepest penetration, crack surfaces from the hole, fragments), and the result."""
+    deepest penetration, crack surfaces from the hole, fragments), and the result. ``last``
+    (a dict) gets the last accepted step's arrays and piece per vertex."""
     from ngfracture.run.simulation import Simulation
     steps = []
 
@@ -186,8 +187,11 @@ def run_with_checks(scene, out):
         prob = accepted.problem
         a = prob.arrays
         U = vertex_displacement(prob.u)
+        count, piece = prob.fragments()
         steps.append((accepted.state.x, total_volume(a.points, a.tets), tet_volumes(a.points + U, a.tets).min(),
-                      penetration_depth_3d(prob), crack_surfaces_from_hole(a), prob.fragments()[0]))
+                      penetration_depth_3d(prob), crack_surfaces_from_hole(a), count))
+        if last is not None:
+            last.update(arrays=a, piece=np.asarray(piece))
         check_step_overlap(out, accepted.state.step)     # written before on_step: stop at a violation
 
     result = Simulation(scene, out=out, pictures="none").run(on_step=on_step)
@@ -200,25 +204,36 @@ def run_with_checks(scene, out):
     return steps, result
 
 
+def outer_shell(arrays, piece):
+    """The glass piece that holds the whole outer surface, or None if no one piece does."""
+    outer = arrays.faces[arrays.face_bc == arrays.bc_names.index("outer") + 1]
+    on_outer = np.unique(piece[outer.ravel()])
+    return int(on_outer[0]) if len(on_outer) == 1 else None
+
+
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason="run from the start, the coarse confined sphere ends at step 35 (x = 3.484e-3 "
-                   "of 3.56e-3, 5 fragments): at step 36 two tetrahedra of the glass and of a piece broken off, which "
-                   "shared an edge in the reference, cross with no vertex inside the other (overlap volume 4.2e-10, "
-                   "1.1e-10 of the volume), at every cut: edges crossing next to copies of a point where the lips slid "
-                   "over a kink, which neither the rows at copies nor edge-to-edge rows hold (docs/contact.md, "
-                   "'Edge-to-edge rows in 3D')")
 def test_run_confined(tmp_path):
-    steps, result = run_with_checks(sphere3d(**COARSE), tmp_path)
+    """The paper's Fig. 9 in 3D: the run reaches its final load with the invariants of
+    every step, cracks from the hole, and the rigid shell keeps the glass's outer surface
+    on one piece (the 2D disk's intact ring). How many pieces break off at the hole is not
+    asserted: on this mesh it depends on the path (2 and 6 fragments at the final load in
+    two runs whose contact rules differed only at points where several cracks meet), as
+    the number of radial cracks does in 2D (tests/test_disk.py); nor the number of separate
+    crack surfaces, since radial cracks that meet join into one."""
+    last = {}
+    steps, result = run_with_checks(sphere3d(**COARSE), tmp_path, last)
     assert result.ok and result.reason == "load_max", result.message
-    assert steps[-1][4] >= 2
+    assert steps[-1][4] >= 1
+    assert outer_shell(last["arrays"], last["piece"]) is not None
 
 
 @pytest.mark.slow
 @pytest.mark.xfail(strict=True, reason="the coarse free run does not reach the end of its load range (4.14e-3): "
-                   "it has five fragments at x = 2.604e-3 (step 37, 539 s) and step 38 fails at every cut, the "
-                   "fragments overlapping by 1.6e-10 of the volume with edges crossing next to copies of a point where "
-                   "the lips slid over a kink, which neither the rows at copies nor edge-to-edge rows hold "
-                   "(docs/contact.md, 'Edge-to-edge rows in 3D')")
+                   "it has nine fragments at x = 3.298e-3 (step 48, 616 s) and step 49 fails on overlap (1.4e-10 of "
+                   "the volume, no vertex inside another piece) at an edge with three copies, a crack inside one "
+                   "fragment meeting a cut, where a tetrahedron with three boundary faces slid 2.2e-4 along the "
+                   "matched plane past the edge of the other piece's tetrahedron (docs/contact.md, 'Rows at copies "
+                   "found by their planes')")
 def test_run_free(tmp_path):
     """sphere3d_free on the coarse mesh: the same invariants per step, and it falls apart
     (the core and at least two glass pieces), as the 2D disintegration."""

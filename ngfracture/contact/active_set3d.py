@@ -41,7 +41,12 @@ Candidates, each identified by its key ("f", slave, master vertices sorted; "e",
   vertex found in its own fragment, through the lip row of its pair of copies. A found
   row stays a candidate while it is active or found again, as in 2D, and once the
   complementarity problem chooses the set, while it has been wanted or imposed in the
-  solve (a row the problem released must stay visible to the next problem).
+  solve (a row the problem released must stay visible to the next problem). Found the
+  same way, from the planes at copies of a point: a copy behind the plane of a partner
+  face at its copy, and the ends of a junction edge inside the wedge of a diagonal
+  neighbour's copy of it, deeper than ``copy_tol``
+  (:meth:`ActiveSet3d._with_rows_at_copies`; docs/contact.md, "Rows at copies found by
+  their planes").
 
 - *edge* rows (:mod:`~ngfracture.contact.edge_rows3d`): pairs of boundary edges of two
   fragments that cross at the configuration of the last solve deeper than ``edge_tol``
@@ -68,19 +73,22 @@ the set (:class:`~ngfracture.contact.active_set.ActiveSet`) are array operations
 (``numpy.isin``, sorting), with the same results as with tuples; the tuples are made only
 where a caller reads them (:class:`~ngfracture.contact.active_set.RowKeys`).
 """
+import functools
 import time
 
 import numpy as np
 import scipy.sparse as sp
 
 from .active_set import ActiveSet, Candidates, RowKeys, refreshed
-from .copies3d import folded_rows_at_copies, found_rows_at_copies, two_sided_rows
+from .copies3d import (behind_partner_rows, folded_rows_at_copies, found_rows_at_copies, rows_at_copies_of,
+                       two_sided_rows)
 from .edge_rows3d import EdgeRows, edge_rows, no_edge_rows, relinearise_edge_rows
 from .intsets import isin_ints, union_ints, unique_ints
 from .mixed_rows import MixedRows
 from .redundancy import holds_on_columns
 from .rows3d import NodeToFaceRows, no_face_rows, node_to_face_rows, relinearise_node_to_face
 from .setup3d import FaceKeys, MeshSetup3d
+from .wedges3d import wedge_rows
 
 __all__ = ["ActiveSet3d", "FaceKeys", "fixed_rows_3d"]
 
@@ -165,14 +173,19 @@ class ActiveSet3d(ActiveSet):
     edge_tol : float, optional
         Depth (a length) of a crossing of two edges that makes an edge-to-edge row
         (default ``penetration_tol``); once a row, it is judged by ``penetration_tol``.
+    copy_tol : float, optional
+        Depth (a length) of a copy behind a partner face's plane at its copy, or of a
+        junction edge in a diagonal neighbour's wedge, that makes a row
+        (:meth:`_with_rows_at_copies`; default ``penetration_tol``).
     **options
         ``rank_tol``, ``pdas_rounds``, ``max_updates``, ``warm`` of ActiveSet (``tol`` and
         ``kink_angle`` have no role in 3D).
     """
 
-    def __init__(self, geometry, penetration_tol, setups=None, edge_tol=None, **options):
+    def __init__(self, geometry, penetration_tol, setups=None, edge_tol=None, copy_tol=None, **options):
         super().__init__(geometry, 0.0, penetration_tol, **options)
         self.edge_tol = penetration_tol if edge_tol is None else edge_tol
+        self.copy_tol = penetration_tol if copy_tol is None else copy_tol
         a = geometry.arrays
         # the work on the mesh alone (codec, detector, copy index, fixed rows): made here or
         # taken from the set-up of the solve before on the same mesh
@@ -183,6 +196,12 @@ class ActiveSet3d(ActiveSet):
         self.n2s_keys = RowKeys(np.zeros(0, dtype=np.int64), self.codec)
         self.edges = no_edge_rows(len(a.points))
         self.edge_keys = RowKeys(np.zeros(0, dtype=np.int64), self.codec)
+
+    @functools.cached_property
+    def tied(self):
+        """The vertex pairs the scene's own rows tie (:func:`tied_pairs` of the holds, made at
+        first use: the holds of free pieces are dense); their copies keep the fixed rows alone."""
+        return tied_pairs(self.geometry.holds, len(self.geometry.arrays.points))
 
     def update(self, U, timings):
         """The candidate rows at X + U, the configuration of the last solve.
@@ -216,6 +235,7 @@ class ActiveSet3d(ActiveSet):
         pen = self.setup.detector.detect(U)
         timings["collision"] += time.perf_counter() - t0
         found, found_codes = self._node_to_face(pen)
+        found, found_codes = self._with_rows_at_copies(found, found_codes, U, pen)
         n2s_codes = self.n2s_keys.codes
         retained = self._retained(n2s_codes, found_codes)
         new = np.flatnonzero(~isin_ints(found_codes, np.concatenate([n2s_codes, self.seam_keys.codes])))
@@ -328,6 +348,37 @@ class ActiveSet3d(ActiveSet):
         deep = np.flatnonzero(rows.dist < -self.edge_tol)
         return rows.subset(deep), self.codec.edge_codes(pairs[kept[deep]])
 
+    def _with_rows_at_copies(self, found, codes, U, pen):
+        """The found rows and their key codes with the rows at copies that X + U violates
+        deeper than ``copy_tol`` and they lack: a copy behind a partner face's plane
+        at its copy (:func:`~ngfracture.contact.copies3d.behind_partner_rows`; not for
+        pairs the scene's rows tie), and junction edges in a diagonal neighbour's wedge
+        (:func:`~ngfracture.contact.wedges3d.wedge_rows`); in the first round, also the
+        rows at copies that the warm start names
+        (:func:`~ngfracture.contact.copies3d.rows_at_copies_of`). A slave that the detection
+        (``pen``) finds deeper than ``penetration_tol`` gets none: its detected row holds it
+        (in a prediction whole lips pass through each other, and rows linearised there
+        would hold planes far from where the lips come back to)."""
+        a, setup = self.geometry.arrays, self.setup
+        nv = len(a.points)
+        parts = [behind_partner_rows(setup.partners, U, self.copy_tol, setup.copy_index),
+                 wedge_rows(a.points, a.faces, setup.diagonal_edges, U, self.copy_tol, setup.copy_index.unit)]
+        if self.warm:
+            # the rows at copies the solve before imposed, which the warm start names
+            warm = self._key_codes(sorted(self.warm))
+            parts.append(rows_at_copies_of(*self.codec.faces_of(warm[warm >= 0]), U, setup.copy_index))
+        more = NodeToFaceRows.stack(parts)
+        if not len(more):
+            return found, codes
+        copy = more.master[np.arange(len(more)), np.argmax(more.bary, axis=1)]
+        deep = unique_ints(np.asarray(pen.vertex, dtype=np.int64)[pen.gap < -self.penetration_tol])
+        keep = ~isin_ints(np.minimum(more.slave, copy) * nv + np.maximum(more.slave, copy), self.tied)
+        more = more.subset(np.flatnonzero(keep & ~isin_ints(more.slave, deep)))
+        more_codes = self.codec.codes(more)
+        first = np.sort(np.unique(more_codes, return_index=True)[1])
+        first = first[~isin_ints(more_codes[first], codes)]
+        return NodeToFaceRows.stack([found, more.subset(first)]), np.concatenate([codes, more_codes[first]])
+
     def _node_to_face(self, pen):
         """The pairs detected (``pen``, the detection at X + U) that no twin row covers, as
         rows with their key codes."""
@@ -351,7 +402,7 @@ class ActiveSet3d(ActiveSet):
         if deep_at_copy.any():
             # and, where the lip at the copy is folded, a row on every coincident face there
             folded = folded_rows_at_copies(a.points, a.faces, rows, deep_at_copy[keep],
-                                           setup.vertex_fragment, tied_pairs(self.geometry.holds, len(a.points)),
+                                           setup.vertex_fragment, self.tied,
                                            index=setup.copy_index)
             folded_codes = self.codec.codes(folded)
             first = np.sort(np.unique(folded_codes, return_index=True)[1])

@@ -54,10 +54,11 @@ behind a lip face at its copy, the pair's row holding only the other side).
 """
 import numpy as np
 
-from .kinks3d import KINK, CopyIndex, expand_ranges, isin_ints, partner_faces, unique_ints
-from .rows3d import NodeToFaceRows
+from .kinks3d import KINK, CopyIndex, copy_pairs, expand_ranges, isin_ints, partner_faces, unique_ints
+from .rows3d import NodeToFaceRows, no_face_rows
 
-__all__ = ["found_rows_at_copies", "folded_rows_at_copies", "two_sided_rows"]
+__all__ = ["found_rows_at_copies", "folded_rows_at_copies", "two_sided_rows", "partner_incidences",
+           "behind_partner_rows", "rows_at_copies_of"]
 
 
 def _partner_at(index, face, vertex):
@@ -263,3 +264,126 @@ def two_sided_rows(rows, points, displacement, index, margin=0.0):
     normal, dist = rows.normal.copy(), rows.dist.copy()
     normal[r], dist[r] = reverse[tighter], gap[tighter]
     return NodeToFaceRows(rows.slave, rows.master, rows.face, rows.bary, normal, dist, rows.g, nv=rows.nv)
+
+
+def partner_incidences(index, vertex_fragment):
+    """Every pair (s, f) of a copy s and a face f at a copy t of s coincident with a face at s, s the slave of the pair.
+
+    One direction per pair of copies, the fixed rows' (:mod:`~ngfracture.contact.junctions3d`,
+    :func:`~ngfracture.contact.rows3d.lip_rows`): the slave on the higher fragment, on one
+    fragment the higher vertex. The reversed condition on the coincident face is the same
+    row while the faces stay parallel, and the re-linearisation takes the tighter of the
+    two (:func:`two_sided_rows`).
+
+    Parameters
+    ----------
+    index : ngfracture.contact.kinks3d.CopyIndex
+        The index of the mesh's reference points and boundary faces.
+    vertex_fragment : numpy.ndarray of int, shape (nv,)
+        The fragment of every vertex.
+
+    Returns
+    -------
+    slave, face, corner : numpy.ndarray of int
+        As :func:`~ngfracture.contact.kinks3d.partner_faces` returns them (lips of one
+        fragment included).
+    """
+    s, t = copy_pairs(index)
+    vf = np.asarray(vertex_fragment, dtype=np.int64)
+    ahead = (vf[s] > vf[t]) | ((vf[s] == vf[t]) & (s > t))       # the fixed rows' direction
+    return partner_faces(index.points, index.faces, s[ahead], t[ahead], all_pairs=True, one_way=False, index=index)
+
+
+def behind_partner_rows(partners, displacement, tol, index):
+    """Rows of copies that lie behind the plane of a partner face at their copy deeper than ``tol``.
+
+    The fixed rows hold a copy s against one face at its copy t, and against the others
+    only where they turn away from it by more than :data:`~ngfracture.contact.kinks3d.KINK`.
+    Sliding along one face, s goes behind the plane of a partner face turned by less, by
+    the slip times the angle; once deeper than ``tol`` that face gets its row (the first-
+    order condition of two copies, :mod:`~ngfracture.contact.kinks3d`).
+
+    Parameters
+    ----------
+    partners : tuple of numpy.ndarray
+        :func:`partner_incidences` of the mesh.
+    displacement : numpy.ndarray, shape (nv, 3)
+        Displacements U: the configuration X + U tested.
+    tol : float
+        Depth (a length) behind a partner face's plane that makes a row.
+    index : ngfracture.contact.kinks3d.CopyIndex
+        The index of the reference points and boundary faces.
+
+    Returns
+    -------
+    NodeToFaceRows
+        For every pair of copies with a partner face that s is behind deeper than ``tol``,
+        the rows on all of the pair's partner faces (the active set imposes those that
+        bind; found one by one, each held plane lets s slide behind the next), in the
+        order of ``partners``: projected at the copy (``g`` 0), the face's unit normal of
+        the reference configuration, ``dist`` the gap at X + U.
+    """
+    slave, face, corner = partners
+    X, F = index.points, index.faces
+    nv = len(X)
+    if not len(slave):
+        return no_face_rows(nv)
+    x = X + np.asarray(displacement, dtype=np.float64)
+    copy = F[face, corner]
+    d = x[slave] - x[copy]
+    gap = np.zeros(len(slave))
+    apart = np.flatnonzero(np.any(d != 0.0, axis=1))          # copies that meet are behind no plane
+    tri = x[F[face[apart]]]
+    area = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    gap[apart] = np.einsum("ij,ij->i", area, d[apart]) / np.linalg.norm(area, axis=1)
+    pair = slave * nv + copy
+    hit = np.flatnonzero(isin_ints(pair, unique_ints(pair[gap < -tol])))    # every partner face of a pair hit
+    if not len(hit):
+        return no_face_rows(nv)
+    s, f, k, gap = slave[hit], face[hit], corner[hit], gap[hit]
+    bary = np.zeros((len(hit), 3))
+    bary[np.arange(len(hit)), k] = 1.0
+    return NodeToFaceRows(slave=s, master=F[f], face=f, bary=bary, normal=index.unit[f].copy(), dist=gap,
+                          g=np.zeros(len(hit)), nv=nv)
+
+
+def rows_at_copies_of(slave, face, displacement, index):
+    """The rows at copies with the given slaves and faces (keys of an earlier solve): those
+    whose face has a corner at the slave's reference point other than the slave.
+
+    A warm start names the rows a solve imposed by their keys; a row at a copy found in
+    that solve (a copy behind a partner face, a junction edge in a wedge, a detected copy)
+    is no fixed row, and unless the next solve can impose it at once it is found again
+    only after a round that lets the copy through.
+
+    Parameters
+    ----------
+    slave, face : numpy.ndarray of int, shape (m,)
+        The keys' slaves and faces.
+    displacement : numpy.ndarray, shape (nv, 3)
+        Displacements U: ``dist`` is the gap at X + U.
+    index : ngfracture.contact.kinks3d.CopyIndex
+        The index of the reference points and boundary faces.
+
+    Returns
+    -------
+    NodeToFaceRows
+        The rows of the pairs at a copy, in their order: projected at the copy (``g`` 0),
+        the face's unit normal of the reference configuration.
+    """
+    X, F, pid = index.points, index.faces, index.point
+    nv = len(X)
+    slave, face = np.asarray(slave, dtype=np.int64), np.asarray(face, dtype=np.int64)
+    master = F[face]
+    at = (pid[master] == pid[slave][:, None]) & (master != slave[:, None]) & (pid[slave] >= 0)[:, None]
+    keep = np.flatnonzero(at.sum(axis=1) == 1)
+    if not len(keep):
+        return no_face_rows(nv)
+    slave, face, master, bary = slave[keep], face[keep], master[keep], at[keep].astype(np.float64)
+    x = X + np.asarray(displacement, dtype=np.float64)
+    tri = x[master]
+    area = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    copy = master[np.arange(len(keep)), np.argmax(bary, axis=1)]
+    gap = np.einsum("ij,ij->i", area, x[slave] - x[copy]) / np.linalg.norm(area, axis=1)
+    return NodeToFaceRows(slave=slave, master=master, face=face, bary=bary, normal=index.unit[face].copy(), dist=gap,
+                          g=np.zeros(len(keep)), nv=nv)

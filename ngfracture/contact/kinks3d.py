@@ -27,7 +27,8 @@ import numpy as np
 from .. import _ngfracture as _ext
 from .intsets import isin_ints, sorted_members, unique_ints
 
-__all__ = ["KINK", "CopyIndex", "point_groups", "point_ids", "face_point_keys", "partner_faces", "expand_ranges",
+__all__ = ["KINK", "CopyIndex", "point_groups", "point_ids", "face_point_keys", "partner_faces", "copy_pairs",
+           "expand_ranges",
            "sorted_members", "unique_ints", "isin_ints"]
 
 #: 1 - cos of the smallest angle between a lip's face and the face of its one row for which
@@ -222,6 +223,25 @@ def partner_faces(points, faces, slave, copy, all_pairs, one_way=True, index=Non
     nk = len(index.faces) + 1                                              # more than the number of keys
     keep = sorted_members(index.vertex_keys, s * nk + index.face_key[face])   # f's key is that of a face at s
     return s[keep], face[keep], corner[keep]
+
+
+def copy_pairs(index):
+    """Every ordered pair (s, t) of boundary vertices at the bitwise-equal reference point, s == t included.
+
+    Parameters
+    ----------
+    index : CopyIndex
+
+    Returns
+    -------
+    s, t : numpy.ndarray of int64
+        The pairs, point by point in the index's order.
+    """
+    on, group = index.on, index.group
+    first = np.searchsorted(group, group)                                  # start of each vertex's group
+    size = np.searchsorted(group, group, side="right") - first
+    who, other = expand_ranges(first, size)
+    return on[who], on[other]
 
 
 def expand_ranges(start, count):

@@ -62,7 +62,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from .. import _ngfracture as _ext
-from .kinks3d import KINK, CopyIndex, expand_ranges, isin_ints, partner_faces
+from .kinks3d import KINK, CopyIndex, copy_pairs, expand_ranges, isin_ints, partner_faces
 from .rows import RowTable
 
 __all__ = ["NodeToFaceRows", "no_face_rows", "node_to_face_rows", "twin_rows", "fragment_twin_rows", "lip_rows", "face_gap_rows",
@@ -354,7 +354,7 @@ def twin_rows(points, faces, slave):
     if mask.shape != (nv,) or mask.dtype != bool:
         raise ValueError(f"slave must be a boolean mask of shape ({nv},), got {mask.dtype} {mask.shape}")
     index = CopyIndex(X, F)
-    s, t = _copy_pairs(index)
+    s, t = copy_pairs(index)
     pick = mask[s] & ~mask[t]
     rows = _with_junction_rows(index, _rows_at_copies(index, s[pick], t[pick], s[pick]), s[pick], t[pick], False)
     return rows.subset(np.lexsort((rows.face, rows.slave)))
@@ -392,7 +392,7 @@ def fragment_twin_rows(points, faces, vertex_fragment, index=None):
     """
     X, F, vf = _fragment_arrays(points, faces, vertex_fragment)
     index = CopyIndex(X, F) if index is None else index
-    s, t = _copy_pairs(index)
+    s, t = copy_pairs(index)
     pick = vf[s] != vf[t]
     rows = _with_junction_rows(index, _rows_at_copies(index, s[pick], t[pick], s[pick]), s[pick], t[pick], False)
     return rows.subset(np.lexsort((rows.face, rows.slave, vf[rows.slave])))
@@ -440,7 +440,7 @@ def lip_rows(points, faces, vertex_fragment, index=None):
     X, F, frag = _fragment_arrays(points, faces, vertex_fragment)
     nv = len(X)
     index = CopyIndex(X, F) if index is None else index
-    s, t = _copy_pairs(index)
+    s, t = copy_pairs(index)
     pick = (frag[s] == frag[t]) & (s > t)
     s, t = s[pick], t[pick]
     if not len(s):              # no crack inside a fragment
@@ -460,15 +460,6 @@ def _fragment_arrays(points, faces, vertex_fragment):
     if vf.shape != (nv,) or (vf.size and not np.issubdtype(vf.dtype, np.integer)):
         raise ValueError(f"vertex_fragment must be integers of shape ({nv},), got {vf.dtype} {vf.shape}")
     return X, F, vf
-
-
-def _copy_pairs(index):
-    """Every ordered pair (s, t) of boundary vertices at the bitwise-equal reference point, s == t included."""
-    on, group = index.on, index.group
-    first = np.searchsorted(group, group)                                  # start of each vertex's group
-    size = np.searchsorted(group, group, side="right") - first
-    who, other = expand_ranges(first, size)
-    return on[who], on[other]
 
 
 def _rows_at_copies(index, s, t, per):

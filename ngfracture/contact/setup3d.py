@@ -17,11 +17,13 @@ import numpy as np
 from .. import _ngfracture as _ext
 from .active_set import RowKeys
 from .collision3d import PenetrationDetector3d
+from .copies3d import partner_incidences
 from .edge_crossings3d import EdgeCrossingDetector
 from .edge_rows3d import two_faces
 from .junctions3d import covered_pairs, fragment_pair_rows
 from .kinks3d import CopyIndex
 from .rows3d import NodeToFaceRows, lip_rows, node_to_face_rows
+from .wedges3d import diagonal_edges
 
 __all__ = ["FaceKeys", "MeshSetup3d", "MeshSetups", "fixed_rows", "vertex_fragments"]
 
@@ -60,6 +62,7 @@ class FaceKeys:
         _, self.face_set, self.triples = _ext.SortedTripleRanks(F, int(F.max(initial=-1)) + 1)
         self.n = max(len(self.triples), 1)
         self._lookup = None
+        self._face_of_set = None
         self.edges = np.zeros((0, 2), dtype=np.int64) if edges is None else np.asarray(edges, dtype=np.int64)
         self._edge_lookup = None
 
@@ -108,6 +111,25 @@ class FaceKeys:
                 return -1 - (i * ne + j) if 0 <= i < j else -1
             return (k[1] * self.n + look[k[2:]]) if k[2:] in look else -1
         return np.fromiter((code(k) for k in keys), dtype=np.int64, count=len(keys))
+
+    def faces_of(self, codes):
+        """The slave and a face of the node-to-face keys of codes (>= 0).
+
+        Parameters
+        ----------
+        codes : numpy.ndarray of int64
+            Codes of node-to-face keys.
+
+        Returns
+        -------
+        slave, face : numpy.ndarray of int64
+            The key's slave and the boundary face on its master's vertices.
+        """
+        if self._face_of_set is None:
+            self._face_of_set = np.zeros(self.n, dtype=np.int64)
+            self._face_of_set[self.face_set] = np.arange(len(self.face_set))
+        slave, sets = np.divmod(np.asarray(codes, dtype=np.int64), self.n)
+        return slave, self._face_of_set[sets]
 
     def edge_codes(self, pairs):
         """The codes of edge-to-edge keys given as pairs (i, j), i < j, of edge numbers.
@@ -224,6 +246,12 @@ class MeshSetup3d:
     edge_detector : ngfracture.contact.edge_crossings3d.EdgeCrossingDetector
     faces_at_edge : numpy.ndarray of int64, shape (nE, 2)
         The two faces at every boundary edge (:func:`~ngfracture.contact.edge_rows3d.two_faces`).
+    partners : tuple of numpy.ndarray
+        Every copy's partner faces at its other copies
+        (:func:`~ngfracture.contact.copies3d.partner_incidences`).
+    diagonal_edges : ngfracture.contact.wedges3d.DiagonalEdges
+        The copies of junction edges on fragments that share no face there
+        (:func:`~ngfracture.contact.wedges3d.diagonal_edges`).
     copy_index : ngfracture.contact.kinks3d.CopyIndex
     vertex_fragment : numpy.ndarray of int64
     rows : NodeToFaceRows
@@ -248,6 +276,9 @@ class MeshSetup3d:
                                                   self.vertex_fragment[np.asarray(self.faces, dtype=np.int64)[:, 0]],
                                                   across=True, point=self.copy_index.point)
         self.faces_at_edge = two_faces(self.edge_detector.edge_face_ptr, self.edge_detector.edge_faces)
+        self.partners = partner_incidences(self.copy_index, self.vertex_fragment)
+        self.diagonal_edges = diagonal_edges(self.edge_detector.edges, self.faces_at_edge, self.vertex_fragment,
+                                             self.copy_index)
         self.codec = FaceKeys(self.faces, self.edge_detector.edges)
         self.rows, self.keys = fixed_rows(self.points, self.faces, self.vertex_fragment, self.codec,
                                           self.detector, self.copy_index)

@@ -26,9 +26,11 @@ On a tetrahedral mesh (``problem.dim == 3``) the same rounds run with
 :class:`~ngfracture.contact.active_set3d.ActiveSet3d` (node-to-face rows,
 :mod:`ngfracture.contact.rows3d`, and edge-to-edge rows, :mod:`ngfracture.contact.edge_rows3d`),
 rows in the three-component layout and six held rigid modes per free piece; ``tol`` then
-only sets the default ``penetration_tol`` and the depth of a crossing of two edges that
-makes an edge row, max(``EDGE_TOL`` tol, ``penetration_tol``), and ``kink_angle`` has no
-role (docs/contact.md, "Contact in 3D runs", "Edge-to-edge rows in 3D").
+only sets the default ``penetration_tol``, the depth of a crossing of two edges that
+makes an edge row, max(``EDGE_TOL`` tol, ``penetration_tol``), and the depth behind a
+plane at a copy of a point that makes a row there, max(``COPY_TOL`` tol,
+``penetration_tol``); ``kink_angle`` has no role (docs/contact.md, "Contact in 3D runs",
+"Edge-to-edge rows in 3D", "Rows at copies found by their planes").
 """
 import functools
 import math
@@ -55,6 +57,11 @@ __all__ = ["ContactResult", "ContactSolver", "space_columns", "space_columns_3d"
 #: edges crossing by less than this fraction of ``tol`` (or ``penetration_tol``, the larger) get
 #: no edge-to-edge row (3D; docs/contact.md, "Edge-to-edge rows in 3D")
 EDGE_TOL = 1e-3
+
+#: a copy behind a partner face at its copy, or a junction edge in a diagonal neighbour's
+#: wedge, by less than this fraction of ``tol`` (or ``penetration_tol``, the larger) gets no
+#: row of its own (3D; docs/contact.md, "Rows at copies found by their planes")
+COPY_TOL = 1e-4
 
 #: label of the problem's constraint rows that the contact solve owns
 LABEL = "contact"
@@ -290,7 +297,8 @@ class ContactSolver:
         options = dict(rank_tol=self.rank_tol, pdas_rounds=self.pdas_rounds, max_updates=self.max_updates, warm=warm)
         if self.problem.dim == 3:
             return ActiveSet3d(geometry, self.penetration_tol, setups=self.setups,
-                               edge_tol=max(EDGE_TOL * self.tol, self.penetration_tol), **options)
+                               edge_tol=max(EDGE_TOL * self.tol, self.penetration_tol),
+                               copy_tol=max(COPY_TOL * self.tol, self.penetration_tol), **options)
         return ActiveSet(geometry, self.tol, self.penetration_tol, kink_angle=self.kink_angle, **options)
 
     def _columns(self, C):

@@ -1,0 +1,165 @@
+"""Edges at a junction of fragments pushed into the wedge of a diagonal neighbour.
+
+Where three or more cut surfaces meet along a line, every fragment around the line has a
+copy of its edges there, and two fragments opposite each other across the line (diagonal
+neighbours) share the edge but no face along it: each is held by its rows to the fragments
+between them (:mod:`ngfracture.contact.junctions3d`), which stay between them only while
+those stay together. Once the middle pieces open, fragment A's copy of the junction edge can
+slide into fragment B's wedge at its copy: the edge line of A behind both planes of B's two
+faces at B's edge. Near the edge's ends the corners of B are bounded by more faces, so
+neither end of A's edge need lie inside B, and the node-to-face detection (a vertex inside
+a tetrahedron) finds nothing; the edge-to-edge rows leave pairs at copies of a point alone
+(their normals lie within about 1e-3 rad of the rows at the copy).
+
+:func:`diagonal_edges` lists, once per mesh, every ordered pair (edge a on A, edge b on B)
+of boundary edges on the same two reference points on different fragments with no face of
+A at a coincident with a face of B at b. :func:`wedge_rows` tests them at a configuration:
+where B's wedge at b is convex and the midpoint of a lies behind both of its faces' planes
+deeper than ``tol`` (measured from b's midpoint), the ends of a behind the plane of the
+less deep face get the row of that face, projected at their copy on b (barycentric 1
+there), with the face's unit normal of the reference configuration: the rows at copies'
+form (:func:`~ngfracture.contact.copies3d.found_rows_at_copies`), so that the active set
+re-linearises them as it does those. Out of B's wedge, the edge line keeps out of it
+through one face or the other: a union, of which the row keeps the one nearer to hold
+(docs/contact.md, "Junction edges in 3D").
+"""
+from dataclasses import dataclass
+
+import numpy as np
+
+from .kinks3d import expand_ranges
+from .rows3d import NodeToFaceRows, no_face_rows
+
+__all__ = ["DiagonalEdges", "diagonal_edges", "wedge_rows"]
+
+
+@dataclass(frozen=True)
+class DiagonalEdges:
+    """Ordered pairs of copies of a junction edge on diagonal fragments.
+
+    Parameters
+    ----------
+    a : numpy.ndarray of int64, shape (m, 2)
+        The ends of edge a (on fragment A).
+    b : numpy.ndarray of int64, shape (m, 2)
+        Their copies on edge b (on fragment B): ``b[:, k]`` at the reference point of ``a[:, k]``.
+    b_faces : numpy.ndarray of int64, shape (m, 2)
+        The two boundary faces of B at edge b.
+    """
+    a: np.ndarray
+    b: np.ndarray
+    b_faces: np.ndarray
+
+    def __len__(self):
+        return len(self.a)
+
+
+def diagonal_edges(edges, faces_at_edge, vertex_fragment, index):
+    """The ordered pairs of copies of one boundary edge on two fragments that share no face there.
+
+    Parameters
+    ----------
+    edges : numpy.ndarray of int, shape (nE, 2)
+        Boundary edges.
+    faces_at_edge : numpy.ndarray of int, shape (nE, 2)
+        The two boundary faces at every edge (-1 where an edge has other than two,
+        :func:`~ngfracture.contact.edge_rows3d.two_faces`).
+    vertex_fragment : numpy.ndarray of int, shape (nv,)
+        The fragment of every vertex.
+    index : ngfracture.contact.kinks3d.CopyIndex
+        The index of the mesh's reference points and boundary faces.
+
+    Returns
+    -------
+    DiagonalEdges
+        Sorted by edge a, then edge b.
+    """
+    E = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
+    at = np.asarray(faces_at_edge, dtype=np.int64).reshape(-1, 2)
+    vf = np.asarray(vertex_fragment, dtype=np.int64)
+    pid = index.point
+    none = DiagonalEdges(np.zeros((0, 2), np.int64), np.zeros((0, 2), np.int64), np.zeros((0, 2), np.int64))
+    if not len(E):
+        return none
+    P = np.sort(pid[E], axis=1)
+    code = P[:, 0] * (np.int64(P.max()) + 1) + P[:, 1]
+    order = np.argsort(code, kind="stable")
+    run_start = np.searchsorted(code[order], code[order])
+    run_size = np.searchsorted(code[order], code[order], side="right") - run_start
+    # two copies of an edge without a common face need four or more around the edge: of
+    # three wedges around a line every two are neighbours
+    several = np.flatnonzero(run_size >= 4)
+    if not len(several):
+        return none
+    owner, slot = expand_ranges(run_start[several], run_size[several])
+    a, b = order[several[owner]], order[slot]
+    a, b = a[(a != b) & (vf[E[a, 0]] != vf[E[b, 0]])], b[(a != b) & (vf[E[a, 0]] != vf[E[b, 0]])]
+    fa, fb = at[a], at[b]
+    two = (fa >= 0).all(axis=1) & (fb >= 0).all(axis=1)
+    key = index.face_key
+    shared = (key[np.maximum(fa, 0)][:, :, None] == key[np.maximum(fb, 0)][:, None, :]).any(axis=(1, 2))
+    keep = np.flatnonzero(two & ~shared)
+    a, b = a[keep], b[keep]
+    ends_b = E[b]
+    flip = pid[ends_b[:, 0]] != pid[E[a, 0]]
+    ends_b[flip] = ends_b[flip][:, ::-1]
+    sort = np.lexsort((b, a))
+    return DiagonalEdges(E[a][sort], ends_b[sort], at[b][sort])
+
+
+def wedge_rows(points, faces, pairs, displacement, tol, unit):
+    """Rows for the ends of junction edges whose midpoint lies deeper than ``tol`` in a diagonal neighbour's wedge.
+
+    Parameters
+    ----------
+    points : numpy.ndarray, shape (nv, 3)
+        Reference coordinates X.
+    faces : numpy.ndarray of int, shape (nf, 3)
+        Boundary faces, outward.
+    pairs : DiagonalEdges
+        :func:`diagonal_edges` of the mesh.
+    displacement : numpy.ndarray, shape (nv, 3)
+        Displacements U: the configuration X + U tested.
+    tol : float
+        Depth (a length) of the midpoint below the less deep face that makes rows.
+    unit : numpy.ndarray, shape (nf, 3)
+        The faces' unit outward normals in the reference configuration
+        (:class:`~ngfracture.contact.kinks3d.CopyIndex` ``unit``).
+
+    Returns
+    -------
+    NodeToFaceRows
+        For every such pair the rows of a's ends behind the less deep face's plane, on that
+        face, projected at the end's copy (``g`` 0, ``dist`` the end's gap at X + U), in
+        the order of the pairs.
+    """
+    X = np.asarray(points, dtype=np.float64)
+    F = np.asarray(faces, dtype=np.int64)
+    nv = len(X)
+    if not len(pairs):
+        return no_face_rows(nv)
+    x = X + np.asarray(displacement, dtype=np.float64)
+    a, b, fb = pairs.a, pairs.b, pairs.b_faces
+    normals = []
+    for k in range(2):
+        tri = x[F[fb[:, k]]]
+        n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+        normals.append(n / np.linalg.norm(n, axis=1)[:, None])
+    # the corner of B's second face off the edge: B's wedge is convex where it lies behind the first's plane
+    third = F[fb[:, 1]].sum(axis=1) - b.sum(axis=1)
+    convex = np.einsum("ij,ij->i", normals[0], x[third] - x[b[:, 0]]) < 0
+    gap = np.stack([np.stack([np.einsum("ij,ij->i", normals[k], x[a[:, e]] - x[b[:, e]]) for e in range(2)], axis=1)
+                    for k in range(2)], axis=1)                       # [pair, face, end]
+    middle = gap.mean(axis=2)                                         # [pair, face]
+    nearer = np.argmax(middle, axis=1)
+    inside = convex & (middle.max(axis=1) < -tol)
+    pair, end = np.nonzero(inside[:, None] & (gap[np.arange(len(a)), nearer] < 0))
+    if not len(pair):
+        return no_face_rows(nv)
+    face = fb[pair, nearer[pair]]
+    slave, copy = a[pair, end], b[pair, end]
+    master = F[face]
+    bary = (master == copy[:, None]).astype(np.float64)
+    dist = gap[pair, nearer[pair], end]
+    return NodeToFaceRows(slave=slave, master=master, face=face, bary=bary, normal=unit[face].copy(), dist=dist,
+                          g=np.zeros(len(slave)), nv=nv)
