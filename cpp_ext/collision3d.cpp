@@ -640,7 +640,8 @@ namespace ngfracture
     // wedge can be reflex, and v outside one of its planes may still be inside it.
     // With `lips_of` (the copies), the candidates are instead the lips among those faces
     // (IsLip), and only one that v is behind is returned (see the caller). With `tet`
-    // null, the candidates are the boundary faces at t that v is behind (see the caller).
+    // null, the candidates are the faces at t of every tetrahedron that v is behind
+    // (lips only with `lips_of`; see the caller).
     int32_t SeparatingFace (const TetMesh3 & m, const VertexFaces & vfaces, const Topology & topo,
                             int32_t v, int32_t t, const int32_t * tet, double & depth,
                             const Copies * lips_of = nullptr)
@@ -948,12 +949,13 @@ namespace ngfracture
           // lip of another copy, v in front of it)
           if (sep < 0 && t_copy >= 0 && copies.CountOn(D.vfrag, v, F) >= 3)
             sep = SeparatingFace(m, vfaces, T, v, t_copy, m.tets + 4*t, depth, &copies);
-          // none, and the holding tetrahedron has no face on the boundary at t: v slid past
-          // the faces of the tetrahedra at t deeper into t's star (where several cracks
-          // meet); the face at t that v is least deep behind (the nearest face of F may be
-          // one v is in front of, whose row does not hold it)
-          if (sep < 0 && t_copy >= 0 && !HasBoundaryFaceAt(m, vfaces, t_copy, m.tets + 4*t))
-            sep = SeparatingFace(m, vfaces, T, v, t_copy, nullptr, depth);
+          // none, three or more copies on F, and the holding tetrahedron has no face on the
+          // boundary at t: v slid past the faces of the tetrahedra at t deeper into t's star
+          // where several cracks meet; the lip at t that v is least deep behind (the
+          // nearest face of F may be one v is in front of, whose row does not hold it)
+          if (sep < 0 && t_copy >= 0 && copies.CountOn(D.vfrag, v, F) >= 3
+              && !HasBoundaryFaceAt(m, vfaces, t_copy, m.tets + 4*t))
+            sep = SeparatingFace(m, vfaces, T, v, t_copy, nullptr, depth, &copies);
           if (sep >= 0)
             {
               const int32_t * T = m.faces + 3*sep;

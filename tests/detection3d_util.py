@@ -9,8 +9,8 @@ a tetrahedron at a copy t of the vertex, the face of that tetrahedron at t with 
 vertex's reference star outside its plane that the vertex is least deep behind; if none
 passes and three copies of the point lie on the fragment, the lip of that tetrahedron at
 t the vertex is least deep behind if it is behind one; else, where that tetrahedron has no
-boundary face at t, the face at t (any boundary face there) that the vertex is least deep
-behind; else the nearest face of the fragment
+boundary face at t and three copies lie on the fragment, the lip at t (of any tetrahedron)
+that the vertex is least deep behind; else the nearest face of the fragment
 opposing the vertex's normal or coincident with one of its faces (partner faces). Import with ``PYTHONPATH=.:tests``.
 """
 from collections import Counter, defaultdict
@@ -144,15 +144,16 @@ class MasterReference:
         e = X[np.unique(T[np.any(T == a, axis=1)])] - X[a]
         sep = at[np.all(n @ e.T >= -1e-9 * np.linalg.norm(e, axis=1), axis=1)]
         by_lip = False
+        on_block = int(np.count_nonzero(np.all(X == X[a], axis=1) & (self.vf == f)))
         if not len(sep):
             lips = at[[self.points_count[self.points[g]] > 1 for g in at]]
-            on_block = int(np.count_nonzero(np.all(X == X[a], axis=1) & (self.vf == f)))
             if len(lips) and on_block >= 3 and self.signed(a, t[0], lips).max() < 0:
                 sep, by_lip = lips, True
-        if not len(sep) and not len(at):
-            # a tetrahedron with no boundary face at the copy: every boundary face at the
-            # copy that a is behind, least deep
+        if not len(sep) and not len(at) and on_block >= 3:
+            # a tetrahedron with no boundary face at the copy, three copies on the fragment:
+            # the lips at the copy that a is behind, least deep
             star = np.flatnonzero(np.any(F == t[0], axis=1))
+            star = star[[self.points_count[self.points[g]] > 1 for g in star]]
             behind_of = self.signed(a, t[0], star) < 0
             if not behind_of.any():
                 return None

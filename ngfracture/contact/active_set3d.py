@@ -351,18 +351,19 @@ class ActiveSet3d(ActiveSet):
     def _with_rows_at_copies(self, found, codes, U, pen):
         """The found rows and their key codes with the rows at copies that X + U violates
         deeper than ``copy_tol`` and they lack: a copy behind a partner face's plane
-        at its copy (:func:`~ngfracture.contact.copies3d.behind_partner_rows`; not for
-        pairs the scene's rows tie), and junction edges in a diagonal neighbour's wedge
-        (:func:`~ngfracture.contact.wedges3d.wedge_rows`); in the first round, also the
-        rows at copies that the warm start names
-        (:func:`~ngfracture.contact.copies3d.rows_at_copies_of`). A slave that the detection
+        at its copy (:func:`~ngfracture.contact.copies3d.behind_partner_rows`), and junction
+        edges in a diagonal neighbour's wedge (:func:`~ngfracture.contact.wedges3d.wedge_rows`);
+        in the first round, also the rows at copies that the warm start names
+        (:func:`~ngfracture.contact.copies3d.rows_at_copies_of`). None for a pair of
+        copies the scene's rows tie (:attr:`tied`). A slave that the detection
         (``pen``) finds deeper than ``penetration_tol`` gets none: its detected row holds it
         (in a prediction whole lips pass through each other, and rows linearised there
         would hold planes far from where the lips come back to)."""
         a, setup = self.geometry.arrays, self.setup
         nv = len(a.points)
         parts = [behind_partner_rows(setup.partners, U, self.copy_tol, setup.copy_index),
-                 wedge_rows(a.points, a.faces, setup.diagonal_edges, U, self.copy_tol, setup.copy_index.unit)]
+                 wedge_rows(a.points, a.faces, setup.diagonal_edges, U, self.copy_tol, setup.copy_index.unit,
+                            setup.vertex_fragment)]
         if self.warm:
             # the rows at copies the solve before imposed, which the warm start names
             warm = self._key_codes(sorted(self.warm))

@@ -62,13 +62,14 @@ boundary face on its three points) that v is least deep behind, if v is behind o
 v's wedge can lie across the plane of the lip it crossed into t's wedge, and the nearest
 face is the coincident lip at the third copy, which v is in front of (the coarse confined
 sphere at x = 2.70e-3: v 1.4e-5 behind the lip at t, reported 2.35e-5 deep on the lip at
-the third copy, whose row did not hold it). If neither gives a face (v slid past the
-faces of the tetrahedra at t into one with no face on the boundary, where several cracks
-meet), the boundary face at t, of any tetrahedron, that v is least deep behind, if v is
-behind one: the nearest face of F can be one that v is in front of (the coarse free
-sphere at x = 1.660e-3: a copy at a point of five copies on one fragment, 2.7e-5 in
-front of the nearest face, reported 3.6e-5 deep on it, and 2.2e-5 behind another face at
-its copy; the row on the nearest face did not hold it).
+the third copy, whose row did not hold it). If neither gives a face, the holding
+tetrahedron has no boundary face at t and three or more copies lie on F (v slid past the
+faces of the tetrahedra at t deeper into t's star where several cracks meet): the lip at
+t, of any tetrahedron, that v is least deep behind, if v is behind one; the nearest face
+of F can be one that v is in front of (the coarse free sphere at x = 1.660e-3: a copy at
+a point of five copies on one fragment, 2.7e-5 in front of the nearest face, reported
+3.6e-5 deep on it, and 2.2e-5 to 2.7e-5 behind faces at its copy; the row on the nearest
+face did not hold it).
 Else, in this order:
 
 1. touching: a boundary face of F that holds v exactly (closed triangle, exact

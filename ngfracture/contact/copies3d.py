@@ -335,7 +335,9 @@ def behind_partner_rows(partners, displacement, tol, index):
     apart = np.flatnonzero(np.any(d != 0.0, axis=1))          # copies that meet are behind no plane
     tri = x[F[face[apart]]]
     area = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
-    gap[apart] = np.einsum("ij,ij->i", area, d[apart]) / np.linalg.norm(area, axis=1)
+    length = np.linalg.norm(area, axis=1)
+    # a face squeezed flat has no plane: no row from it
+    gap[apart] = np.where(length > 0, np.einsum("ij,ij->i", area, d[apart]) / np.where(length > 0, length, 1.0), 0.0)
     pair = slave * nv + copy
     hit = np.flatnonzero(isin_ints(pair, unique_ints(pair[gap < -tol])))    # every partner face of a pair hit
     if not len(hit):
@@ -383,7 +385,9 @@ def rows_at_copies_of(slave, face, displacement, index):
     x = X + np.asarray(displacement, dtype=np.float64)
     tri = x[master]
     area = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    length = np.linalg.norm(area, axis=1)
     copy = master[np.arange(len(keep)), np.argmax(bary, axis=1)]
-    gap = np.einsum("ij,ij->i", area, x[slave] - x[copy]) / np.linalg.norm(area, axis=1)
+    # the gap along the face's normal (0 on a face squeezed flat: the re-linearisation decides)
+    gap = np.where(length > 0, np.einsum("ij,ij->i", area, x[slave] - x[copy]) / np.where(length > 0, length, 1.0), 0.0)
     return NodeToFaceRows(slave=slave, master=master, face=face, bary=bary, normal=index.unit[face].copy(), dist=gap,
                           g=np.zeros(len(keep)), nv=nv)

@@ -124,11 +124,19 @@ class FaceKeys:
         -------
         slave, face : numpy.ndarray of int64
             The key's slave and the boundary face on its master's vertices.
+
+        Raises
+        ------
+        ValueError
+            On a negative code (an edge key, or -1: no key).
         """
+        codes = np.asarray(codes, dtype=np.int64)
+        if np.any(codes < 0):
+            raise ValueError("FaceKeys.faces_of: a negative code is no node-to-face key")
         if self._face_of_set is None:
             self._face_of_set = np.zeros(self.n, dtype=np.int64)
             self._face_of_set[self.face_set] = np.arange(len(self.face_set))
-        slave, sets = np.divmod(np.asarray(codes, dtype=np.int64), self.n)
+        slave, sets = np.divmod(codes, self.n)
         return slave, self._face_of_set[sets]
 
     def edge_codes(self, pairs):

@@ -21,12 +21,13 @@ there), with the face's unit normal of the reference configuration: the rows at 
 form (:func:`~ngfracture.contact.copies3d.found_rows_at_copies`), so that the active set
 re-linearises them as it does those. Out of B's wedge, the edge line keeps out of it
 through one face or the other: a union, of which the row keeps the one nearer to hold
-(docs/contact.md, "Junction edges in 3D").
+(docs/contact.md, "Rows at copies found by their planes").
 """
 from dataclasses import dataclass
 
 import numpy as np
 
+from .intsets import isin_ints
 from .kinks3d import expand_ranges
 from .rows3d import NodeToFaceRows, no_face_rows
 
@@ -45,10 +46,14 @@ class DiagonalEdges:
         Their copies on edge b (on fragment B): ``b[:, k]`` at the reference point of ``a[:, k]``.
     b_faces : numpy.ndarray of int64, shape (m, 2)
         The two boundary faces of B at edge b.
+    edge_a, edge_b : numpy.ndarray of int64, shape (m,)
+        The numbers of edges a and b among the boundary edges.
     """
     a: np.ndarray
     b: np.ndarray
     b_faces: np.ndarray
+    edge_a: np.ndarray
+    edge_b: np.ndarray
 
     def __len__(self):
         return len(self.a)
@@ -78,7 +83,7 @@ def diagonal_edges(edges, faces_at_edge, vertex_fragment, index):
     at = np.asarray(faces_at_edge, dtype=np.int64).reshape(-1, 2)
     vf = np.asarray(vertex_fragment, dtype=np.int64)
     pid = index.point
-    none = DiagonalEdges(np.zeros((0, 2), np.int64), np.zeros((0, 2), np.int64), np.zeros((0, 2), np.int64))
+    none = DiagonalEdges(*(np.zeros((0, 2), np.int64) for _ in range(3)), *(np.zeros(0, np.int64) for _ in range(2)))
     if not len(E):
         return none
     P = np.sort(pid[E], axis=1)
@@ -86,9 +91,7 @@ def diagonal_edges(edges, faces_at_edge, vertex_fragment, index):
     order = np.argsort(code, kind="stable")
     run_start = np.searchsorted(code[order], code[order])
     run_size = np.searchsorted(code[order], code[order], side="right") - run_start
-    # two copies of an edge without a common face need four or more around the edge: of
-    # three wedges around a line every two are neighbours
-    several = np.flatnonzero(run_size >= 4)
+    several = np.flatnonzero(run_size >= 2)                      # edges with a copy
     if not len(several):
         return none
     owner, slot = expand_ranges(run_start[several], run_size[several])
@@ -104,10 +107,10 @@ def diagonal_edges(edges, faces_at_edge, vertex_fragment, index):
     flip = pid[ends_b[:, 0]] != pid[E[a, 0]]
     ends_b[flip] = ends_b[flip][:, ::-1]
     sort = np.lexsort((b, a))
-    return DiagonalEdges(E[a][sort], ends_b[sort], at[b][sort])
+    return DiagonalEdges(E[a][sort], ends_b[sort], at[b][sort], a[sort], b[sort])
 
 
-def wedge_rows(points, faces, pairs, displacement, tol, unit):
+def wedge_rows(points, faces, pairs, displacement, tol, unit, vertex_fragment):
     """Rows for the ends of junction edges whose midpoint lies deeper than ``tol`` in a diagonal neighbour's wedge.
 
     Parameters
@@ -125,13 +128,18 @@ def wedge_rows(points, faces, pairs, displacement, tol, unit):
     unit : numpy.ndarray, shape (nf, 3)
         The faces' unit outward normals in the reference configuration
         (:class:`~ngfracture.contact.kinks3d.CopyIndex` ``unit``).
+    vertex_fragment : numpy.ndarray of int, shape (nv,)
+        The fragment of every vertex.
 
     Returns
     -------
     NodeToFaceRows
         For every such pair the rows of a's ends behind the less deep face's plane, on that
         face, projected at the end's copy (``g`` 0, ``dist`` the end's gap at X + U), in
-        the order of the pairs.
+        the order of the pairs. Where both orders of two edges are inside, only the one
+        with a on the higher fragment gives rows (the fixed rows' direction): for opposite
+        wedges the two are one condition, and rows of both, on different faces, would
+        hold the copies out of both half-spaces instead of one.
     """
     X = np.asarray(points, dtype=np.float64)
     F = np.asarray(faces, dtype=np.int64)
@@ -140,19 +148,23 @@ def wedge_rows(points, faces, pairs, displacement, tol, unit):
         return no_face_rows(nv)
     x = X + np.asarray(displacement, dtype=np.float64)
     a, b, fb = pairs.a, pairs.b, pairs.b_faces
-    normals = []
+    normals, ok = [], np.ones(len(a), dtype=bool)
     for k in range(2):
         tri = x[F[fb[:, k]]]
         n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
-        normals.append(n / np.linalg.norm(n, axis=1)[:, None])
-    # the corner of B's second face off the edge: B's wedge is convex where it lies behind the first's plane
+        length = np.linalg.norm(n, axis=1)
+        ok &= length > 0                                              # a face squeezed flat has no plane
+        normals.append(n / np.where(length > 0, length, 1.0)[:, None])
+    # the corner of B's second face off the edge: B's wedge is convex (or flat) where it
+    # lies behind (or on) the first's plane, as edge_rows3d judges an edge
     third = F[fb[:, 1]].sum(axis=1) - b.sum(axis=1)
-    convex = np.einsum("ij,ij->i", normals[0], x[third] - x[b[:, 0]]) < 0
+    convex = np.einsum("ij,ij->i", normals[0], x[third] - x[b[:, 0]]) <= 0
     gap = np.stack([np.stack([np.einsum("ij,ij->i", normals[k], x[a[:, e]] - x[b[:, e]]) for e in range(2)], axis=1)
                     for k in range(2)], axis=1)                       # [pair, face, end]
     middle = gap.mean(axis=2)                                         # [pair, face]
     nearer = np.argmax(middle, axis=1)
-    inside = convex & (middle.max(axis=1) < -tol)
+    inside = convex & (middle.max(axis=1) < -tol) & ok
+    inside &= ~_reverse_also_inside(pairs, inside, vertex_fragment)
     pair, end = np.nonzero(inside[:, None] & (gap[np.arange(len(a)), nearer] < 0))
     if not len(pair):
         return no_face_rows(nv)
@@ -163,3 +175,12 @@ def wedge_rows(points, faces, pairs, displacement, tol, unit):
     dist = gap[pair, nearer[pair], end]
     return NodeToFaceRows(slave=slave, master=master, face=face, bary=bary, normal=unit[face].copy(), dist=dist,
                           g=np.zeros(len(slave)), nv=nv)
+
+
+def _reverse_also_inside(pairs, inside, vertex_fragment):
+    """Per pair: inside, with the reversed pair (b, a) inside too, and a on the lower fragment."""
+    vf = np.asarray(vertex_fragment, dtype=np.int64)
+    n = np.int64(max(int(pairs.edge_a.max(initial=0)), int(pairs.edge_b.max(initial=0))) + 1)
+    code, reverse = pairs.edge_a * n + pairs.edge_b, pairs.edge_b * n + pairs.edge_a
+    both = inside & isin_ints(reverse, code[inside])
+    return both & (vf[pairs.a[:, 0]] < vf[pairs.b[:, 0]])
