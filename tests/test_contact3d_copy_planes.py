@@ -122,8 +122,7 @@ def test_edge_in_the_wedge_gets_rows_with_its_gap(quadrants):
     arrays, setup = quadrants
     d = 1e-3
     U = moved(arrays, setup, (d, d, 0.0))
-    rows = wedge_rows(arrays.points, arrays.faces, setup.diagonal_edges, U, 1e-6, setup.copy_index.unit,
-                      setup.vertex_fragment)
+    rows = wedge_rows(setup.diagonal_edges, U, 1e-6, setup.copy_index, setup.vertex_fragment)
     vf = setup.vertex_fragment
     line_edges = len(Z) - 1
     # Q1's edge in Q3's wedge and Q3's in Q1's: one condition, the rows of Q3's ends (the
@@ -142,6 +141,5 @@ def test_edge_in_the_wedge_gets_rows_with_its_gap(quadrants):
 def test_no_rows_out_of_the_wedge_or_below_the_tolerance(quadrants, shift, tol):
     arrays, setup = quadrants
     U = moved(arrays, setup, shift)
-    rows = wedge_rows(arrays.points, arrays.faces, setup.diagonal_edges, U, tol, setup.copy_index.unit,
-                      setup.vertex_fragment)
+    rows = wedge_rows(setup.diagonal_edges, U, tol, setup.copy_index, setup.vertex_fragment)
     assert len(rows) == 0

@@ -362,8 +362,7 @@ class ActiveSet3d(ActiveSet):
         a, setup = self.geometry.arrays, self.setup
         nv = len(a.points)
         parts = [behind_partner_rows(setup.partners, U, self.copy_tol, setup.copy_index),
-                 wedge_rows(a.points, a.faces, setup.diagonal_edges, U, self.copy_tol, setup.copy_index.unit,
-                            setup.vertex_fragment)]
+                 wedge_rows(setup.diagonal_edges, U, self.copy_tol, setup.copy_index, setup.vertex_fragment)]
         if self.warm:
             # the rows at copies the solve before imposed, which the warm start names
             warm = self._key_codes(sorted(self.warm))
@@ -374,11 +373,15 @@ class ActiveSet3d(ActiveSet):
         copy = more.master[np.arange(len(more)), np.argmax(more.bary, axis=1)]
         deep = unique_ints(np.asarray(pen.vertex, dtype=np.int64)[pen.gap < -self.penetration_tol])
         keep = ~isin_ints(np.minimum(more.slave, copy) * nv + np.maximum(more.slave, copy), self.tied)
-        more = more.subset(np.flatnonzero(keep & ~isin_ints(more.slave, deep)))
+        return self._with_new(found, codes, more.subset(np.flatnonzero(keep & ~isin_ints(more.slave, deep))))
+
+    def _with_new(self, rows, codes, more):
+        """``rows`` and their key ``codes`` followed by the rows of ``more`` whose keys they
+        lack, each key once (its first row)."""
         more_codes = self.codec.codes(more)
         first = np.sort(np.unique(more_codes, return_index=True)[1])
         first = first[~isin_ints(more_codes[first], codes)]
-        return NodeToFaceRows.stack([found, more.subset(first)]), np.concatenate([codes, more_codes[first]])
+        return NodeToFaceRows.stack([rows, more.subset(first)]), np.concatenate([codes, more_codes[first]])
 
     def _node_to_face(self, pen):
         """The pairs detected (``pen``, the detection at X + U) that no twin row covers, as
@@ -405,9 +408,5 @@ class ActiveSet3d(ActiveSet):
             folded = folded_rows_at_copies(a.points, a.faces, rows, deep_at_copy[keep],
                                            setup.vertex_fragment, self.tied,
                                            index=setup.copy_index)
-            folded_codes = self.codec.codes(folded)
-            first = np.sort(np.unique(folded_codes, return_index=True)[1])
-            first = first[~isin_ints(folded_codes[first], codes)]
-            rows = NodeToFaceRows.stack([rows, folded.subset(first)])
-            codes = np.concatenate([codes, folded_codes[first]])
+            rows, codes = self._with_new(rows, codes, folded)
         return rows, codes

@@ -58,7 +58,7 @@ from .kinks3d import KINK, CopyIndex, copy_pairs, expand_ranges, isin_ints, part
 from .rows3d import NodeToFaceRows, no_face_rows
 
 __all__ = ["found_rows_at_copies", "folded_rows_at_copies", "two_sided_rows", "partner_incidences",
-           "behind_partner_rows", "rows_at_copies_of"]
+           "behind_partner_rows", "rows_at_copies_of", "rows_at_copy"]
 
 
 def _partner_at(index, face, vertex):
@@ -192,12 +192,7 @@ def folded_rows_at_copies(points, faces, rows, pick, vertex_fragment, tied=None,
     parallel = 1.0 - np.sum(normal[incidence] * rows.normal[picked], axis=1) <= KINK
     keep = np.ones(len(face), dtype=bool)
     keep[incidence[parallel]] = False
-    slave, face, corner, master, normal = slave[keep], face[keep], corner[keep], master[keep], normal[keep]
-    bary = np.zeros((len(face), 3))
-    bary[np.arange(len(face)), corner] = 1.0
-    zero = np.zeros(len(face))
-    return NodeToFaceRows(slave=slave, master=master, face=face, bary=bary, normal=normal, dist=zero,
-                          g=zero.copy(), nv=nv)
+    return rows_at_copy(slave[keep], face[keep], corner[keep], np.zeros(int(keep.sum())), index)
 
 
 def two_sided_rows(rows, points, displacement, index, margin=0.0):
@@ -266,6 +261,41 @@ def two_sided_rows(rows, points, displacement, index, margin=0.0):
     return NodeToFaceRows(rows.slave, rows.master, rows.face, rows.bary, normal, dist, rows.g, nv=rows.nv)
 
 
+def rows_at_copy(slave, face, corner, dist, index):
+    """Node-to-face rows of slaves on faces at one of their copies, in the form of every row at a copy.
+
+    Projected at the copy (barycentric 1 at the face's corner ``corner``, ``g`` 0: the
+    copies' reference points are equal), with the face's unit normal of the reference
+    configuration.
+
+    Parameters
+    ----------
+    slave, face, corner : numpy.ndarray of int, shape (m,)
+        The slaves, their faces and the position of the slave's copy in each face.
+    dist : numpy.ndarray, shape (m,)
+        The rows' gaps at the configuration that found them.
+    index : ngfracture.contact.kinks3d.CopyIndex
+        The index of the reference points and boundary faces.
+
+    Returns
+    -------
+    NodeToFaceRows
+    """
+    bary = np.zeros((len(slave), 3))
+    bary[np.arange(len(slave)), corner] = 1.0
+    return NodeToFaceRows(slave=slave, master=index.faces[face], face=face, bary=bary, normal=index.unit[face],
+                          dist=dist, g=np.zeros(len(slave)), nv=len(index.points))
+
+
+def _plane_gaps(x, faces, face, slave, copy):
+    """n_f . (x_s - x_t) with the faces' unit normals at x; 0 on a face squeezed flat (no plane)."""
+    tri = x[faces[face]]
+    area = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    length = np.linalg.norm(area, axis=1)
+    return np.where(length > 0, np.einsum("ij,ij->i", area, x[slave] - x[copy]) / np.where(length > 0, length, 1.0),
+                    0.0)
+
+
 def partner_incidences(index, vertex_fragment):
     """Every pair (s, f) of a copy s and a face f at a copy t of s coincident with a face at s, s the slave of the pair.
 
@@ -330,23 +360,14 @@ def behind_partner_rows(partners, displacement, tol, index):
         return no_face_rows(nv)
     x = X + np.asarray(displacement, dtype=np.float64)
     copy = F[face, corner]
-    d = x[slave] - x[copy]
     gap = np.zeros(len(slave))
-    apart = np.flatnonzero(np.any(d != 0.0, axis=1))          # copies that meet are behind no plane
-    tri = x[F[face[apart]]]
-    area = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
-    length = np.linalg.norm(area, axis=1)
-    # a face squeezed flat has no plane: no row from it
-    gap[apart] = np.where(length > 0, np.einsum("ij,ij->i", area, d[apart]) / np.where(length > 0, length, 1.0), 0.0)
+    apart = np.flatnonzero(np.any(x[slave] != x[copy], axis=1))      # copies that meet are behind no plane
+    gap[apart] = _plane_gaps(x, F, face[apart], slave[apart], copy[apart])
     pair = slave * nv + copy
     hit = np.flatnonzero(isin_ints(pair, unique_ints(pair[gap < -tol])))    # every partner face of a pair hit
     if not len(hit):
         return no_face_rows(nv)
-    s, f, k, gap = slave[hit], face[hit], corner[hit], gap[hit]
-    bary = np.zeros((len(hit), 3))
-    bary[np.arange(len(hit)), k] = 1.0
-    return NodeToFaceRows(slave=s, master=F[f], face=f, bary=bary, normal=index.unit[f].copy(), dist=gap,
-                          g=np.zeros(len(hit)), nv=nv)
+    return rows_at_copy(slave[hit], face[hit], corner[hit], gap[hit], index)
 
 
 def rows_at_copies_of(slave, face, displacement, index):
@@ -381,13 +402,7 @@ def rows_at_copies_of(slave, face, displacement, index):
     keep = np.flatnonzero(at.sum(axis=1) == 1)
     if not len(keep):
         return no_face_rows(nv)
-    slave, face, master, bary = slave[keep], face[keep], master[keep], at[keep].astype(np.float64)
+    slave, face, corner = slave[keep], face[keep], np.argmax(at[keep], axis=1)
     x = X + np.asarray(displacement, dtype=np.float64)
-    tri = x[master]
-    area = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
-    length = np.linalg.norm(area, axis=1)
-    copy = master[np.arange(len(keep)), np.argmax(bary, axis=1)]
-    # the gap along the face's normal (0 on a face squeezed flat: the re-linearisation decides)
-    gap = np.where(length > 0, np.einsum("ij,ij->i", area, x[slave] - x[copy]) / np.where(length > 0, length, 1.0), 0.0)
-    return NodeToFaceRows(slave=slave, master=master, face=face, bary=bary, normal=index.unit[face].copy(), dist=gap,
-                          g=np.zeros(len(keep)), nv=nv)
+    gap = _plane_gaps(x, F, face, slave, F[face, corner])
+    return rows_at_copy(slave, face, corner, gap, index)

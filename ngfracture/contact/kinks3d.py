@@ -28,7 +28,7 @@ from .. import _ngfracture as _ext
 from .intsets import isin_ints, sorted_members, unique_ints
 
 __all__ = ["KINK", "CopyIndex", "point_groups", "point_ids", "face_point_keys", "partner_faces", "copy_pairs",
-           "expand_ranges",
+           "equal_key_pairs", "expand_ranges",
            "sorted_members", "unique_ints", "isin_ints"]
 
 #: 1 - cos of the smallest angle between a lip's face and the face of its one row for which
@@ -237,11 +237,26 @@ def copy_pairs(index):
     s, t : numpy.ndarray of int64
         The pairs, point by point in the index's order.
     """
-    on, group = index.on, index.group
-    first = np.searchsorted(group, group)                                  # start of each vertex's group
-    size = np.searchsorted(group, group, side="right") - first
-    who, other = expand_ranges(first, size)
-    return on[who], on[other]
+    who, other = equal_key_pairs(index.group)
+    return index.on[who], index.on[other]
+
+
+def equal_key_pairs(key):
+    """Every ordered pair (i, j) of positions of a sorted array with equal values, i == j included.
+
+    Parameters
+    ----------
+    key : numpy.ndarray, shape (m,)
+        Sorted values.
+
+    Returns
+    -------
+    i, j : numpy.ndarray of int
+        The pairs, i increasing, then j.
+    """
+    first = np.searchsorted(key, key)                                      # start of each value's run
+    size = np.searchsorted(key, key, side="right") - first
+    return expand_ranges(first, size)
 
 
 def expand_ranges(start, count):

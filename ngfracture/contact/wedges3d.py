@@ -27,9 +27,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .copies3d import rows_at_copy
 from .intsets import isin_ints
-from .kinks3d import expand_ranges
-from .rows3d import NodeToFaceRows, no_face_rows
+from .kinks3d import equal_key_pairs
+from .rows3d import no_face_rows
 
 __all__ = ["DiagonalEdges", "diagonal_edges", "wedge_rows"]
 
@@ -89,14 +90,9 @@ def diagonal_edges(edges, faces_at_edge, vertex_fragment, index):
     P = np.sort(pid[E], axis=1)
     code = P[:, 0] * (np.int64(P.max()) + 1) + P[:, 1]
     order = np.argsort(code, kind="stable")
-    run_start = np.searchsorted(code[order], code[order])
-    run_size = np.searchsorted(code[order], code[order], side="right") - run_start
-    several = np.flatnonzero(run_size >= 2)                      # edges with a copy
-    if not len(several):
-        return none
-    owner, slot = expand_ranges(run_start[several], run_size[several])
-    a, b = order[several[owner]], order[slot]
-    a, b = a[(a != b) & (vf[E[a, 0]] != vf[E[b, 0]])], b[(a != b) & (vf[E[a, 0]] != vf[E[b, 0]])]
+    a, b = (order[i] for i in equal_key_pairs(code[order]))      # the copies of every edge, pairwise
+    other = vf[E[a, 0]] != vf[E[b, 0]]                           # (an edge with itself too: same fragment)
+    a, b = a[other], b[other]
     fa, fb = at[a], at[b]
     two = (fa >= 0).all(axis=1) & (fb >= 0).all(axis=1)
     key = index.face_key
@@ -110,24 +106,19 @@ def diagonal_edges(edges, faces_at_edge, vertex_fragment, index):
     return DiagonalEdges(E[a][sort], ends_b[sort], at[b][sort], a[sort], b[sort])
 
 
-def wedge_rows(points, faces, pairs, displacement, tol, unit, vertex_fragment):
+def wedge_rows(pairs, displacement, tol, index, vertex_fragment):
     """Rows for the ends of junction edges whose midpoint lies deeper than ``tol`` in a diagonal neighbour's wedge.
 
     Parameters
     ----------
-    points : numpy.ndarray, shape (nv, 3)
-        Reference coordinates X.
-    faces : numpy.ndarray of int, shape (nf, 3)
-        Boundary faces, outward.
     pairs : DiagonalEdges
         :func:`diagonal_edges` of the mesh.
     displacement : numpy.ndarray, shape (nv, 3)
         Displacements U: the configuration X + U tested.
     tol : float
         Depth (a length) of the midpoint below the less deep face that makes rows.
-    unit : numpy.ndarray, shape (nf, 3)
-        The faces' unit outward normals in the reference configuration
-        (:class:`~ngfracture.contact.kinks3d.CopyIndex` ``unit``).
+    index : ngfracture.contact.kinks3d.CopyIndex
+        The index of the mesh's reference points X and boundary faces.
     vertex_fragment : numpy.ndarray of int, shape (nv,)
         The fragment of every vertex.
 
@@ -141,8 +132,7 @@ def wedge_rows(points, faces, pairs, displacement, tol, unit, vertex_fragment):
         wedges the two are one condition, and rows of both, on different faces, would
         hold the copies out of both half-spaces instead of one.
     """
-    X = np.asarray(points, dtype=np.float64)
-    F = np.asarray(faces, dtype=np.int64)
+    X, F = index.points, index.faces
     nv = len(X)
     if not len(pairs):
         return no_face_rows(nv)
@@ -169,12 +159,8 @@ def wedge_rows(points, faces, pairs, displacement, tol, unit, vertex_fragment):
     if not len(pair):
         return no_face_rows(nv)
     face = fb[pair, nearer[pair]]
-    slave, copy = a[pair, end], b[pair, end]
-    master = F[face]
-    bary = (master == copy[:, None]).astype(np.float64)
-    dist = gap[pair, nearer[pair], end]
-    return NodeToFaceRows(slave=slave, master=master, face=face, bary=bary, normal=unit[face].copy(), dist=dist,
-                          g=np.zeros(len(slave)), nv=nv)
+    corner = np.argmax(F[face] == b[pair, end][:, None], axis=1)
+    return rows_at_copy(a[pair, end], face, corner, gap[pair, nearer[pair], end], index)
 
 
 def _reverse_also_inside(pairs, inside, vertex_fragment):
