@@ -3,42 +3,13 @@
 // ((a0 + a2) + a1) + 0.0, einsum "ij,ijk->ik" ((b0 P0 + b1 P1) + b2 P2) + 0.0 (einsum
 // sums into a +0.0: a -0.0 sum comes out +0.0); np.cross a1 b2 - a2 b1, ...
 #include "contact_rows3d.hpp"
+#include "numpy_order.hpp"
 #include <cmath>
 
 namespace ngfracture
 {
   namespace
   {
-    void Cross (const double * a, const double * b, double * c)
-    {
-      c[0] = a[1] * b[2] - a[2] * b[1];
-      c[1] = a[2] * b[0] - a[0] * b[2];
-      c[2] = a[0] * b[1] - a[1] * b[0];
-    }
-
-    double Dot (const double * a, const double * b)       // einsum "ij,ij->i"
-    {
-      return ((a[0] * b[0] + a[2] * b[2]) + a[1] * b[1]) + 0.0;
-    }
-
-    double Norm (const double * a)                        // np.linalg.norm(axis=1)
-    {
-      return std::sqrt((a[0] * a[0] + a[1] * a[1]) + a[2] * a[2]);
-    }
-
-    // twice the area vector of the triangle of vertices tri in the points P
-    void AreaVector (const double * P, const int64_t * tri, double * c)
-    {
-      const double * p0 = P + 3 * tri[0], * p1 = P + 3 * tri[1], * p2 = P + 3 * tri[2];
-      double e1[3], e2[3];
-      for (int k = 0; k < 3; k++)
-        {
-          e1[k] = p1[k] - p0[k];
-          e2[k] = p2[k] - p0[k];
-        }
-      Cross(e1, e2, c);
-    }
-
     // sum_l b_l P[tri_l] (einsum "ij,ijk->ik")
     void Combination (const double * P, const int64_t * tri, const double * b, double * out)
     {
@@ -59,8 +30,8 @@ namespace ngfracture
               u[k] = a[k] - q[k];
               v[k] = c[k] - q[k];
             }
-          Cross(u, v, w);
-          b[l] = Dot(w, fn) / scale;
+          NumpyCross(u, v, w);
+          b[l] = EinsumDot(w, fn) / scale;
         }
       for (int l = 0; l < 3; l++)
         b[l] = b[l] > 0.0 ? b[l] : 0.0;                   // np.clip(b, 0, None): -0.0 -> 0.0
@@ -123,7 +94,7 @@ namespace ngfracture
         Combination(X, master + 3 * r, bary + 3 * r, proj);
         for (int k = 0; k < 3; k++)
           d[k] = Q[k] - proj[k];
-        g[r] = Dot(d, normal + 3 * r);
+        g[r] = EinsumDot(d, normal + 3 * r);
       }
   }
 
@@ -139,14 +110,14 @@ namespace ngfracture
         double area2[3], area0[3], fn[3];
         AreaVector(x, tri, area2);
         AreaVector(X, tri, area0);
-        double length = Norm(area2), reference = Norm(area0);
+        double length = NumpyNorm(area2), reference = NumpyNorm(area0);
         bool degenerate = !(length > 1e-16 * reference);
         double scale = degenerate ? 1.0 : length;
         for (int k = 0; k < 3; k++)
           fn[k] = area2[k] / scale;
         double * b = bary_out + 3 * r, * n = normal_out + 3 * r;
         Barycentrics(x, tri, q, fn, scale, b);
-        double side = Dot(fn, old_n) < 0 ? -1.0 : 1.0;
+        double side = EinsumDot(fn, old_n) < 0 ? -1.0 : 1.0;
         for (int k = 0; k < 3; k++)
           n[k] = degenerate ? old_n[k] : fn[k] * side;
         int top = 0;                                      // np.argmax: the first largest
@@ -163,7 +134,7 @@ namespace ngfracture
         Combination(x, tri, b, proj);
         for (int k = 0; k < 3; k++)
           d[k] = q[k] - proj[k];
-        dist[r] = Dot(d, n);
+        dist[r] = EinsumDot(d, n);
       }
     GapOffsets3(m, X, slave, master, bary_out, normal_out, g);
   }

@@ -54,6 +54,7 @@ behind a lip face at its copy, the pair's row holding only the other side).
 """
 import numpy as np
 
+from .. import _ngfracture as _ext
 from .kinks3d import KINK, CopyIndex, copy_pairs, expand_ranges, isin_ints, partner_faces, unique_ints
 from .rows3d import NodeToFaceRows, no_face_rows
 
@@ -354,20 +355,16 @@ def behind_partner_rows(partners, displacement, tol, index):
         the reference configuration, ``dist`` the gap at X + U.
     """
     slave, face, corner = partners
-    X, F = index.points, index.faces
-    nv = len(X)
+    X = index.points
     if not len(slave):
-        return no_face_rows(nv)
+        return no_face_rows(len(X))
     x = X + np.asarray(displacement, dtype=np.float64)
-    copy = F[face, corner]
-    gap = np.zeros(len(slave))
-    apart = np.flatnonzero(np.any(x[slave] != x[copy], axis=1))      # copies that meet are behind no plane
-    gap[apart] = _plane_gaps(x, F, face[apart], slave[apart], copy[apart])
-    pair = slave * nv + copy
-    hit = np.flatnonzero(isin_ints(pair, unique_ints(pair[gap < -tol])))    # every partner face of a pair hit
+    # C++ (cpp_ext/copy_planes3d.cpp): the plane gaps of :func:`_plane_gaps` (0 where the
+    # copies meet), bit for bit, and every incidence of a pair with one below -tol
+    hit, gap = _ext.BehindPartnerGaps(x, index.faces, slave, face, corner, float(tol))
     if not len(hit):
-        return no_face_rows(nv)
-    return rows_at_copy(slave[hit], face[hit], corner[hit], gap[hit], index)
+        return no_face_rows(len(X))
+    return rows_at_copy(slave[hit], face[hit], corner[hit], gap, index)
 
 
 def rows_at_copies_of(slave, face, displacement, index):

@@ -27,6 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .. import _ngfracture as _ext
 from .copies3d import rows_at_copy
 from .intsets import isin_ints
 from .kinks3d import equal_key_pairs
@@ -137,36 +138,28 @@ def wedge_rows(pairs, displacement, tol, index, vertex_fragment):
     if not len(pairs):
         return no_face_rows(nv)
     x = X + np.asarray(displacement, dtype=np.float64)
-    a, b, fb = pairs.a, pairs.b, pairs.b_faces
-    normals, ok = [], np.ones(len(a), dtype=bool)
-    for k in range(2):
-        tri = x[F[fb[:, k]]]
-        n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
-        length = np.linalg.norm(n, axis=1)
-        ok &= length > 0                                              # a face squeezed flat has no plane
-        normals.append(n / np.where(length > 0, length, 1.0)[:, None])
-    # the corner of B's second face off the edge: B's wedge is convex (or flat) where it
-    # lies behind (or on) the first's plane, as edge_rows3d judges an edge
-    third = F[fb[:, 1]].sum(axis=1) - b.sum(axis=1)
-    convex = np.einsum("ij,ij->i", normals[0], x[third] - x[b[:, 0]]) <= 0
-    gap = np.stack([np.stack([np.einsum("ij,ij->i", normals[k], x[a[:, e]] - x[b[:, e]]) for e in range(2)], axis=1)
-                    for k in range(2)], axis=1)                       # [pair, face, end]
-    middle = gap.mean(axis=2)                                         # [pair, face]
-    nearer = np.argmax(middle, axis=1)
-    inside = convex & (middle.max(axis=1) < -tol) & ok
-    inside &= ~_reverse_also_inside(pairs, inside, vertex_fragment)
-    pair, end = np.nonzero(inside[:, None] & (gap[np.arange(len(a)), nearer] < 0))
+    # C++ (cpp_ext/copy_planes3d.cpp), bit for bit the numpy computation: per pair B's two
+    # unit normals at x (a face squeezed flat has no plane: no rows), B's wedge convex or
+    # flat (the corner of B's second face off the edge behind or on the first's plane, as
+    # edge_rows3d judges an edge), the gaps of a's ends to both planes measured from their
+    # copies on b, and the pairs whose midpoint's gap to the less deep face is below -tol
+    inside, nearer, gap = _ext.WedgeInside(x, F, pairs.a, pairs.b, pairs.b_faces, float(tol))
+    keep = ~_reverse_also_inside(pairs, inside, vertex_fragment)
+    inside, nearer, gap = inside[keep], nearer[keep], gap[keep]
+    pair, end = np.nonzero(gap < 0)                                   # the ends behind that face's plane
     if not len(pair):
         return no_face_rows(nv)
-    face = fb[pair, nearer[pair]]
-    corner = np.argmax(F[face] == b[pair, end][:, None], axis=1)
-    return rows_at_copy(a[pair, end], face, corner, gap[pair, nearer[pair], end], index)
+    p = inside[pair]
+    face = pairs.b_faces[p, nearer[pair]]
+    corner = np.argmax(F[face] == pairs.b[p, end][:, None], axis=1)
+    return rows_at_copy(pairs.a[p, end], face, corner, gap[pair, end], index)
 
 
 def _reverse_also_inside(pairs, inside, vertex_fragment):
-    """Per pair: inside, with the reversed pair (b, a) inside too, and a on the lower fragment."""
+    """Per pair inside (``inside``: their numbers among ``pairs``): the reversed pair (b, a)
+    is inside too and a lies on the lower fragment."""
     vf = np.asarray(vertex_fragment, dtype=np.int64)
     n = np.int64(max(int(pairs.edge_a.max(initial=0)), int(pairs.edge_b.max(initial=0))) + 1)
-    code, reverse = pairs.edge_a * n + pairs.edge_b, pairs.edge_b * n + pairs.edge_a
-    both = inside & isin_ints(reverse, code[inside])
-    return both & (vf[pairs.a[:, 0]] < vf[pairs.b[:, 0]])
+    code = pairs.edge_a[inside] * n + pairs.edge_b[inside]
+    reverse = pairs.edge_b[inside] * n + pairs.edge_a[inside]
+    return isin_ints(reverse, code) & (vf[pairs.a[inside, 0]] < vf[pairs.b[inside, 0]])

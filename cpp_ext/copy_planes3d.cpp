@@ -1,0 +1,104 @@
+// Rows at copies found by their planes (copy_planes3d.hpp), in numpy's orders of
+// operations (numpy_order.hpp; np.mean of two (g0 + g1) / 2).
+#include "copy_planes3d.hpp"
+#include "numpy_order.hpp"
+#include <algorithm>
+#include <cmath>
+
+namespace ngfracture
+{
+  namespace
+  {
+    // x_p - x_q
+    void Difference (const double * x, int64_t p, int64_t q, double * d)
+    {
+      for (int k = 0; k < 3; k++)
+        d[k] = x[3 * p + k] - x[3 * q + k];
+    }
+  }
+
+  void BehindPartnerGaps (int64_t m, int64_t nv, const double * x, const int64_t * faces, const int64_t * slave,
+                          const int64_t * face, const int64_t * corner, double tol, std::vector<int64_t> & hit,
+                          std::vector<double> & gap)
+  {
+    std::vector<double> all(m, 0.0);
+    std::vector<int64_t> deep;                            // codes s nv + t of the pairs hit
+    for (int64_t i = 0; i < m; i++)
+      {
+        const int64_t * tri = faces + 3 * face[i];
+        int64_t s = slave[i], t = tri[corner[i]];
+        double d[3], area[3];
+        Difference(x, s, t, d);
+        if (x[3 * s] == x[3 * t] && x[3 * s + 1] == x[3 * t + 1] && x[3 * s + 2] == x[3 * t + 2])
+          continue;                                       // copies that meet are behind no plane
+        AreaVector(x, tri, area);
+        double length = NumpyNorm(area);
+        all[i] = length > 0 ? EinsumDot(area, d) / length : 0.0;
+        if (all[i] < -tol)
+          deep.push_back(s * nv + t);
+      }
+    std::sort(deep.begin(), deep.end());
+    deep.erase(std::unique(deep.begin(), deep.end()), deep.end());
+    hit.clear();
+    gap.clear();
+    if (deep.empty())
+      return;
+    for (int64_t i = 0; i < m; i++)
+      {
+        int64_t code = slave[i] * nv + faces[3 * face[i] + corner[i]];
+        if (std::binary_search(deep.begin(), deep.end(), code))
+          {
+            hit.push_back(i);
+            gap.push_back(all[i]);
+          }
+      }
+  }
+
+  void WedgeInside (int64_t m, const double * x, const int64_t * faces, const int64_t * a, const int64_t * b,
+                    const int64_t * fb, double tol, std::vector<int64_t> & pair, std::vector<int64_t> & nearer,
+                    std::vector<double> & gap)
+  {
+    pair.clear();
+    nearer.clear();
+    gap.clear();
+    for (int64_t p = 0; p < m; p++)
+      {
+        double unit[2][3], g[2][2], middle[2];
+        bool ok = true;
+        for (int k = 0; k < 2; k++)
+          {
+            double n[3];
+            AreaVector(x, faces + 3 * fb[2 * p + k], n);
+            double length = NumpyNorm(n);
+            ok = ok && length > 0;                        // a face squeezed flat has no plane
+            double scale = length > 0 ? length : 1.0;
+            for (int c = 0; c < 3; c++)
+              unit[k][c] = n[c] / scale;
+          }
+        // the corner of B's second face off the edge: B's wedge is convex (or flat) where
+        // it lies behind (or on) the first's plane
+        const int64_t * second = faces + 3 * fb[2 * p + 1];
+        int64_t third = (second[0] + second[1] + second[2]) - (b[2 * p] + b[2 * p + 1]);
+        double d[3];
+        Difference(x, third, b[2 * p], d);
+        bool convex = EinsumDot(unit[0], d) <= 0;
+        for (int k = 0; k < 2; k++)
+          {
+            for (int e = 0; e < 2; e++)
+              {
+                Difference(x, a[2 * p + e], b[2 * p + e], d);
+                g[k][e] = EinsumDot(unit[k], d);
+              }
+            middle[k] = (g[k][0] + g[k][1]) / 2.0;
+          }
+        int near = middle[1] > middle[0] ? 1 : 0;          // np.argmax: the first largest
+        if (convex && std::max(middle[0], middle[1]) < -tol && ok)
+          {
+            pair.push_back(p);
+            nearer.push_back(near);
+            gap.push_back(g[near][0]);
+            gap.push_back(g[near][1]);
+          }
+      }
+  }
+}

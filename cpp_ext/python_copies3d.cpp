@@ -1,0 +1,121 @@
+// Python bindings of the rows at copies found by their planes (copy_planes3d.hpp).
+// Low level: ngfracture/contact/copies3d.py and wedges3d.py make the arrays and are the
+// documented API; the bindings check shapes and vertex and face numbers.
+#include <python_comp.hpp>
+#include "numpy_arrays.hpp"
+#include "copy_planes3d.hpp"
+
+namespace py = pybind11;
+using namespace ngfracture;
+
+namespace
+{
+  using DArr = py::array_t<double, py::array::c_style | py::array::forcecast>;
+  using LArr = py::array_t<int64_t, py::array::c_style | py::array::forcecast>;
+
+  void Check (const char * fn, const char * name, const py::array & a, int ndim, py::ssize_t cols,
+              py::ssize_t rows = -1)
+  {
+    if (a.ndim() != ndim || (ndim == 2 && a.shape(1) != cols) || (rows >= 0 && a.shape(0) != rows))
+      throw std::invalid_argument(std::string("ngfracture.") + fn + ": " + name + " has the wrong shape");
+  }
+
+  void CheckRange (const char * fn, const char * name, const LArr & a, int64_t bound)
+  {
+    const int64_t * p = a.data();
+    for (py::ssize_t i = 0; i < a.size(); i++)
+      if (p[i] < 0 || p[i] >= bound)
+        throw std::invalid_argument(std::string("ngfracture.") + fn + ": " + name + " has an entry outside [0, "
+                                    + std::to_string(bound) + ")");
+  }
+}
+
+void ExportCopies3d (py::module & m)
+{
+  m.def("BehindPartnerGaps",
+        [] (DArr x, LArr faces, LArr slave, LArr face, LArr corner, double tol)
+        {
+          const char * fn = "BehindPartnerGaps";
+          Check(fn, "x", x, 2, 3);
+          Check(fn, "faces", faces, 2, 3);
+          Check(fn, "slave", slave, 1, 0);
+          Check(fn, "face", face, 1, 0, slave.shape(0));
+          Check(fn, "corner", corner, 1, 0, slave.shape(0));
+          int64_t nv = x.shape(0);
+          CheckRange(fn, "faces", faces, nv);
+          CheckRange(fn, "slave", slave, nv);
+          CheckRange(fn, "face", face, faces.shape(0));
+          CheckRange(fn, "corner", corner, 3);
+          std::vector<int64_t> hit;
+          std::vector<double> gap;
+          {
+            py::gil_scoped_release release;
+            BehindPartnerGaps(slave.shape(0), nv, x.data(), faces.data(), slave.data(), face.data(), corner.data(),
+                              tol, hit, gap);
+          }
+          return py::make_tuple(ToNumpy(hit), ToNumpy(gap));
+        },
+        py::arg("x"), py::arg("faces"), py::arg("slave"), py::arg("face"), py::arg("corner"), py::arg("tol"),
+        R"doc(The partner incidences of the pairs of copies behind a partner face's plane deeper than tol.
+
+Returns
+-------
+hit : numpy.ndarray of int64
+    Every incidence of a pair (slave, copy) with a gap below -tol, increasing.
+gap : numpy.ndarray
+    Their gaps n_f . (x_s - x_t) at x (0 where the copies meet), bit for bit the numpy
+    computation of copies3d.behind_partner_rows.
+)doc");
+
+  m.def("WedgeInside",
+        [] (DArr x, LArr faces, LArr a, LArr b, LArr b_faces, double tol)
+        {
+          const char * fn = "WedgeInside";
+          Check(fn, "x", x, 2, 3);
+          Check(fn, "faces", faces, 2, 3);
+          Check(fn, "a", a, 2, 2);
+          Check(fn, "b", b, 2, 2, a.shape(0));
+          Check(fn, "b_faces", b_faces, 2, 2, a.shape(0));
+          int64_t nv = x.shape(0), nf = faces.shape(0);
+          CheckRange(fn, "faces", faces, nv);
+          CheckRange(fn, "a", a, nv);
+          CheckRange(fn, "b", b, nv);
+          CheckRange(fn, "b_faces", b_faces, nf);
+          for (py::ssize_t p = 0; p < a.shape(0); p++)
+            for (int k = 0; k < 2; k++)
+              {
+                const int64_t * f = faces.data() + 3 * b_faces.data()[2 * p + k];
+                for (int e = 0; e < 2; e++)
+                  {
+                    int64_t v = b.data()[2 * p + e];
+                    if (f[0] != v && f[1] != v && f[2] != v)
+                      throw std::invalid_argument("ngfracture.WedgeInside: b_faces[" + std::to_string(p) + ", "
+                                                  + std::to_string(k) + "] does not hold edge b");
+                  }
+              }
+          std::vector<int64_t> pair, nearer;
+          std::vector<double> gap;
+          {
+            py::gil_scoped_release release;
+            WedgeInside(a.shape(0), x.data(), faces.data(), a.data(), b.data(), b_faces.data(), tol, pair, nearer,
+                        gap);
+          }
+          py::array_t<double> G = ToNumpy(gap, 2);
+          if (gap.empty())
+            G = py::array_t<double>(std::vector<py::ssize_t>{ 0, 2 });
+          return py::make_tuple(ToNumpy(pair), ToNumpy(nearer), G);
+        },
+        py::arg("x"), py::arg("faces"), py::arg("a"), py::arg("b"), py::arg("b_faces"), py::arg("tol"),
+        R"doc(The diagonal edge pairs whose edge a's midpoint lies deeper than tol in B's convex wedge.
+
+Returns
+-------
+pair : numpy.ndarray of int64
+    The pairs inside, increasing.
+nearer : numpy.ndarray of int64
+    The less deep of B's two faces (0 or 1).
+gap : numpy.ndarray, shape (k, 2)
+    The gaps of a's two ends to that face's plane at x, bit for bit the numpy
+    computation of wedges3d.wedge_rows.
+)doc");
+}

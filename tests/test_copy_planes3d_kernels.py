@@ -1,0 +1,153 @@
+"""The C++ kernels of the rows at copies found by their planes against their numpy reference, bit for bit.
+
+``copies3d.behind_partner_rows`` (``BehindPartnerGaps``) and ``wedges3d.wedge_rows``
+(``WedgeInside``) compute in C++ what the numpy code below computes, every round of every
+3D contact solve; the rows they make must be the same to the last bit (gaps and their
+zeros, the order of the rows), on configurations where many rows fire: a body cut into
+2 x 2 x 2 blocks (junction lines of four blocks, a point of eight) whose vertices are
+moved at random by up to a fifth of the element size, some pairs of copies left
+together (gap exactly 0), some faces squeezed flat (no plane).
+"""
+import numpy as np
+import pytest
+
+from ngfracture import _ngfracture as ext
+from ngfracture.contact.copies3d import behind_partner_rows, rows_at_copy
+from ngfracture.contact.intsets import isin_ints, unique_ints
+from ngfracture.contact.rows3d import no_face_rows
+from ngfracture.contact.setup3d import MeshSetup3d
+from ngfracture.contact.wedges3d import wedge_rows
+from ngfracture.geometry.pieces import fragmented_box
+
+CELLS, PIECES = 4, 2
+
+
+def reference_plane_gaps(x, faces, face, slave, copy):
+    """n_f . (x_s - x_t) with the faces' unit normals at x; 0 on a face squeezed flat."""
+    tri = x[faces[face]]
+    area = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    length = np.linalg.norm(area, axis=1)
+    return np.where(length > 0, np.einsum("ij,ij->i", area, x[slave] - x[copy]) / np.where(length > 0, length, 1.0),
+                    0.0)
+
+
+def reference_behind_partner_rows(partners, displacement, tol, index):
+    """The numpy computation of copies3d.behind_partner_rows."""
+    slave, face, corner = partners
+    X, F = index.points, index.faces
+    nv = len(X)
+    x = X + np.asarray(displacement, dtype=np.float64)
+    copy = F[face, corner]
+    gap = np.zeros(len(slave))
+    apart = np.flatnonzero(np.any(x[slave] != x[copy], axis=1))
+    gap[apart] = reference_plane_gaps(x, F, face[apart], slave[apart], copy[apart])
+    pair = slave * nv + copy
+    hit = np.flatnonzero(isin_ints(pair, unique_ints(pair[gap < -tol])))
+    if not len(hit):
+        return no_face_rows(nv)
+    return rows_at_copy(slave[hit], face[hit], corner[hit], gap[hit], index)
+
+
+def reference_wedge_rows(pairs, displacement, tol, index, vertex_fragment):
+    """The numpy computation of wedges3d.wedge_rows."""
+    X, F = index.points, index.faces
+    nv = len(X)
+    x = X + np.asarray(displacement, dtype=np.float64)
+    a, b, fb = pairs.a, pairs.b, pairs.b_faces
+    normals, ok = [], np.ones(len(a), dtype=bool)
+    for k in range(2):
+        tri = x[F[fb[:, k]]]
+        n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+        length = np.linalg.norm(n, axis=1)
+        ok &= length > 0
+        normals.append(n / np.where(length > 0, length, 1.0)[:, None])
+    third = F[fb[:, 1]].sum(axis=1) - b.sum(axis=1)
+    convex = np.einsum("ij,ij->i", normals[0], x[third] - x[b[:, 0]]) <= 0
+    gap = np.stack([np.stack([np.einsum("ij,ij->i", normals[k], x[a[:, e]] - x[b[:, e]]) for e in range(2)], axis=1)
+                    for k in range(2)], axis=1)
+    middle = gap.mean(axis=2)
+    nearer = np.argmax(middle, axis=1)
+    inside = convex & (middle.max(axis=1) < -tol) & ok
+    vf = np.asarray(vertex_fragment, dtype=np.int64)
+    n = np.int64(max(int(pairs.edge_a.max(initial=0)), int(pairs.edge_b.max(initial=0))) + 1)
+    code, reverse = pairs.edge_a * n + pairs.edge_b, pairs.edge_b * n + pairs.edge_a
+    inside &= ~(inside & isin_ints(reverse, code[inside]) & (vf[pairs.a[:, 0]] < vf[pairs.b[:, 0]]))
+    pair, end = np.nonzero(inside[:, None] & (gap[np.arange(len(a)), nearer] < 0))
+    if not len(pair):
+        return no_face_rows(nv)
+    face = fb[pair, nearer[pair]]
+    corner = np.argmax(F[face] == b[pair, end][:, None], axis=1)
+    return rows_at_copy(a[pair, end], face, corner, gap[pair, nearer[pair], end], index)
+
+
+@pytest.fixture(scope="module")
+def blocks():
+    arrays, piece = fragmented_box(CELLS, PIECES)
+    return arrays, MeshSetup3d(arrays.points, arrays.tets, arrays.faces, np.asarray(piece, dtype=np.int64))
+
+
+def configurations(arrays, setup, seed):
+    """Random displacements up to h / 5, with pairs of copies left together and faces squeezed flat."""
+    rng = np.random.default_rng(seed)
+    X = arrays.points
+    U = rng.uniform(-0.2, 0.2, X.shape) / CELLS
+    index = setup.copy_index
+    slave, face, corner = setup.partners
+    together = rng.choice(len(slave), len(slave) // 4, replace=False)          # copies that meet
+    copy = index.faces[face[together], corner[together]]
+    U[slave[together]] = U[copy]
+    squeezed = index.faces[rng.choice(len(index.faces), 5, replace=False)]     # a face flat: all on one point
+    for tri in squeezed:
+        U[tri] = X[tri[0]] + U[tri[0]] - X[tri]
+    return U
+
+
+def same_rows(a, b):
+    """Equal fields, floats to the last bit (the sign of zeros too)."""
+    def bits(v):
+        return v.view(np.int64) if v.dtype == np.float64 else v
+    return len(a) == len(b) and all(np.array_equal(bits(getattr(a, f)), bits(getattr(b, f))) for f in type(a).FIELDS)
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+@pytest.mark.parametrize("tol", [0.0, 1e-3, 1e-2])
+def test_behind_partner_rows_equal_their_numpy_reference(blocks, seed, tol):
+    arrays, setup = blocks
+    U = configurations(arrays, setup, seed)
+    rows = behind_partner_rows(setup.partners, U, tol, setup.copy_index)
+    reference = reference_behind_partner_rows(setup.partners, U, tol, setup.copy_index)
+    assert len(reference) > 0
+    assert same_rows(rows, reference)
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+@pytest.mark.parametrize("tol", [0.0, 1e-3])
+def test_wedge_rows_equal_their_numpy_reference(blocks, seed, tol):
+    arrays, setup = blocks
+    U = configurations(arrays, setup, seed)
+    args = setup.diagonal_edges, U, tol, setup.copy_index, setup.vertex_fragment
+    rows, reference = wedge_rows(*args), reference_wedge_rows(*args)
+    assert len(reference) > 0
+    assert same_rows(rows, reference)
+
+
+def test_no_rows_where_nothing_moved(blocks):
+    arrays, setup = blocks
+    U = np.zeros_like(arrays.points)
+    assert len(behind_partner_rows(setup.partners, U, 0.0, setup.copy_index)) == 0
+    assert len(wedge_rows(setup.diagonal_edges, U, 0.0, setup.copy_index, setup.vertex_fragment)) == 0
+
+
+def test_bad_input_names_the_argument(blocks):
+    arrays, setup = blocks
+    x, F = arrays.points, setup.copy_index.faces
+    slave, face, corner = setup.partners
+    with pytest.raises(ValueError, match="slave has an entry outside"):
+        ext.BehindPartnerGaps(x, F, slave + len(x), face, corner, 0.0)
+    with pytest.raises(ValueError, match="corner has the wrong shape"):
+        ext.BehindPartnerGaps(x, F, slave, face, corner[:-1], 0.0)
+    d = setup.diagonal_edges
+    other = d.b_faces.copy()
+    other[0, 1] = next(f for f in range(len(F)) if not set(d.b[0]) <= set(F[f]))
+    with pytest.raises(ValueError, match=r"b_faces\[0, 1\] does not hold edge b"):
+        ext.WedgeInside(x, F, d.a, d.b, other, 0.0)
