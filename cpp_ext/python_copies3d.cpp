@@ -1,9 +1,9 @@
-// Python bindings of the rows at copies found by their planes (copy_planes3d.hpp).
+// Python bindings of the rows between copies of a point (copies3d.hpp).
 // Low level: ngfracture/contact/copies3d.py and wedges3d.py make the arrays and are the
 // documented API; the bindings check shapes and vertex and face numbers.
 #include <python_comp.hpp>
 #include "numpy_arrays.hpp"
-#include "copy_planes3d.hpp"
+#include "copies3d.hpp"
 
 namespace py = pybind11;
 using namespace ngfracture;
@@ -32,6 +32,41 @@ namespace
 
 void ExportCopies3d (py::module & m)
 {
+  m.def("PartnerAt",
+        [] (LArr faces, LArr key_order, LArr key_start, LArr key_count, LArr face, LArr vertex)
+        {
+          const char * fn = "PartnerAt";
+          Check(fn, "faces", faces, 2, 3);
+          int64_t nf = faces.shape(0);
+          Check(fn, "key_order", key_order, 1, 0, nf);
+          Check(fn, "key_start", key_start, 1, 0, nf);
+          Check(fn, "key_count", key_count, 1, 0, nf);
+          Check(fn, "face", face, 1, 0);
+          Check(fn, "vertex", vertex, 1, 0, face.shape(0));
+          CheckRange(fn, "key_order", key_order, nf);
+          CheckRange(fn, "face", face, nf);
+          for (int64_t f = 0; f < nf; f++)
+            if (key_start.data()[f] < 0 || key_count.data()[f] < 0 || key_start.data()[f] + key_count.data()[f] > nf)
+              throw std::invalid_argument("ngfracture.PartnerAt: key_start and key_count of face " + std::to_string(f)
+                                          + " leave key_order");
+          py::array_t<int64_t> out(face.shape(0));
+          {
+            py::gil_scoped_release release;
+            PartnerAt(face.shape(0), faces.data(), key_order.data(), key_start.data(), key_count.data(), face.data(),
+                      vertex.data(), out.mutable_data());
+          }
+          return out;
+        },
+        py::arg("faces"), py::arg("key_order"), py::arg("key_start"), py::arg("key_count"), py::arg("face"),
+        py::arg("vertex"),
+        R"doc(For every (face, vertex): the face on the same three points with the vertex as a corner, or -1.
+
+Returns
+-------
+numpy.ndarray of int64
+    The first such face in key order (copies3d._partner_at's numpy loop).
+)doc");
+
   m.def("BehindPartnerGaps",
         [] (DArr x, LArr faces, LArr slave, LArr face, LArr corner, double tol)
         {

@@ -64,15 +64,8 @@ __all__ = ["found_rows_at_copies", "folded_rows_at_copies", "two_sided_rows", "p
 
 def _partner_at(index, face, vertex):
     """For every (face, vertex): the face on the same three points with ``vertex`` as a corner, or -1."""
-    F, order = index.faces, index.key_order
-    start, count = index.key_start[face], index.key_count[face]
-    out = np.full(len(face), -1, dtype=np.int64)
-    for shift in range(int(count.max(initial=0))):            # the faces on the same points: a few at most
-        slot = np.minimum(start + shift, len(order) - 1)
-        cand = order[slot]
-        hit = (shift < count) & (out < 0) & np.any(F[cand] == vertex[:, None], axis=1)
-        out[hit] = cand[hit]
-    return out
+    # C++ (cpp_ext/copies3d.cpp): the faces on the face's key in key order, the first with the vertex
+    return _ext.PartnerAt(index.faces, index.key_order, index.key_start, index.key_count, face, vertex)
 
 
 def found_rows_at_copies(points, faces, rows, vertex_fragment, index=None):
@@ -359,7 +352,7 @@ def behind_partner_rows(partners, displacement, tol, index):
     if not len(slave):
         return no_face_rows(len(X))
     x = X + np.asarray(displacement, dtype=np.float64)
-    # C++ (cpp_ext/copy_planes3d.cpp): the plane gaps of :func:`_plane_gaps` (0 where the
+    # C++ (cpp_ext/copies3d.cpp): the plane gaps of :func:`_plane_gaps` (0 where the
     # copies meet), bit for bit, and every incidence of a pair with one below -tol
     hit, gap = _ext.BehindPartnerGaps(x, index.faces, slave, face, corner, float(tol))
     if not len(hit):

@@ -138,7 +138,7 @@ def wedge_rows(pairs, displacement, tol, index, vertex_fragment):
     if not len(pairs):
         return no_face_rows(nv)
     x = X + np.asarray(displacement, dtype=np.float64)
-    # C++ (cpp_ext/copy_planes3d.cpp), bit for bit the numpy computation: per pair B's two
+    # C++ (cpp_ext/copies3d.cpp), bit for bit the numpy computation: per pair B's two
     # unit normals at x (a face squeezed flat has no plane: no rows), B's wedge convex or
     # flat (the corner of B's second face off the edge behind or on the first's plane, as
     # edge_rows3d judges an edge), the gaps of a's ends to both planes measured from their

@@ -1,8 +1,9 @@
-"""The C++ kernels of the rows at copies found by their planes against their numpy reference, bit for bit.
+"""The C++ kernels of the rows between copies of a point against their numpy reference, bit for bit.
 
-``copies3d.behind_partner_rows`` (``BehindPartnerGaps``) and ``wedges3d.wedge_rows``
-(``WedgeInside``) compute in C++ what the numpy code below computes, every round of every
-3D contact solve; the rows they make must be the same to the last bit (gaps and their
+``copies3d.behind_partner_rows`` (``BehindPartnerGaps``), ``wedges3d.wedge_rows``
+(``WedgeInside``) and the partner face of a (face, vertex) that found rows at copies and
+their re-linearisation look up (``PartnerAt``) compute in C++ what the numpy code below
+computes, every round of every 3D contact solve; the rows they make must be the same to the last bit (gaps and their
 zeros, the order of the rows), on configurations where many rows fire: a body cut into
 2 x 2 x 2 blocks (junction lines of four blocks, a point of eight) whose vertices are
 moved at random by up to a fifth of the element size, some pairs of copies left
@@ -20,6 +21,19 @@ from ngfracture.contact.wedges3d import wedge_rows
 from ngfracture.geometry.pieces import fragmented_box
 
 CELLS, PIECES = 4, 2
+
+
+def reference_partner_at(index, face, vertex):
+    """The numpy loop of copies3d._partner_at: the first face in key order on the face's points with the vertex."""
+    F, order = index.faces, index.key_order
+    start, count = index.key_start[face], index.key_count[face]
+    out = np.full(len(face), -1, dtype=np.int64)
+    for shift in range(int(count.max(initial=0))):
+        slot = np.minimum(start + shift, len(order) - 1)
+        cand = order[slot]
+        hit = (shift < count) & (out < 0) & np.any(F[cand] == vertex[:, None], axis=1)
+        out[hit] = cand[hit]
+    return out
 
 
 def reference_plane_gaps(x, faces, face, slave, copy):
@@ -129,6 +143,22 @@ def test_wedge_rows_equal_their_numpy_reference(blocks, seed, tol):
     rows, reference = wedge_rows(*args), reference_wedge_rows(*args)
     assert len(reference) > 0
     assert same_rows(rows, reference)
+
+
+def test_partner_at_equals_its_numpy_reference(blocks):
+    _, setup = blocks
+    index = setup.copy_index
+    slave, face, corner = setup.partners
+    rng = np.random.default_rng(3)
+    # every partner incidence's face with its slave (a partner face at the slave) and with
+    # its copy (the face itself), and random (face, boundary vertex) pairs (mostly none)
+    face = np.concatenate([face, face, rng.integers(0, len(index.faces), 2000)])
+    vertex = np.concatenate([slave, index.faces[setup.partners[1], corner], rng.choice(index.on, 2000)])
+    found = ext.PartnerAt(index.faces, index.key_order, index.key_start, index.key_count, face, vertex)
+    assert np.array_equal(found, reference_partner_at(index, face, vertex))
+    m = len(slave)
+    assert (found[:m] >= 0).all() and np.array_equal(found[m:2 * m], setup.partners[1])
+    assert (found[2 * m:] < 0).any()
 
 
 def test_no_rows_where_nothing_moved(blocks):

@@ -1,6 +1,6 @@
-// Rows at copies found by their planes (copy_planes3d.hpp), in numpy's orders of
+// Rows between copies of a point (copies3d.hpp), in numpy's orders of
 // operations (numpy_order.hpp; np.mean of two (g0 + g1) / 2).
-#include "copy_planes3d.hpp"
+#include "copies3d.hpp"
 #include "numpy_order.hpp"
 #include <algorithm>
 #include <cmath>
@@ -15,6 +15,25 @@ namespace ngfracture
       for (int k = 0; k < 3; k++)
         d[k] = x[3 * p + k] - x[3 * q + k];
     }
+  }
+
+  void PartnerAt (int64_t m, const int64_t * faces, const int64_t * key_order, const int64_t * key_start,
+                  const int64_t * key_count, const int64_t * face, const int64_t * vertex, int64_t * out)
+  {
+    for (int64_t i = 0; i < m; i++)
+      {
+        out[i] = -1;
+        for (int64_t k = 0; k < key_count[face[i]]; k++)
+          {
+            int64_t cand = key_order[key_start[face[i]] + k];
+            const int64_t * tri = faces + 3 * cand;
+            if (tri[0] == vertex[i] || tri[1] == vertex[i] || tri[2] == vertex[i])
+              {
+                out[i] = cand;
+                break;
+              }
+          }
+      }
   }
 
   void BehindPartnerGaps (int64_t m, int64_t nv, const double * x, const int64_t * faces, const int64_t * slave,

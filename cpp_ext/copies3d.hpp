@@ -1,13 +1,19 @@
-// Rows at copies found by their planes, the passes of every round (the numpy computations
-// of ngfracture/contact/copies3d.py behind_partner_rows and wedges3d.wedge_rows in the same
-// operations and order, bit for bit; compiled without fma contraction).
-#ifndef NGFRACTURE_COPY_PLANES3D_HPP
-#define NGFRACTURE_COPY_PLANES3D_HPP
+// Rows between copies of a point, the passes of every round: the numpy computations of
+// ngfracture/contact/copies3d.py (_partner_at, behind_partner_rows) and wedges3d.wedge_rows
+// in the same operations and order, bit for bit (compiled without fma contraction).
+#ifndef NGFRACTURE_COPIES3D_HPP
+#define NGFRACTURE_COPIES3D_HPP
 #include <cstdint>
 #include <vector>
 
 namespace ngfracture
 {
+  // For every (face f, vertex v): the first face in key order on f's three points with v
+  // as a corner, or -1. The faces on f's points are key_order[key_start[f] ..
+  // key_start[f] + key_count[f]).
+  void PartnerAt (int64_t m, const int64_t * faces, const int64_t * key_order, const int64_t * key_start,
+                  const int64_t * key_count, const int64_t * face, const int64_t * vertex, int64_t * out);
+
   // The partner incidences (slave s, face f, corner of s's copy t in f) at x: the gap
   // n_f . (x_s - x_t) with f's unit normal at x (0 where the copies meet or f is squeezed
   // flat). hit: every incidence of a pair (s, t) with some gap below -tol, increasing;
