@@ -348,10 +348,12 @@ namespace ngfracture
         p1[e] = std::max(x, y);
       }
     std::vector<int64_t> order = CountingOrder(nE, n_points, p0, start);
+    auto higher = [&p1] (int64_t x, int64_t y) { return p1[x] < p1[y]; };
     for (int64_t q = 0; q < n_points; q++)
-      if (start[q + 1] - start[q] > 1)
-        std::stable_sort(order.begin() + start[q], order.begin() + start[q + 1],
-                         [&p1] (int64_t x, int64_t y) { return p1[x] < p1[y]; });
+      if (start[q + 1] - start[q] > 64)
+        std::stable_sort(order.begin() + start[q], order.begin() + start[q + 1], higher);
+      else if (start[q + 1] - start[q] > 1)
+        InsertionSort(order, start[q], start[q + 1], higher);
     std::vector<int64_t> run_of(nE), run_start;
     for (int64_t i = 0; i < nE; i++)
       {

@@ -11,7 +11,8 @@ a sort of the (edge, face slot) pairs). Meshes: fragmented boxes (junctions of 4
 copies; a crack inside one block, where three copies meet; bent lips), the contact
 benchmark's body at 6 cells, random small cases (faces and fragments drawn at random over
 points with several copies, so that runs of copies, shared keys and edges with other than
-two faces occur in every combination), empty inputs, and (slow) a cracked state of the
+two faces occur in every combination; faces around one point with more than 64 edges,
+the sorts' long buckets), empty inputs, and (slow) a cracked state of the
 default sphere.
 """
 from types import SimpleNamespace
@@ -150,11 +151,23 @@ def random_case(seed, nv=40, points=12, nf=60, fragments=3):
     return X, F.astype(np.int64), vf
 
 
+def random_hub(seed, nv=60, nf=150):
+    """Random faces that all have a copy of the lowest point (four copies): more than 64
+    edges on that point, the long buckets of the kernels' sorts."""
+    X, F, vf = random_case(seed, nv=nv, nf=nf)
+    X[:4] = -1.0
+    rng = np.random.default_rng(seed)
+    F[:, 0] = rng.integers(0, 4, size=nf)
+    F[:, 1:] = np.stack([rng.choice(np.arange(4, nv), size=2, replace=False) for _ in range(nf)])
+    return X, F, vf
+
+
 def mesh_cases():
     """(name, points, faces, vertex_fragment) of the boxes, the benchmark body and random cases."""
     cases = [(f"box{b}", *box(**b)) for b in BODIES]
     cases.append(("benchmark", *benchmark_body()))
     cases += [(f"random{seed}", *random_case(seed)) for seed in range(6)]
+    cases += [(f"random_hub{seed}", *random_hub(seed)) for seed in range(2)]
     return cases
 
 
