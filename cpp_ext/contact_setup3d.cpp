@@ -265,4 +265,177 @@ namespace ngfracture
           }
       }
   }
+
+  void CopyPairs (int64_t n, const int64_t * on, const int64_t * group, std::vector<int64_t> & s,
+                  std::vector<int64_t> & t)
+  {
+    s.clear();
+    t.clear();
+    for (int64_t lo = 0; lo < n;)
+      {
+        int64_t hi = lo;
+        while (hi < n && group[hi] == group[lo])
+          hi++;
+        for (int64_t i = lo; i < hi; i++)
+          for (int64_t j = lo; j < hi; j++)
+            {
+              s.push_back(on[i]);
+              t.push_back(on[j]);
+            }
+        lo = hi;
+      }
+  }
+
+  void PartnerIncidences (const PartnerInput & in, std::vector<int64_t> & slave, std::vector<int64_t> & face,
+                          std::vector<int64_t> & corner)
+  {
+    slave.clear();
+    face.clear();
+    corner.clear();
+    // where every vertex's incidences begin in ``incident`` (sorted)
+    std::vector<int64_t> first(in.nv + 1, 0);
+    for (int64_t i = 0; i < 3 * in.nf; i++)
+      first[in.incident[i] + 1]++;
+    for (int64_t v = 0; v < in.nv; v++)
+      first[v + 1] += first[v];
+    // a face f at t is coincident with a face at s where s has a face of f's key
+    std::vector<int64_t> at_s;
+    for (int64_t lo = 0; lo < in.n_on;)
+      {
+        int64_t hi = lo;
+        while (hi < in.n_on && in.group[hi] == in.group[lo])
+          hi++;
+        for (int64_t i = lo; i < hi; i++)
+          {
+            int64_t s = in.on[i];
+            at_s.clear();
+            for (int64_t p = first[s]; p < first[s + 1]; p++)
+              at_s.push_back(in.face_key[in.incidence[p] / 3]);
+            for (int64_t j = lo; j < hi; j++)
+              {
+                int64_t t = in.on[j];
+                if (!(in.vf[s] > in.vf[t] || (in.vf[s] == in.vf[t] && s > t)))
+                  continue;
+                for (int64_t p = first[t]; p < first[t + 1]; p++)
+                  {
+                    int64_t slot = in.incidence[p], f = slot / 3;
+                    if (std::find(at_s.begin(), at_s.end(), in.face_key[f]) != at_s.end())
+                      {
+                        slave.push_back(s);
+                        face.push_back(f);
+                        corner.push_back(slot % 3);
+                      }
+                  }
+              }
+          }
+        lo = hi;
+      }
+  }
+
+  void DiagonalEdgePairs (int64_t nE, const int64_t * E, const int64_t * at, const int64_t * vf,
+                          const int64_t * pid, int64_t n_points, const int64_t * face_key,
+                          std::vector<int64_t> & a, std::vector<int64_t> & b, std::vector<int64_t> & ends_b)
+  {
+    a.clear();
+    b.clear();
+    ends_b.clear();
+    // the edges by their sorted pair of points (stable), and every run of equal pairs
+    std::vector<int64_t> p0(nE), p1(nE), start;
+    for (int64_t e = 0; e < nE; e++)
+      {
+        int64_t x = pid[E[2 * e]], y = pid[E[2 * e + 1]];
+        p0[e] = std::min(x, y);
+        p1[e] = std::max(x, y);
+      }
+    std::vector<int64_t> order = CountingOrder(nE, n_points, p0, start);
+    auto higher = [&p1] (int64_t x, int64_t y) { return p1[x] < p1[y]; };
+    for (int64_t q = 0; q < n_points; q++)
+      if (start[q + 1] - start[q] > 64)
+        std::stable_sort(order.begin() + start[q], order.begin() + start[q + 1], higher);
+      else if (start[q + 1] - start[q] > 1)
+        InsertionSort(order, start[q], start[q + 1], higher);
+    std::vector<int64_t> run_of(nE), run_start;
+    for (int64_t i = 0; i < nE; i++)
+      {
+        if (!i || p0[order[i]] != p0[order[i - 1]] || p1[order[i]] != p1[order[i - 1]])
+          run_start.push_back(i);
+        run_of[order[i]] = run_start.size() - 1;
+      }
+    run_start.push_back(nE);
+    for (int64_t ea = 0; ea < nE; ea++)
+      {
+        const int64_t * fa = at + 2 * ea;
+        if (fa[0] < 0 || fa[1] < 0)
+          continue;
+        int64_t r = run_of[ea];
+        for (int64_t i = run_start[r]; i < run_start[r + 1]; i++)   // b increasing: a stable run
+          {
+            int64_t eb = order[i];
+            const int64_t * fb = at + 2 * eb;
+            if (vf[E[2 * ea]] == vf[E[2 * eb]] || fb[0] < 0 || fb[1] < 0)
+              continue;
+            bool shared = false;
+            for (int k = 0; k < 2; k++)
+              for (int l = 0; l < 2; l++)
+                shared = shared || face_key[fa[k]] == face_key[fb[l]];
+            if (shared)
+              continue;
+            a.push_back(ea);
+            b.push_back(eb);
+            bool flip = pid[E[2 * eb]] != pid[E[2 * ea]];
+            ends_b.push_back(E[2 * eb + (flip ? 1 : 0)]);
+            ends_b.push_back(E[2 * eb + (flip ? 0 : 1)]);
+          }
+      }
+  }
+
+  void VertexFragments (int64_t nv, int64_t ne, const int64_t * tets, int64_t row, int64_t col,
+                        const int64_t * fragment, int64_t * out)
+  {
+    std::fill(out, out + nv, int64_t(-1));
+    for (int64_t e = 0; e < ne; e++)
+      for (int k = 0; k < 4; k++)
+        out[tets[e * row + k * col]] = fragment[e];
+  }
+
+  void CoveredPairs (int64_t nv, const double * X, const int64_t * vf, int64_t m, const int64_t * slave,
+                     const int64_t * master, std::vector<int64_t> & codes)
+  {
+    codes.clear();
+    codes.reserve(2 * m);
+    for (int64_t r = 0; r < m; r++)
+      codes.push_back(vf[master[3 * r]] * nv + slave[r]);
+    for (int64_t r = 0; r < m; r++)
+      {
+        int64_t s = slave[r];
+        if (vf[master[3 * r]] == vf[s])
+          continue;
+        const double * p = X + 3 * s;
+        for (int c = 0; c < 3; c++)
+          {
+            const double * q = X + 3 * master[3 * r + c];
+            if (q[0] == p[0] && q[1] == p[1] && q[2] == p[2])
+              {
+                codes.push_back(vf[s] * nv + master[3 * r + c]);
+                break;
+              }
+          }
+      }
+    std::sort(codes.begin(), codes.end());
+    codes.erase(std::unique(codes.begin(), codes.end()), codes.end());
+  }
+
+  void TwoFaces (int64_t nE, const int64_t * ptr, const int64_t * faces, int64_t * out)
+  {
+    for (int64_t e = 0; e < nE; e++)
+      {
+        out[2 * e] = out[2 * e + 1] = -1;
+        if (ptr[e + 1] - ptr[e] == 2)
+          {
+            int64_t x = faces[ptr[e]], y = faces[ptr[e] + 1];
+            out[2 * e] = std::min(x, y);
+            out[2 * e + 1] = std::max(x, y);
+          }
+      }
+  }
 }

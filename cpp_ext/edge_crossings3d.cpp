@@ -150,15 +150,36 @@ namespace ngfracture
                                         + std::to_string(f) + " of fragment " + std::to_string(face_fragment[f]));
         }
     // every (edge key, face slot 3 f + k), sorted: the edges in lexicographic order, the
-    // faces at each edge increasing
+    // faces at each edge increasing. A counting sort by the edge's lower vertex (slots in
+    // increasing order), then a stable insertion sort of every vertex's few slots by the
+    // higher vertex (many: std::stable_sort): the order of std::sort of the pairs (key,
+    // slot), which are distinct
     std::vector<std::pair<uint64_t, int64_t>> slots(3 * nf);
-    for (int64_t f = 0; f < nf; f++)
-      for (int k = 0; k < 3; k++)
-        {
-          uint64_t u = uint32_t(faces[3*f+k]), w = uint32_t(faces[3*f+(k+1)%3]);
-          slots[3*f+k] = { (std::min(u, w) << 32) | std::max(u, w), 3*f+k };
-        }
-    std::sort(slots.begin(), slots.end());
+    {
+      std::vector<int64_t> start(nv + 1, 0);
+      for (int64_t i = 0; i < 3 * nf; i++)
+        start[std::min(faces[i], faces[i - i % 3 + (i % 3 + 1) % 3]) + 1]++;
+      for (int64_t v = 0; v < nv; v++) start[v+1] += start[v];
+      std::vector<int64_t> fill(start.begin(), start.end() - 1);
+      for (int64_t f = 0; f < nf; f++)
+        for (int k = 0; k < 3; k++)
+          {
+            uint64_t u = uint32_t(faces[3*f+k]), w = uint32_t(faces[3*f+(k+1)%3]);
+            slots[fill[std::min(u, w)]++] = { (std::min(u, w) << 32) | std::max(u, w), 3*f+k };
+          }
+      auto by_key = [] (const std::pair<uint64_t, int64_t> & x, const std::pair<uint64_t, int64_t> & y)
+        { return x.first < y.first; };
+      for (int64_t v = 0; v < nv; v++)
+        if (start[v+1] - start[v] > 64)
+          std::stable_sort(slots.begin() + start[v], slots.begin() + start[v+1], by_key);
+        else for (int64_t i = start[v] + 1; i < start[v+1]; i++)
+          {
+            auto x = slots[i];
+            int64_t j = i;
+            for (; j > start[v] && x.first < slots[j-1].first; j--) slots[j] = slots[j-1];
+            slots[j] = x;
+          }
+    }
     face_edges_.resize(3 * nf);
     edge_faces_.resize(3 * nf);
     edge_face_ptr_.push_back(0);

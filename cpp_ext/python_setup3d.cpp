@@ -29,6 +29,15 @@ namespace
         throw std::invalid_argument(std::string("ngfracture.") + fn + ": " + name + " has an entry outside [0, "
                                     + std::to_string(bound) + ")");
   }
+
+  // a 1D array whose entries do not decrease
+  void CheckSorted (const char * fn, const char * name, const LArr & a)
+  {
+    const int64_t * p = a.data();
+    for (py::ssize_t i = 1; i < a.size(); i++)
+      if (p[i] < p[i - 1])
+        throw std::invalid_argument(std::string("ngfracture.") + fn + ": " + name + " is not sorted");
+  }
 }
 
 void ExportSetup3d (py::module & m)
@@ -145,4 +154,178 @@ slave, face, corner : numpy.ndarray of int64
 matched : numpy.ndarray of bool, shape (nv,)
     Whether a vertex lies on a face matched to a face of another fragment.
 )doc");
+
+  m.def("CopyPairs",
+        [] (LArr on, LArr group)
+        {
+          Check("CopyPairs", "on", on, 1, 0);
+          Check("CopyPairs", "group", group, 1, 0, on.shape(0));
+          CheckSorted("CopyPairs", "group", group);
+          std::vector<int64_t> s, t;
+          {
+            py::gil_scoped_release release;
+            CopyPairs(on.shape(0), on.data(), group.data(), s, t);
+          }
+          return py::make_tuple(ToNumpy(s), ToNumpy(t));
+        },
+        py::arg("on"), py::arg("group"),
+        R"doc(Every ordered pair of entries of ``on`` with equal ``group`` (sorted), kinks3d.copy_pairs.
+
+Returns
+-------
+s, t : numpy.ndarray of int64
+    ``on[i], on[j]`` for every i, then every j of i's run of equal group (i == j included).
+)doc");
+
+  m.def("PartnerIncidences",
+        [] (LArr on, LArr group, LArr incident, LArr incidence, LArr face_key, LArr vf)
+        {
+          const char * fn = "PartnerIncidences";
+          Check(fn, "vertex_fragment", vf, 1, 0);
+          Check(fn, "face_key", face_key, 1, 0);
+          int64_t nv = vf.shape(0), nf = face_key.shape(0);
+          Check(fn, "on", on, 1, 0);
+          Check(fn, "group", group, 1, 0, on.shape(0));
+          Check(fn, "incident", incident, 1, 0, 3 * nf);
+          Check(fn, "incidence", incidence, 1, 0, 3 * nf);
+          CheckRange(fn, "on", on, nv);
+          CheckRange(fn, "incident", incident, nv);
+          CheckRange(fn, "incidence", incidence, 3 * nf);
+          CheckSorted(fn, "group", group);
+          CheckSorted(fn, "incident", incident);
+          PartnerInput in { nv, nf, on.shape(0), on.data(), group.data(), incident.data(), incidence.data(),
+                            face_key.data(), vf.data() };
+          std::vector<int64_t> slave, face, corner;
+          {
+            py::gil_scoped_release release;
+            PartnerIncidences(in, slave, face, corner);
+          }
+          return py::make_tuple(ToNumpy(slave), ToNumpy(face), ToNumpy(corner));
+        },
+        py::arg("on"), py::arg("group"), py::arg("incident"), py::arg("incidence"), py::arg("face_key"),
+        py::arg("vertex_fragment"),
+        R"doc(copies3d.partner_incidences from the arrays of a kinks3d.CopyIndex.
+
+Returns
+-------
+slave, face, corner : numpy.ndarray of int64
+    Per pair of copies (s, t) in the fixed rows' direction (copy_pairs' order), every face
+    at t (incidence order) coincident with a face at s, and t's corner in it.
+)doc");
+
+  m.def("DiagonalEdgePairs",
+        [] (LArr edges, LArr at, LArr vf, LArr pid, LArr face_key)
+        {
+          const char * fn = "DiagonalEdgePairs";
+          Check(fn, "edges", edges, 2, 2);
+          int64_t nE = edges.shape(0), nv = vf.shape(0), nf = face_key.shape(0);
+          Check(fn, "faces_at_edge", at, 2, 2, nE);
+          Check(fn, "vertex_fragment", vf, 1, 0);
+          Check(fn, "point", pid, 1, 0, nv);
+          Check(fn, "face_key", face_key, 1, 0);
+          CheckRange(fn, "edges", edges, nv);
+          for (py::ssize_t i = 0; i < at.size(); i++)
+            if (at.data()[i] < -1 || at.data()[i] >= nf)
+              throw std::invalid_argument("ngfracture.DiagonalEdgePairs: faces_at_edge has an entry outside [-1, "
+                                          + std::to_string(nf) + ")");
+          int64_t n_points = 0;
+          for (py::ssize_t i = 0; i < edges.size(); i++)
+            {
+              int64_t q = pid.data()[edges.data()[i]];
+              if (q < 0)
+                throw std::invalid_argument("ngfracture.DiagonalEdgePairs: edges has a vertex of no point (point -1)");
+              n_points = std::max(n_points, q + 1);
+            }
+          std::vector<int64_t> a, b, ends_b;
+          {
+            py::gil_scoped_release release;
+            DiagonalEdgePairs(nE, edges.data(), at.data(), vf.data(), pid.data(), n_points, face_key.data(), a, b,
+                              ends_b);
+          }
+          py::array_t<int64_t> B = ToNumpy(ends_b, 2);
+          if (ends_b.empty())
+            B = py::array_t<int64_t>(std::vector<py::ssize_t>{ 0, 2 });
+          return py::make_tuple(ToNumpy(a), ToNumpy(b), B);
+        },
+        py::arg("edges"), py::arg("faces_at_edge"), py::arg("vertex_fragment"), py::arg("point"),
+        py::arg("face_key"),
+        R"doc(The pairs of wedges3d.diagonal_edges.
+
+Returns
+-------
+a, b : numpy.ndarray of int64
+    The edges a and b of every pair, sorted by a, then b.
+ends_b : numpy.ndarray of int64, shape (m, 2)
+    b's ends, the one at a's first end's point first.
+)doc");
+
+  m.def("VertexFragments",
+        [] (int64_t nv, py::array_t<int64_t, py::array::forcecast> tets, LArr fragment)
+        {
+          // tets in any memory layout (a mesh's arrays are often column-major): no copy
+          Check("VertexFragments", "tets", tets, 2, 4);
+          Check("VertexFragments", "fragment", fragment, 1, 0, tets.shape(0));
+          if (nv < 0)
+            throw std::invalid_argument("ngfracture.VertexFragments: nv must be >= 0");
+          int64_t ne = tets.shape(0), row = tets.strides(0) / int64_t(sizeof(int64_t)),
+            col = tets.strides(1) / int64_t(sizeof(int64_t));
+          if (tets.strides(0) % int64_t(sizeof(int64_t)) || tets.strides(1) % int64_t(sizeof(int64_t)))
+            throw std::invalid_argument("ngfracture.VertexFragments: tets is not aligned to its items");
+          const int64_t * T = tets.data();
+          for (int64_t e = 0; e < ne; e++)
+            for (int k = 0; k < 4; k++)
+              if (T[e * row + k * col] < 0 || T[e * row + k * col] >= nv)
+                throw std::invalid_argument("ngfracture.VertexFragments: tets has an entry outside [0, "
+                                            + std::to_string(nv) + ")");
+          py::array_t<int64_t> out(nv);
+          int64_t * po = out.mutable_data();
+          {
+            py::gil_scoped_release release;
+            VertexFragments(nv, ne, T, row, col, fragment.data(), po);
+          }
+          return out;
+        },
+        py::arg("nv"), py::arg("tets"), py::arg("fragment"),
+        R"doc(setup3d.vertex_fragments: the fragment of every vertex (of the last tetrahedron at it), -1 in none.)doc");
+
+  m.def("CoveredPairs",
+        [] (DArr points, LArr vf, LArr slave, LArr master)
+        {
+          Check("CoveredPairs", "points", points, 2, 3);
+          int64_t nv = points.shape(0);
+          Check("CoveredPairs", "vertex_fragment", vf, 1, 0, nv);
+          Check("CoveredPairs", "slave", slave, 1, 0);
+          Check("CoveredPairs", "master", master, 2, 3, slave.shape(0));
+          CheckRange("CoveredPairs", "slave", slave, nv);
+          CheckRange("CoveredPairs", "master", master, nv);
+          std::vector<int64_t> codes;
+          {
+            py::gil_scoped_release release;
+            CoveredPairs(nv, points.data(), vf.data(), slave.shape(0), slave.data(), master.data(), codes);
+          }
+          return ToNumpy(codes);
+        },
+        py::arg("points"), py::arg("vertex_fragment"), py::arg("slave"), py::arg("master"),
+        R"doc(junctions3d.covered_pairs of rows given by their slaves and masters: the codes, sorted, unique.)doc");
+
+  m.def("TwoFaces",
+        [] (LArr ptr, LArr faces)
+        {
+          Check("TwoFaces", "edge_face_ptr", ptr, 1, 0);
+          Check("TwoFaces", "edge_faces", faces, 1, 0);
+          int64_t n = ptr.shape(0), m = faces.shape(0);
+          if (n < 1 || ptr.data()[0] < 0 || ptr.data()[n - 1] > m)
+            throw std::invalid_argument("ngfracture.TwoFaces: edge_face_ptr must start at 0 or more and end at "
+                                        "len(edge_faces) or less");
+          CheckSorted("TwoFaces", "edge_face_ptr", ptr);
+          py::array_t<int64_t> out({ n - 1, int64_t(2) });
+          int64_t * po = out.mutable_data();
+          {
+            py::gil_scoped_release release;
+            TwoFaces(n - 1, ptr.data(), faces.data(), po);
+          }
+          return out;
+        },
+        py::arg("edge_face_ptr"), py::arg("edge_faces"),
+        R"doc(edge_rows3d.two_faces: the two faces at every edge, increasing; -1, -1 at an edge with other than two.)doc");
 }

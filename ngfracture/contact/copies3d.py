@@ -55,7 +55,7 @@ behind a lip face at its copy, the pair's row holding only the other side).
 import numpy as np
 
 from .. import _ngfracture as _ext
-from .kinks3d import KINK, CopyIndex, copy_pairs, expand_ranges, isin_ints, partner_faces, unique_ints
+from .kinks3d import KINK, CopyIndex, expand_ranges, isin_ints, partner_faces, unique_ints
 from .rows3d import NodeToFaceRows, no_face_rows
 
 __all__ = ["found_rows_at_copies", "folded_rows_at_copies", "two_sided_rows", "partner_incidences",
@@ -311,11 +311,19 @@ def partner_incidences(index, vertex_fragment):
     slave, face, corner : numpy.ndarray of int
         As :func:`~ngfracture.contact.kinks3d.partner_faces` returns them (lips of one
         fragment included).
+
+    Raises
+    ------
+    ValueError
+        If ``vertex_fragment`` is not one number per vertex of the index.
     """
-    s, t = copy_pairs(index)
     vf = np.asarray(vertex_fragment, dtype=np.int64)
-    ahead = (vf[s] > vf[t]) | ((vf[s] == vf[t]) & (s > t))       # the fixed rows' direction
-    return partner_faces(index.points, index.faces, s[ahead], t[ahead], all_pairs=True, one_way=False, index=index)
+    if vf.shape != (len(index.points),):
+        raise ValueError(f"partner_incidences: vertex_fragment must have shape ({len(index.points)},), got {vf.shape}")
+    # C++ (cpp_ext/contact_setup3d.cpp): the pairs (s, t) of copy_pairs with vf[s] > vf[t],
+    # on one fragment s > t (the fixed rows' direction), through partner_faces(all_pairs=True,
+    # one_way=False); the same arrays (tests/test_contact3d_setup_kernels.py compares)
+    return _ext.PartnerIncidences(index.on, index.group, index.incident, index.incidence, index.face_key, vf)
 
 
 def behind_partner_rows(partners, displacement, tol, index):

@@ -38,6 +38,7 @@ from typing import ClassVar
 import numpy as np
 import scipy.sparse as sp
 
+from .. import _ngfracture as _ext
 from .rows import RowTable
 
 __all__ = ["EdgeRows", "PARALLEL", "no_edge_rows", "two_faces", "edge_rows", "relinearise_edge_rows"]
@@ -162,14 +163,15 @@ def two_faces(edge_face_ptr, edge_faces):
     numpy.ndarray of int64, shape (nE, 2)
         The two faces at each edge in increasing order; -1 and -1 at an edge with other
         than two faces.
+
+    Raises
+    ------
+    ValueError
+        If ``edge_face_ptr`` is empty, decreases or leaves ``edge_faces``.
     """
-    ptr = np.asarray(edge_face_ptr, dtype=np.int64)
-    faces = np.asarray(edge_faces, dtype=np.int64)
-    out = np.full((len(ptr) - 1, 2), -1, dtype=np.int64)
-    two = np.flatnonzero(np.diff(ptr) == 2)
-    pair = np.sort(np.stack([faces[ptr[two]], faces[ptr[two] + 1]], axis=1), axis=1)
-    out[two] = pair
-    return out
+    # C++ (cpp_ext/contact_setup3d.cpp), the numpy computation's array
+    # (tests/test_contact3d_setup_kernels.py compares)
+    return _ext.TwoFaces(np.asarray(edge_face_ptr, dtype=np.int64), np.asarray(edge_faces, dtype=np.int64))
 
 
 def _locally_inside(x, faces, edge, at, p):

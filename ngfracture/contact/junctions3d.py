@@ -40,7 +40,7 @@ twin opposing the slave's vertex normal), which the patch test needs.
 import numpy as np
 
 from .. import _ngfracture as _ext
-from .kinks3d import KINK, CopyIndex, unique_ints
+from .kinks3d import KINK, CopyIndex
 from .rows3d import NodeToFaceRows, face_gap_rows, fragment_twin_rows, no_face_rows
 
 __all__ = ["fragment_pair_rows", "covered_pairs"]
@@ -165,11 +165,9 @@ def covered_pairs(points, rows, vertex_fragment):
     if X.ndim != 2 or X.shape[1] != 3 or vf.shape != (len(X),) or rows.nv != len(X):
         raise ValueError(f"covered_pairs: points {X.shape}, vertex_fragment {vf.shape} and rows of "
                          f"{rows.nv} vertices do not fit")
-    nv = len(X)
-    s, m = np.asarray(rows.slave, dtype=np.int64), np.asarray(rows.master, dtype=np.int64).reshape(-1, 3)
-    vf = vf.astype(np.int64)
-    copy = np.all(X[m] == X[s][:, None, :], axis=2)                      # [row, corner]
-    has = copy.any(axis=1) & (vf[m[:, 0]] != vf[s])
-    t = m[np.flatnonzero(has), copy[has].argmax(axis=1)]
-    return unique_ints(np.r_[vf[m[:, 0]] * nv + s, vf[s[has]] * nv + t])
+    # C++ (cpp_ext/contact_setup3d.cpp): the codes of every row's (s, G), then of (t, F)
+    # where the master has a copy t of s (the first such corner) on another fragment,
+    # sorted and unique (tests/test_contact3d_setup_pairs.py keeps the numpy computation)
+    return _ext.CoveredPairs(X, vf.astype(np.int64), np.asarray(rows.slave, dtype=np.int64),
+                             np.asarray(rows.master, dtype=np.int64).reshape(-1, 3))
 

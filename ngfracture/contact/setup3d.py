@@ -195,10 +195,19 @@ def vertex_fragments(nv, tets, fragment):
     Returns
     -------
     numpy.ndarray of int64, shape (nv,)
+        A vertex in tetrahedra of several fragments gets the last one's.
+
+    Raises
+    ------
+    ValueError
+        Naming ``tets`` (not of shape (ne, 4), a vertex number outside [0, nv)) or
+        ``fragment`` (not one per tetrahedron).
     """
-    vertex_fragment = np.full(nv, -1, dtype=np.int64)
-    vertex_fragment[np.asarray(tets).ravel()] = np.repeat(np.asarray(fragment, dtype=np.int64), 4)
-    return vertex_fragment
+    # C++ (cpp_ext/contact_setup3d.cpp): the numpy scatter
+    # full(nv, -1)[tets.ravel()] = repeat(fragment, 4), the last tetrahedron's fragment
+    # kept (tests/test_contact3d_setup_pairs.py compares)
+    return _ext.VertexFragments(int(nv), np.asarray(tets, dtype=np.int64).reshape(-1, 4),
+                                np.asarray(fragment, dtype=np.int64))
 
 
 def fixed_rows(points, faces, vertex_fragment, codec, detector, index):

@@ -30,7 +30,6 @@ import numpy as np
 from .. import _ngfracture as _ext
 from .copies3d import rows_at_copy
 from .intsets import isin_ints
-from .kinks3d import equal_key_pairs
 from .rows3d import no_face_rows
 
 __all__ = ["DiagonalEdges", "diagonal_edges", "wedge_rows"]
@@ -80,6 +79,12 @@ def diagonal_edges(edges, faces_at_edge, vertex_fragment, index):
     -------
     DiagonalEdges
         Sorted by edge a, then edge b.
+
+    Raises
+    ------
+    ValueError
+        Naming the array: a wrong shape, a vertex or face number out of range, an edge
+        with a vertex on no boundary face (no reference point in ``index``).
     """
     E = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
     at = np.asarray(faces_at_edge, dtype=np.int64).reshape(-1, 2)
@@ -88,23 +93,12 @@ def diagonal_edges(edges, faces_at_edge, vertex_fragment, index):
     none = DiagonalEdges(*(np.zeros((0, 2), np.int64) for _ in range(3)), *(np.zeros(0, np.int64) for _ in range(2)))
     if not len(E):
         return none
-    P = np.sort(pid[E], axis=1)
-    code = P[:, 0] * (np.int64(P.max()) + 1) + P[:, 1]
-    order = np.argsort(code, kind="stable")
-    a, b = (order[i] for i in equal_key_pairs(code[order]))      # the copies of every edge, pairwise
-    other = vf[E[a, 0]] != vf[E[b, 0]]                           # (an edge with itself too: same fragment)
-    a, b = a[other], b[other]
-    fa, fb = at[a], at[b]
-    two = (fa >= 0).all(axis=1) & (fb >= 0).all(axis=1)
-    key = index.face_key
-    shared = (key[np.maximum(fa, 0)][:, :, None] == key[np.maximum(fb, 0)][:, None, :]).any(axis=(1, 2))
-    keep = np.flatnonzero(two & ~shared)
-    a, b = a[keep], b[keep]
-    ends_b = E[b]
-    flip = pid[ends_b[:, 0]] != pid[E[a, 0]]
-    ends_b[flip] = ends_b[flip][:, ::-1]
-    sort = np.lexsort((b, a))
-    return DiagonalEdges(E[a][sort], ends_b[sort], at[b][sort], a[sort], b[sort])
+    # C++ (cpp_ext/contact_setup3d.cpp): the edges on the same two points pairwise, on two
+    # fragments, each with two faces, no face key shared; b's ends flipped to a's points;
+    # sorted by (a, b). The same arrays as the numpy computation that
+    # tests/test_contact3d_setup_kernels.py keeps and compares
+    a, b, ends_b = _ext.DiagonalEdgePairs(E, at, vf, pid, index.face_key)
+    return DiagonalEdges(E[a], ends_b, at[b], a, b)
 
 
 def wedge_rows(pairs, displacement, tol, index, vertex_fragment):
