@@ -3,32 +3,12 @@
 // documented API; the bindings check shapes and vertex and face numbers.
 #include <python_comp.hpp>
 #include "numpy_arrays.hpp"
+#include "binding_checks.hpp"
 #include "copies3d.hpp"
 
 namespace py = pybind11;
 using namespace ngfracture;
-
-namespace
-{
-  using DArr = py::array_t<double, py::array::c_style | py::array::forcecast>;
-  using LArr = py::array_t<int64_t, py::array::c_style | py::array::forcecast>;
-
-  void Check (const char * fn, const char * name, const py::array & a, int ndim, py::ssize_t cols,
-              py::ssize_t rows = -1)
-  {
-    if (a.ndim() != ndim || (ndim == 2 && a.shape(1) != cols) || (rows >= 0 && a.shape(0) != rows))
-      throw std::invalid_argument(std::string("ngfracture.") + fn + ": " + name + " has the wrong shape");
-  }
-
-  void CheckRange (const char * fn, const char * name, const LArr & a, int64_t bound)
-  {
-    const int64_t * p = a.data();
-    for (py::ssize_t i = 0; i < a.size(); i++)
-      if (p[i] < 0 || p[i] >= bound)
-        throw std::invalid_argument(std::string("ngfracture.") + fn + ": " + name + " has an entry outside [0, "
-                                    + std::to_string(bound) + ")");
-  }
-}
+using namespace ngfracture::bindings;
 
 void ExportCopies3d (py::module & m)
 {

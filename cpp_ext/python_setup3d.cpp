@@ -3,33 +3,15 @@
 // input, keep the numpy computations as the reference and are the documented API.
 #include <python_comp.hpp>
 #include "numpy_arrays.hpp"
+#include "binding_checks.hpp"
 #include "contact_setup3d.hpp"
 
 namespace py = pybind11;
 using namespace ngfracture;
+using namespace ngfracture::bindings;
 
 namespace
 {
-  using DArr = py::array_t<double, py::array::c_style | py::array::forcecast>;
-  using LArr = py::array_t<int64_t, py::array::c_style | py::array::forcecast>;
-
-  void Check (const char * fn, const char * name, const py::array & a, int ndim, py::ssize_t cols,
-              py::ssize_t rows = -1)
-  {
-    if (a.ndim() != ndim || (ndim == 2 && a.shape(1) != cols) || (rows >= 0 && a.shape(0) != rows))
-      throw std::invalid_argument(std::string("ngfracture.") + fn + ": " + name + " has the wrong shape");
-  }
-
-  // every entry of a in [0, bound)
-  void CheckRange (const char * fn, const char * name, const LArr & a, int64_t bound)
-  {
-    const int64_t * p = a.data();
-    for (py::ssize_t i = 0; i < a.size(); i++)
-      if (p[i] < 0 || p[i] >= bound)
-        throw std::invalid_argument(std::string("ngfracture.") + fn + ": " + name + " has an entry outside [0, "
-                                    + std::to_string(bound) + ")");
-  }
-
   // a 1D array whose entries do not decrease
   void CheckSorted (const char * fn, const char * name, const LArr & a)
   {

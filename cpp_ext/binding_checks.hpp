@@ -1,0 +1,33 @@
+// What the bindings of the 3D contact kernels share: the numpy array types they take
+// (C order, converted if needed) and the checks of their arguments, whose errors name the
+// function and the argument.
+#ifndef NGFRACTURE_BINDING_CHECKS_HPP
+#define NGFRACTURE_BINDING_CHECKS_HPP
+#include <python_comp.hpp>
+#include <stdexcept>
+#include <string>
+
+namespace ngfracture::bindings
+{
+  using DArr = pybind11::array_t<double, pybind11::array::c_style | pybind11::array::forcecast>;
+  using LArr = pybind11::array_t<int64_t, pybind11::array::c_style | pybind11::array::forcecast>;
+
+  // a has ndim dimensions, ``cols`` columns if it has two, and ``rows`` rows unless -1
+  inline void Check (const char * fn, const char * name, const pybind11::array & a, int ndim, pybind11::ssize_t cols,
+                     pybind11::ssize_t rows = -1)
+  {
+    if (a.ndim() != ndim || (ndim == 2 && a.shape(1) != cols) || (rows >= 0 && a.shape(0) != rows))
+      throw std::invalid_argument(std::string("ngfracture.") + fn + ": " + name + " has the wrong shape");
+  }
+
+  // every entry of a in [0, bound)
+  inline void CheckRange (const char * fn, const char * name, const LArr & a, int64_t bound)
+  {
+    const int64_t * p = a.data();
+    for (pybind11::ssize_t i = 0; i < a.size(); i++)
+      if (p[i] < 0 || p[i] >= bound)
+        throw std::invalid_argument(std::string("ngfracture.") + fn + ": " + name + " has an entry outside [0, "
+                                    + std::to_string(bound) + ")");
+  }
+}
+#endif
