@@ -29,5 +29,14 @@ namespace ngfracture::bindings
         throw std::invalid_argument(std::string("ngfracture.") + fn + ": " + name + " has an entry outside [0, "
                                     + std::to_string(bound) + ")");
   }
+
+  // a 1D array whose entries do not decrease
+  inline void CheckSorted (const char * fn, const char * name, const LArr & a)
+  {
+    const int64_t * p = a.data();
+    for (pybind11::ssize_t i = 1; i < a.size(); i++)
+      if (p[i] < p[i - 1])
+        throw std::invalid_argument(std::string("ngfracture.") + fn + ": " + name + " is not sorted");
+  }
 }
 #endif

@@ -36,6 +36,64 @@ namespace ngfracture
       }
   }
 
+  void FoldedIncidences (const FoldInput & in, int64_t m, const uint8_t * pick, const int64_t * slave,
+                         const int64_t * master, const double * bary, const double * normal, const int64_t * tied,
+                         int64_t n_tied, double kink, std::vector<int64_t> & out_slave,
+                         std::vector<int64_t> & out_face, std::vector<int64_t> & out_corner)
+  {
+    out_slave.clear();
+    out_face.clear();
+    out_corner.clear();
+    std::vector<std::pair<int64_t, int64_t>> picked;     // (s nv + t, row), stable by code below
+    for (int64_t i = 0; i < m; i++)
+      {
+        if (!pick[i])
+          continue;
+        const double * b = bary + 3 * i;
+        int top = 0;                                      // np.argmax: the first largest
+        for (int l = 1; l < 3; l++)
+          if (b[l] > b[top])
+            top = l;
+        int64_t s = slave[i], t = master[3 * i + top], p = in.point[s];
+        if (p < 0 || in.copies[p] != 2 || in.vf[s] == in.vf[t])
+          continue;
+        int64_t tie = std::min(s, t) * in.nv + std::max(s, t);
+        if (n_tied && std::binary_search(tied, tied + n_tied, tie))
+          continue;
+        picked.emplace_back(s * in.nv + t, i);
+      }
+    std::stable_sort(picked.begin(), picked.end(), [] (const auto & a, const auto & b) { return a.first < b.first; });
+    const int64_t nk = in.nf + 1;
+    for (size_t lo = 0; lo < picked.size();)
+      {
+        size_t hi = lo;
+        while (hi < picked.size() && picked[hi].first == picked[lo].first)
+          hi++;
+        int64_t s = picked[lo].first / in.nv, t = picked[lo].first % in.nv;
+        const int64_t * first = std::lower_bound(in.incident, in.incident + 3 * in.nf, t);
+        const int64_t * last = std::upper_bound(first, in.incident + 3 * in.nf, t);
+        for (const int64_t * q = first; q < last; q++)
+          {
+            int64_t slot = in.incidence[q - in.incident], f = slot / 3;
+            if (!std::binary_search(in.vertex_keys, in.vertex_keys + in.n_keys, s * nk + in.face_key[f]))
+              continue;                                   // no face of f's key at s
+            const double * u = in.unit + 3 * f;
+            bool parallel = false;
+            for (size_t j = lo; j < hi && !parallel; j++)
+              {
+                const double * n = normal + 3 * picked[j].second;
+                parallel = 1.0 - ((u[0] * n[0] + u[1] * n[1]) + u[2] * n[2]) <= kink;
+              }
+            if (parallel)
+              continue;
+            out_slave.push_back(s);
+            out_face.push_back(f);
+            out_corner.push_back(slot % 3);
+          }
+        lo = hi;
+      }
+  }
+
   void BehindPartnerGaps (int64_t m, int64_t nv, const double * x, const int64_t * faces, const int64_t * slave,
                           const int64_t * face, const int64_t * corner, double tol, std::vector<int64_t> & hit,
                           std::vector<double> & gap)

@@ -14,6 +14,32 @@ namespace ngfracture
   void PartnerAt (int64_t m, const int64_t * faces, const int64_t * key_order, const int64_t * key_start,
                   const int64_t * key_count, const int64_t * face, const int64_t * vertex, int64_t * out);
 
+  // The mesh's boundary as copies3d.folded_rows_at_copies reads it (kinks3d.CopyIndex).
+  struct FoldInput
+  {
+    int64_t nv, nf;
+    const int64_t * faces;         // nf x 3
+    const int64_t * point;         // nv: the point of every vertex, -1 off the boundary
+    const int64_t * copies;        // the number of copies of every point
+    const int64_t * vf;            // nv: the fragment of every vertex
+    const int64_t * incident;      // 3 nf, sorted: the vertex of every incidence
+    const int64_t * incidence;     // 3 nf: its slot 3 f + corner in the faces
+    const int64_t * face_key;      // nf
+    const int64_t * vertex_keys;   // n_keys, sorted: v (nf + 1) + face_key of every incidence
+    int64_t n_keys;
+    const double * unit;           // nf x 3: the faces' unit normals
+  };
+
+  // copies3d.folded_rows_at_copies before its rows: for every pair (s, t) of a picked
+  // row's slave and the copy it is projected at, at a point of two copies on different
+  // fragments and not tied (``tied``: sorted codes min nv + max), the faces f at t with
+  // a face of f's key at s and a unit normal off every picked row's normal of the pair
+  // (1 - n_f . n > kink): (slave, face, corner of t), by pair code s nv + t, then slot.
+  void FoldedIncidences (const FoldInput & in, int64_t m, const uint8_t * pick, const int64_t * slave,
+                         const int64_t * master, const double * bary, const double * normal, const int64_t * tied,
+                         int64_t n_tied, double kink, std::vector<int64_t> & out_slave,
+                         std::vector<int64_t> & out_face, std::vector<int64_t> & out_corner);
+
   // The partner incidences (slave s, face f, corner of s's copy t in f) at x: the gap
   // n_f . (x_s - x_t) with f's unit normal at x (0 where the copies meet or f is squeezed
   // flat). hit: every incidence of a pair (s, t) with some gap below -tol, increasing;

@@ -47,6 +47,61 @@ numpy.ndarray of int64
     The first such face in key order (copies3d._partner_at's numpy loop).
 )doc");
 
+  m.def("FoldedIncidences",
+        [] (LArr faces, LArr point, LArr copies, LArr vertex_fragment, LArr incident, LArr incidence, LArr face_key,
+            LArr vertex_keys, DArr unit, py::array_t<bool, py::array::c_style | py::array::forcecast> pick,
+            LArr slave, LArr master, DArr bary, DArr normal, LArr tied, double kink)
+        {
+          const char * fn = "FoldedIncidences";
+          Check(fn, "faces", faces, 2, 3);
+          int64_t nf = faces.shape(0), nv = point.shape(0), m = slave.shape(0);
+          Check(fn, "point", point, 1, 0);
+          Check(fn, "copies", copies, 1, 0);
+          Check(fn, "vertex_fragment", vertex_fragment, 1, 0, nv);
+          Check(fn, "incident", incident, 1, 0, 3 * nf);
+          Check(fn, "incidence", incidence, 1, 0, 3 * nf);
+          Check(fn, "face_key", face_key, 1, 0, nf);
+          Check(fn, "vertex_keys", vertex_keys, 1, 0);
+          Check(fn, "unit", unit, 2, 3, nf);
+          Check(fn, "pick", pick, 1, 0, m);
+          Check(fn, "slave", slave, 1, 0);
+          Check(fn, "master", master, 2, 3, m);
+          Check(fn, "bary", bary, 2, 3, m);
+          Check(fn, "normal", normal, 2, 3, m);
+          Check(fn, "tied", tied, 1, 0);
+          CheckRange(fn, "faces", faces, nv);
+          for (int64_t v = 0; v < nv; v++)
+            if (point.data()[v] < -1 || point.data()[v] >= copies.shape(0))
+              throw std::invalid_argument("ngfracture.FoldedIncidences: point has an entry outside [-1, "
+                                          + std::to_string(copies.shape(0)) + ")");
+          CheckSorted(fn, "incident", incident);
+          CheckSorted(fn, "vertex_keys", vertex_keys);
+          CheckSorted(fn, "tied", tied);
+          CheckRange(fn, "incident", incident, nv);
+          CheckRange(fn, "incidence", incidence, 3 * nf);
+          CheckRange(fn, "slave", slave, nv);
+          CheckRange(fn, "master", master, nv);
+          FoldInput in { nv, nf, faces.data(), point.data(), copies.data(), vertex_fragment.data(), incident.data(),
+                         incidence.data(), face_key.data(), vertex_keys.data(), vertex_keys.shape(0), unit.data() };
+          std::vector<int64_t> s, f, c;
+          {
+            py::gil_scoped_release release;
+            FoldedIncidences(in, m, reinterpret_cast<const uint8_t *>(pick.data()), slave.data(), master.data(),
+                             bary.data(), normal.data(), tied.data(), tied.shape(0), kink, s, f, c);
+          }
+          return py::make_tuple(ToNumpy(s), ToNumpy(f), ToNumpy(c));
+        },
+        py::arg("faces"), py::arg("point"), py::arg("copies"), py::arg("vertex_fragment"), py::arg("incident"),
+        py::arg("incidence"), py::arg("face_key"), py::arg("vertex_keys"), py::arg("unit"), py::arg("pick"),
+        py::arg("slave"), py::arg("master"), py::arg("bary"), py::arg("normal"), py::arg("tied"), py::arg("kink"),
+        R"doc(The incidences of copies3d.folded_rows_at_copies: its rows' slaves, faces and corners.
+
+Returns
+-------
+slave, face, corner : numpy.ndarray of int64
+    By pair code, then the faces' incidence order at the copy.
+)doc");
+
   m.def("BehindPartnerGaps",
         [] (DArr x, LArr faces, LArr slave, LArr face, LArr corner, double tol)
         {

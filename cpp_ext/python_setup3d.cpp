@@ -10,18 +10,6 @@ namespace py = pybind11;
 using namespace ngfracture;
 using namespace ngfracture::bindings;
 
-namespace
-{
-  // a 1D array whose entries do not decrease
-  void CheckSorted (const char * fn, const char * name, const LArr & a)
-  {
-    const int64_t * p = a.data();
-    for (py::ssize_t i = 1; i < a.size(); i++)
-      if (p[i] < p[i - 1])
-        throw std::invalid_argument(std::string("ngfracture.") + fn + ": " + name + " is not sorted");
-  }
-}
-
 void ExportSetup3d (py::module & m)
 {
   m.def("SortedTripleRanks",

@@ -1,8 +1,9 @@
 """The C++ kernels of the rows between copies of a point against their numpy reference, bit for bit.
 
 ``copies3d.behind_partner_rows`` (``BehindPartnerGaps``), ``wedges3d.wedge_rows``
-(``WedgeInside``) and the partner face of a (face, vertex) that found rows at copies and
-their re-linearisation look up (``PartnerAt``) compute in C++ what the numpy code below
+(``WedgeInside``), ``copies3d.folded_rows_at_copies`` (``FoldedIncidences``) and the
+partner face of a (face, vertex) that found rows at copies and their re-linearisation
+look up (``PartnerAt``) compute in C++ what the numpy code below
 computes, every round of every 3D contact solve; the rows they make must be the same to the last bit (gaps and their
 zeros, the order of the rows), on configurations where many rows fire: a body cut into
 2 x 2 x 2 blocks (junction lines of four blocks, a point of eight) whose vertices are
@@ -13,9 +14,10 @@ import numpy as np
 import pytest
 
 from ngfracture import _ngfracture as ext
-from ngfracture.contact.copies3d import behind_partner_rows, rows_at_copy
+from ngfracture.contact.copies3d import behind_partner_rows, folded_rows_at_copies, found_rows_at_copies, rows_at_copy
 from ngfracture.contact.intsets import isin_ints, unique_ints
-from ngfracture.contact.rows3d import no_face_rows
+from ngfracture.contact.kinks3d import KINK, expand_ranges, partner_faces
+from ngfracture.contact.rows3d import no_face_rows, node_to_face_rows
 from ngfracture.contact.setup3d import MeshSetup3d
 from ngfracture.contact.wedges3d import wedge_rows
 from ngfracture.geometry.pieces import fragmented_box
@@ -34,6 +36,36 @@ def reference_partner_at(index, face, vertex):
         hit = (shift < count) & (out < 0) & np.any(F[cand] == vertex[:, None], axis=1)
         out[hit] = cand[hit]
     return out
+
+
+def reference_folded_rows_at_copies(rows, pick, vertex_fragment, tied, index):
+    """The numpy computation of copies3d.folded_rows_at_copies."""
+    X, F = index.points, index.faces
+    nv = rows.nv
+    vf = np.asarray(vertex_fragment, dtype=np.int64)
+    pid = index.point
+    s = rows.slave
+    t = rows.master[np.arange(len(rows)), np.argmax(rows.bary, axis=1)]
+    two = index.copies[np.maximum(pid[s], 0)] == 2
+    ok = np.asarray(pick, dtype=bool) & two & (pid[s] >= 0) & (vf[s] != vf[t])
+    if tied is not None and len(tied):
+        ok &= ~isin_ints(np.minimum(s, t) * nv + np.maximum(s, t), tied)
+    r = np.flatnonzero(ok)
+    s, t = s[r], t[r]
+    code = s * nv + t
+    pair = unique_ints(code)
+    slave, face, corner = partner_faces(X, F, pair // nv, pair % nv, all_pairs=True, one_way=False, index=index)
+    master = F[face]
+    normal = index.unit[face]
+    order = np.argsort(code, kind="stable")
+    incidence_code = slave * nv + master[np.arange(len(face)), corner]
+    start = np.searchsorted(code[order], incidence_code)
+    incidence, slot = expand_ranges(start, np.searchsorted(code[order], incidence_code, side="right") - start)
+    picked = r[order[slot]]
+    parallel = 1.0 - np.sum(normal[incidence] * rows.normal[picked], axis=1) <= KINK
+    keep = np.ones(len(face), dtype=bool)
+    keep[incidence[parallel]] = False
+    return rows_at_copy(slave[keep], face[keep], corner[keep], np.zeros(int(keep.sum())), index)
 
 
 def reference_plane_gaps(x, faces, face, slave, copy):
@@ -96,7 +128,12 @@ def reference_wedge_rows(pairs, displacement, tol, index, vertex_fragment):
 
 @pytest.fixture(scope="module")
 def blocks():
+    """The blocks with every cut plane bent by 0.2 along grid lines a quarter in (faces turned by 11 degrees
+    there, more than KINK: the folded rows have faces to add); copies stay bitwise equal."""
     arrays, piece = fragmented_box(CELLS, PIECES)
+    P = arrays.points
+    bend = 0.2 * np.abs(P - 0.25)                      # along grid lines off the junctions
+    arrays.points = P + np.stack([bend[:, 1] + bend[:, 2], bend[:, 0] + bend[:, 2], bend[:, 0] + bend[:, 1]], axis=1)
     return arrays, MeshSetup3d(arrays.points, arrays.tets, arrays.faces, np.asarray(piece, dtype=np.int64))
 
 
@@ -159,6 +196,29 @@ def test_partner_at_equals_its_numpy_reference(blocks):
     m = len(slave)
     assert (found[:m] >= 0).all() and np.array_equal(found[m:2 * m], setup.partners[1])
     assert (found[2 * m:] < 0).any()
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_folded_rows_equal_their_numpy_reference(blocks, seed):
+    arrays, setup = blocks
+    U = configurations(arrays, setup, seed)
+    U[setup.vertex_fragment == 0] += 0.2 / CELLS                  # a block pushed into its neighbours
+    index = setup.copy_index
+    found, at_copy = found_rows_at_copies(arrays.points, arrays.faces,
+                                          node_to_face_rows(arrays.points, arrays.faces, setup.detector.detect(U)),
+                                          setup.vertex_fragment, index=index)
+    pick = at_copy & (found.dist < 0)
+    assert pick.sum() > 10
+    s = found.slave
+    t = found.master[np.arange(len(found)), np.argmax(found.bary, axis=1)]
+    codes = unique_ints(np.minimum(s, t) * len(arrays.points) + np.maximum(s, t))
+    some = np.sort(np.random.default_rng(seed).choice(codes, len(codes) // 3, replace=False))
+    for tied in (None, some):
+        args = found, pick, setup.vertex_fragment
+        rows = folded_rows_at_copies(arrays.points, arrays.faces, *args, tied=tied, index=index)
+        reference = reference_folded_rows_at_copies(*args, tied, index)
+        assert len(reference) > 0
+        assert same_rows(rows, reference)
 
 
 def test_no_rows_where_nothing_moved(blocks):

@@ -55,7 +55,7 @@ behind a lip face at its copy, the pair's row holding only the other side).
 import numpy as np
 
 from .. import _ngfracture as _ext
-from .kinks3d import KINK, CopyIndex, expand_ranges, isin_ints, partner_faces, unique_ints
+from .kinks3d import KINK, CopyIndex
 from .rows3d import NodeToFaceRows, no_face_rows
 
 __all__ = ["found_rows_at_copies", "folded_rows_at_copies", "two_sided_rows", "partner_incidences",
@@ -158,35 +158,20 @@ def folded_rows_at_copies(points, faces, rows, pick, vertex_fragment, tied=None,
         configuration, ``dist`` 0 (the copies' points equal).
     """
     X, F = np.asarray(points), np.asarray(faces, dtype=np.int64)
-    nv = rows.nv
     vf = np.asarray(vertex_fragment, dtype=np.int64)
     if index is None:
         index = CopyIndex(X, F)
-    pid = index.point
-    s = rows.slave
-    t = rows.master[np.arange(len(rows)), np.argmax(rows.bary, axis=1)]
-    two = index.copies[np.maximum(pid[s], 0)] == 2
-    ok = np.asarray(pick, dtype=bool) & two & (pid[s] >= 0) & (vf[s] != vf[t])
-    if tied is not None and len(tied):
-        ok &= ~isin_ints(np.minimum(s, t) * nv + np.maximum(s, t), tied)
-    r = np.flatnonzero(ok)
-    s, t = s[r], t[r]
-    code = s * nv + t
-    pair = unique_ints(code)
-    slave, face, corner = partner_faces(X, F, pair // nv, pair % nv, all_pairs=True, one_way=False,
-                                        index=index)
-    master = F[face]
-    normal = index.unit[face]                             # the faces' unit normals
-    # an incidence is dropped where a picked row of its pair has a parallel face
-    order = np.argsort(code, kind="stable")
-    incidence_code = slave * nv + master[np.arange(len(face)), corner]
-    start = np.searchsorted(code[order], incidence_code)
-    incidence, slot = expand_ranges(start, np.searchsorted(code[order], incidence_code, side="right") - start)
-    picked = r[order[slot]]
-    parallel = 1.0 - np.sum(normal[incidence] * rows.normal[picked], axis=1) <= KINK
-    keep = np.ones(len(face), dtype=bool)
-    keep[incidence[parallel]] = False
-    return rows_at_copy(slave[keep], face[keep], corner[keep], np.zeros(int(keep.sum())), index)
+    # C++ (cpp_ext/copies3d.cpp), what numpy computed: the picked rows' pairs (s, t), t the
+    # corner the row is projected at, kept at points of two copies on different fragments and
+    # not tied; the faces at t coincident with a face at s (kinks3d.partner_faces), by pair
+    # code and the faces' order at t; an incidence dropped where a picked row of its pair
+    # has a normal within KINK of the face's (1 - n_f . n <= KINK)
+    tied = np.zeros(0, dtype=np.int64) if tied is None else np.asarray(tied, dtype=np.int64)
+    slave, face, corner = _ext.FoldedIncidences(index.faces, index.point, index.copies, vf, index.incident,
+                                                index.incidence, index.face_key, index.vertex_keys, index.unit,
+                                                np.asarray(pick, dtype=bool), rows.slave, rows.master, rows.bary,
+                                                rows.normal, tied, KINK)
+    return rows_at_copy(slave, face, corner, np.zeros(len(slave)), index)
 
 
 def two_sided_rows(rows, points, displacement, index, margin=0.0):
