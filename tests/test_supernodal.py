@@ -204,7 +204,8 @@ def test_the_supernodal_sparse_forward_solve_is_the_entrywise_one():
 def test_the_weighted_product_of_sparse_columns_is_symmetric_and_the_dense_one(case, monkeypatch):
     """Y^T diag(w) Y (the Schur complement where U = D L^T) equals the dense product to
     rounding (1e-14 of the largest term) and is exactly symmetric: by the symmetric rank-k
-    product, and where a weight is not positive or the block too big by the general one."""
+    product, in column blocks where the dense copy is too big (the blocks above the diagonal
+    by a product), and where a weight is not positive by the general one."""
     if case == "small blocks":
         monkeypatch.setattr(triangular, "PRODUCT_BLOCK_BYTES", 8 * 5)
     rng = np.random.default_rng(12)

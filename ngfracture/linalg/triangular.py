@@ -188,10 +188,11 @@ def weighted_products(y_columns, weights, n):
     """Y^T diag(w) Y of a matrix given by its sparse columns (the Schur complement where
     U = D L^T: X = D^-1 Y, w = 1 / D), exactly symmetric.
 
-    With every weight on the rows Y reaches positive and the dense copy within
-    ``PRODUCT_BLOCK_BYTES``, one symmetric rank-k product (BLAS syrk, half the work of
-    :func:`column_products`) of W = diag(sqrt(w)) Y; else :func:`column_products` of
-    diag(w) Y and Y, symmetrised.
+    With every weight on the rows Y reaches positive: symmetric products of W = diag(sqrt(w)) Y
+    in column blocks whose dense copies take at most ``PRODUCT_BLOCK_BYTES``, the diagonal
+    blocks by BLAS syrk and only the blocks above them by a product (half the work of
+    :func:`column_products`, every dense block made once per block row); else
+    :func:`column_products` of diag(w) Y and Y, symmetrised.
 
     Parameters
     ----------
@@ -207,14 +208,22 @@ def weighted_products(y_columns, weights, n):
     y = _stacked(y_columns)
     rows = np.flatnonzero(_reached(y, n))
     m = len(y_columns)
-    if len(rows) * m * 8 > PRODUCT_BLOCK_BYTES or np.any(weights[rows] <= 0):
+    if np.any(weights[rows] <= 0):
         S = column_products([(r, v * weights[r]) for r, v in y_columns], y_columns, n)
         return 0.5 * (S + S.T)
     place = -np.ones(n, dtype=np.int64)
     place[rows] = np.arange(len(rows))
-    W = _dense_block(y, place, len(rows), 0, m) * np.sqrt(weights[rows])[:, None]
-    upper = blas.dsyrk(1.0, W.T) if m else np.zeros((0, 0))    # W.T is Fortran-ordered: no copy
-    return np.triu(upper) + np.triu(upper, 1).T
+    scale = np.sqrt(weights[rows])[:, None]
+    width = max(1, PRODUCT_BLOCK_BYTES // (8 * max(len(rows), 1)))
+    S = np.zeros((m, m))
+    for i in range(0, m, width):
+        W = _dense_block(y, place, len(rows), i, i + width) * scale
+        upper = blas.dsyrk(1.0, W.T)      # W.T is Fortran-ordered: no copy
+        S[i:i + width, i:i + width] = np.triu(upper) + np.triu(upper, 1).T
+        for j in range(i + width, m, width):
+            block = W.T @ (_dense_block(y, place, len(rows), j, j + width) * scale)
+            S[i:i + width, j:j + width], S[j:j + width, i:i + width] = block, block.T
+    return S
 
 
 def _stacked(columns):
