@@ -17,7 +17,7 @@ import pytest
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from ngfracture import ElasticProblem, StVenantKirchhoff
+from ngfracture import ElasticProblem, Simulation, StepControl, StVenantKirchhoff
 from ngfracture.fracture.split3d import split_by_tensor_3d
 from ngfracture.geometry.solid import solid_mesh
 from ngfracture.linalg import bordered
@@ -25,9 +25,10 @@ from ngfracture.linalg import factor as factor_module
 from ngfracture.linalg.factor import EliminatedFactor
 from ngfracture.linalg.kkt import ConstrainedSolver
 from ngfracture.mechanics.tangent import base_pins
+from ngfracture.scenes import sphere3d
 
 from split3d_util import cube_bar
-from test_kkt_paths import whole_kkt_solution
+from test_kkt_paths import kkt_forward_tolerance, whole_kkt_solution
 
 N = 4     # cubes along each side: 125 vertices, 375 dofs
 
@@ -171,3 +172,83 @@ def test_tangent_of_the_3d_split_mesh_at_the_carried_state_is_the_base_tangent(c
     A = base.K[base.factor_free][:, base.factor_free]
     KF = factor.K[factor._dofs][:, factor._dofs]
     assert abs(factor._Et @ KF @ factor._Et.T - A).max() <= 1e-14 * abs(A).max()
+
+
+COARSE_SPHERE = dict(maxh=0.4, fine=0.15)   # tests/test_sphere3d.py's coarse mesh: 1.1k dofs
+
+
+@pytest.mark.parametrize("against_fresh", [False, pytest.param(True, marks=pytest.mark.slow)])
+def test_every_tenth_bordered_solve_of_a_coarse_sphere_run_solves_its_kkt_system(against_fresh, monkeypatch):
+    """The confined sphere on the coarse mesh for three steps (14 split vertices; its
+    crack passes carried by bordered factors, run/solid_pass.py, with the contact rows
+    across the cracks and the stick rows of the interface): every tenth constrained solver
+    built on a bordered factor solves a random system [K~ B^T; B 0] with a backward error
+    of rounding size (1e-12 of |K~| |du| + |B^T| |lam| + |r|, row by row 1e-12 of
+    |B| |du| + |h|). With ``against_fresh`` (slow: a dense condition number) the 11th (a
+    chain of several passes) also equals the solve of a fresh factorisation of K~ with the
+    same rows to the forward error two backward-stable solves may differ by
+    (test_kkt_paths.kkt_forward_tolerance)."""
+    checked, compared = [], []
+    original = ConstrainedSolver.__init__
+
+    def checking_init(self, K, fixed_dofs, C, *args, **kwargs):
+        original(self, K, fixed_dofs, C, *args, **kwargs)
+        if not isinstance(self.factor, bordered.BorderedFactor):
+            return
+        checked.append(len(self.factor._border))
+        if (len(checked) - 1) % 10 or getattr(self, "_coarse", None) is None:
+            return
+        assert self._Z is None                               # the base's K^-1 on the rows' dofs
+        rng = np.random.default_rng(len(checked))
+        K, ndof, free = self.factor.K, self.ndof, self.free
+        fixed = np.asarray(fixed_dofs)
+        r = np.where(free, rng.standard_normal(ndof), 0.0)
+        du_fixed = np.zeros(ndof)
+        du_fixed[fixed] = 1e-6 * rng.standard_normal(len(fixed))
+        h = 1e-6 * rng.standard_normal(self.m)
+        du, lam = self.solve(r, du_fixed, h)
+        force = (K @ du + self.C.T @ lam - r)[free]
+        force_scale = (abs(K) @ np.abs(du) + abs(self.C.T) @ np.abs(lam) + np.abs(r))[free]
+        assert np.linalg.norm(force) <= 1e-12 * np.linalg.norm(force_scale)
+        assert np.array_equal(du[~free], du_fixed[~free])
+        rows = self.C @ du - h
+        assert np.all(np.abs(rows) <= 1e-12 * (abs(self.C) @ np.abs(du) + np.abs(h)))
+        if not against_fresh or len(checked) != 11:
+            return
+        compared.append(len(self.factor._border))
+        fresh = EliminatedFactor(K, fixed, self.factor.pins, schur_by_dofs=True)
+        other = ConstrainedSolver(None, fixed, self.C, modes=kwargs.get("modes"), pins=self.factor.pins,
+                                  factor=fresh, path="schur")
+        du2, lam2 = other.solve(r, du_fixed, h)
+        tol = kkt_forward_tolerance(K, types.SimpleNamespace(fixed_dofs=fixed, C=self.C))
+        x, x_ref = np.concatenate([du, lam]), np.concatenate([du2, lam2])
+        assert np.linalg.norm(x - x_ref) <= tol * np.linalg.norm(x_ref)
+
+    monkeypatch.setattr(ConstrainedSolver, "__init__", checking_init)
+    result = Simulation(sphere3d(**COARSE_SPHERE), StepControl(max_steps=3), pictures="none").run()
+    assert result.ok and result.summary["n_steps"] == 3 and result.summary["n_split_vertices"] > 0
+    assert len(checked) >= 11 and max(checked) >= 3 * 10        # chains of splits, not single ones
+    assert compared[0] > 3 if against_fresh else not compared
+
+
+@pytest.mark.slow
+def test_a_coarse_sphere_run_through_bordered_factors_ends_as_with_fresh_factorisations(monkeypatch):
+    """Six steps of the coarse confined sphere (64 split vertices), once with every split
+    mesh factorised afresh: the same split vertices step by step, the same fragments and
+    crack area, the volume of both the initial one to the last bit, and final
+    displacements equal to the tolerance of the Newton solves (1e-9 of the largest)."""
+    runs = {}
+    for carried in (True, False):
+        if not carried:
+            monkeypatch.setattr(bordered.BorderedFactor, "build", classmethod(lambda cls, *args: None))
+        runs[carried] = Simulation(sphere3d(**COARSE_SPHERE), StepControl(max_steps=6), pictures="none").run()
+    a, b = runs[True].summary, runs[False].summary
+    assert runs[True].ok and runs[False].ok
+    assert [h["split_vertices"] for h in a["history"]] == [h["split_vertices"] for h in b["history"]]
+    assert a["n_split_vertices"] > 30 and a["n_fragments"] == b["n_fragments"]
+    assert a["volume_final"] == a["volume_initial"] and b["volume_final"] == b["volume_initial"]
+    assert sum(v["factorisations"] for v in a["timings"]["linear_solver"].values()) < \
+        sum(v["factorisations"] for v in b["timings"]["linear_solver"].values())
+    assert abs(a["crack_area"] - b["crack_area"]) <= 1e-12 * b["crack_area"]
+    ua, ub = runs[True].problem.u.vec.FV().NumPy(), runs[False].problem.u.vec.FV().NumPy()
+    assert np.max(np.abs(ua - ub)) <= 1e-9 * np.max(np.abs(ub))
