@@ -9,6 +9,9 @@ whole KKT system [K~ B^T; B 0] to 1e-10 (rounding), with general rows across the
 (the jumps of the new vertices against their parents, as contact rows are) and rows on
 base vertices. The second pass keeps the first one's columns Z = A^-1 B where B's are
 unchanged, and E^T K~ E is the base tangent (every tetrahedron keeps its element matrix).
+Along a run (the coarse confined sphere, its crack passes carried by run/solid_pass.py)
+the bordered KKT solves with the contact and stick rows have backward errors of rounding
+size, and the run ends with the same cracks as with every split mesh factorised afresh.
 """
 import types
 
