@@ -102,7 +102,7 @@ def test_bordered_solve_equals_whole_kkt_solve_in_contact(split_in_contact, spar
     else:
         assert lineage.base._ldl is False                 # below SUPERNODAL_MIN_DOFS: SuperLU's solve
     rows = prob.assemble_constraints()
-    support = base_pins(prob.support(rows), lineage.base, prob.fes.ndof)
+    support = base_pins(prob.support(rows), lineage.base, prob.fes.ndof, prob.dim)
     factor = split_factor.BorderedFactor.build(lineage, prob, rows.fixed_dofs, support.pins)
     assert factor is not None and len(factor._border) > 0
     assert rows.C.shape[0] > 0
@@ -121,7 +121,7 @@ def test_tangent_of_the_split_mesh_at_the_carried_state_is_the_base_tangent(spli
     rounding of the sums."""
     prob, lineage = split_in_contact
     rows = prob.assemble_constraints()
-    support = base_pins(prob.support(rows), lineage.base, prob.fes.ndof)
+    support = base_pins(prob.support(rows), lineage.base, prob.fes.ndof, prob.dim)
     factor = split_factor.BorderedFactor.build(lineage, prob, rows.fixed_dofs, support.pins)
     base = lineage.base
     A = base.K[base.factor_free][:, base.factor_free]
@@ -134,7 +134,7 @@ def test_small_mesh_border_beyond_capacity_or_new_fragment_takes_a_fresh_factori
                                                                                       monkeypatch):
     prob, lineage = split_in_contact
     rows = prob.assemble_constraints()
-    support = base_pins(prob.support(rows), lineage.base, prob.fes.ndof)
+    support = base_pins(prob.support(rows), lineage.base, prob.fes.ndof, prob.dim)
     assert split_factor.BorderedFactor.build(lineage, prob, rows.fixed_dofs, support.pins) is not None
     monkeypatch.setattr(split_factor, "MIN_BASE_DOFS", np.count_nonzero(lineage.base.factor_free) + 1)
     assert split_factor.BorderedFactor.build(lineage, prob, rows.fixed_dofs, support.pins) is None
@@ -272,7 +272,7 @@ def test_two_factors_built_from_one_lineage_do_not_share_columns(split_in_contac
     1e-10) in either order."""
     prob, lineage = split_in_contact
     rows = prob.assemble_constraints()
-    support = base_pins(prob.support(rows), lineage.base, prob.fes.ndof)
+    support = base_pins(prob.support(rows), lineage.base, prob.fes.ndof, prob.dim)
     first = split_factor.BorderedFactor.build(lineage, prob, rows.fixed_dofs, support.pins)
     first.solve(np.ones(prob.fes.ndof))
     same_mesh = split_factor.lineage(first, None, np.arange(prob.mesh.nv))

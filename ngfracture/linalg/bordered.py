@@ -9,17 +9,21 @@ of the split. Let the split mesh's displacement be written as
 x on the dofs of the mesh the chain of splits started from (the base: E copies every
 vertex's parent, so a new vertex moves with the vertex it was split from) and d the jump
 of every new vertex against its parent (J puts it on the new vertex). With the new mesh's
-tangent K~ taken at the base state carried over (every triangle keeps its vertices'
-displacements, so its element matrix is the base's), the system in (x, d) is
+tangent K~ taken at the base state carried over (every element, triangle or
+tetrahedron, keeps its vertices' displacements, so its element matrix is the base's), the
+system in (x, d) is
 
     [ A    B ] [x]   [E^T b]        A = E^T K~ E = the base tangent (factorised),
     [ B^T  D ] [d] = [J^T b],       B = E^T K~ J, D = J^T K~ J,
 
-and eliminating d needs only Z = A^-1 B (two columns per new vertex, kept from one pass
-to the next) and the small dense S_d = D - B^T Z: one base solve per solve. The columns a
-pass adds are solved in one block with the first right-hand side it meets. General
+and eliminating d needs only Z = A^-1 B (a column per free dof of a new vertex, kept from
+one pass to the next) and the small dense S_d = D - B^T Z: one base solve per solve. The
+columns a pass adds are solved in one block with the first right-hand side it meets. General
 rows C become C E and C J, and C K~^+ C^T = (C E) A^-1 (C E)^T + W S_d^-1 W^T with
-W = (C E) Z - C J: the base's sparse Schur complement plus a rank-m term.
+W = (C E) Z - C J: the base's sparse Schur complement plus a rank-m term. In 3D that is
+the base's K^-1 on the rows' dofs (factor.EliminatedFactor ``schur_by_dofs``), kept on the
+base along the chain: C E puts a new vertex's entries on its parent's dofs, so a pass adds
+few dofs to it and rebuilds nothing.
 
 Modified Newton iterates with K~ (the tangent of the base state) as it iterates with the
 tangent of the start of its load step; the residual is the new mesh's own. A border
@@ -102,7 +106,7 @@ class BorderColumns:
     border of the next mesh starts with this one's dofs: its columns are updated in the same
     buffer, solved again only where their column of B changed, and the new ones appended.
     A neighbour's split leaves a column as it was: E^T sums the new vertex's couplings with
-    both copies of the neighbour into the same base dofs, and each triangle keeps its element
+    both copies of the neighbour into the same base dofs, and each element keeps its element
     matrix. A chain has one buffer; only its latest factor may solve
     (``chain["latest"]`` is that factor's ``generation``; an earlier one refuses), and only
     the latest factor's columns are carried on (a factor built twice from one lineage, a
@@ -172,9 +176,10 @@ def _sparse_times_rows(A, Z):
     return np.add.reduceat(Z[A.indices] * A.data[:, None], A.indptr[:-1], axis=0)
 
 
-def _lifted(state, parent):
-    """The base state on the split mesh: every vertex takes its parent's displacement."""
-    return state.reshape(2, -1)[:, parent].reshape(-1)
+def _lifted(state, parent, dim):
+    """The base state on the split mesh: every vertex takes its parent's displacement
+    (``dim`` components, component-major)."""
+    return state.reshape(dim, -1)[:, parent].reshape(-1)
 
 
 class BorderedFactor(FactorBase):
@@ -208,7 +213,8 @@ class BorderedFactor(FactorBase):
         ----------
         lineage : Lineage
         problem : ElasticProblem
-            On the split mesh (its vertices: those of the base, then the new ones).
+            On the split mesh (its vertices: those of the base, then the new ones), 2D or
+            3D: ``problem.dim`` dofs per vertex, component-major.
         fixed_dofs, pins : numpy.ndarray of int
             Of the solve on the split mesh.
 
@@ -223,28 +229,30 @@ class BorderedFactor(FactorBase):
         n_base = np.count_nonzero(base.factor_free)
         if n_base < MIN_BASE_DOFS:
             return None
-        nv, nvb = problem.fes.ndof // 2, base.ndof // 2
+        dim = problem.dim
+        nv, nvb = problem.fes.ndof // dim, base.ndof // dim
         parent = lineage.parent
-        if len(parent) != nv or nv < nvb or not np.array_equal(parent[:nvb], np.arange(nvb)):
+        if (len(parent) != nv or nv < nvb or base.ndof != dim * nvb
+                or not np.array_equal(parent[:nvb], np.arange(nvb))):
             return None
         fixed_dofs = np.asarray(fixed_dofs, dtype=np.int64)
         pins = np.asarray(pins, dtype=np.int64)
-        free = np.ones(2 * nv, dtype=bool)
+        free = np.ones(dim * nv, dtype=bool)
         free[fixed_dofs] = False
         factor_free = free.copy()
         factor_free[pins] = False
         # base vertices keep their constraints and pins; a new vertex is free only where its parent is
-        old = np.concatenate([np.arange(nvb), nv + np.arange(nvb)])
+        old = (np.arange(dim)[:, None] * nv + np.arange(nvb)).reshape(-1)
         if (not np.array_equal(free[old], base.free) or not np.array_equal(factor_free[old], base.factor_free)):
             return None
-        base_dof = np.repeat([0, 1], nv) * nvb + np.tile(parent, 2)
-        new_vertex = np.tile(np.arange(nv) >= nvb, 2)
+        base_dof = np.repeat(np.arange(dim), nv) * nvb + np.tile(parent, dim)
+        new_vertex = np.tile(np.arange(nv) >= nvb, dim)
         if (np.any(factor_free & ~base.factor_free[base_dof]) or np.any(~free & base.free[base_dof])
                 or np.any(free & ~factor_free & new_vertex)):
             return None
         if np.count_nonzero(factor_free) - n_base > border_capacity(n_base):
             return None
-        K = problem.tangent(_lifted(lineage.state, parent))
+        K = problem.tangent(_lifted(lineage.state, parent, dim))
         return cls(lineage, K, fixed_dofs, pins, free, factor_free, base_dof)
 
     def __init__(self, lineage, K, fixed_dofs, pins, free, factor_free, base_dof):
@@ -255,7 +263,8 @@ class BorderedFactor(FactorBase):
         self.fixed_dofs, self.pins, self.free, self.factor_free = fixed_dofs, pins, free, factor_free
         self.inverse = base.inverse
         super().__init__()
-        nv, nvb = self.ndof // 2, base.ndof // 2
+        nv = len(self.parent)
+        nvb = base.ndof // (self.ndof // nv)
         n_base = np.count_nonzero(base.factor_free)
         position = -np.ones(base.ndof, dtype=np.int64)
         position[base.factor_free] = np.arange(n_base)

@@ -131,7 +131,7 @@ class SavedTangent:
         """
         if self.factor is not None or self.lineage is None:
             return False
-        support = base_pins(support, self.lineage.base, problem.fes.ndof)
+        support = base_pins(support, self.lineage.base, problem.fes.ndof, problem.dim)
         factor = BorderedFactor.build(self.lineage, problem, fixed_dofs, support.pins)
         if factor is None:
             return False
@@ -154,7 +154,7 @@ class SavedTangent:
         return self.fixed_dofs is not None and np.array_equal(self.fixed_dofs, fixed_dofs)
 
 
-def base_pins(support, base, ndof):
+def base_pins(support, base, ndof, dim):
     """``support`` with the base factorisation's pins, where they serve as well.
 
     The base's pins are carried to the split mesh (same vertices and components) and taken
@@ -168,13 +168,15 @@ def base_pins(support, base, ndof):
         The factorisation of the mesh the chain of splits started from.
     ndof : int
         Dofs of the split mesh.
+    dim : int
+        Dofs per vertex (the mesh's dimension; component-major numbering).
 
     Returns
     -------
     rigid.Support
         ``support`` itself, or the same modes with the base's pins.
     """
-    nvb, nv = base.ndof // 2, ndof // 2
+    nvb, nv = base.ndof // dim, ndof // dim
     pins = base.pins // nvb * nv + base.pins % nvb
     if len(pins) != len(support.pins) or np.array_equal(pins, support.pins) or not len(pins):
         return support

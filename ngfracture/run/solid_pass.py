@@ -6,14 +6,17 @@ as ``StepControl.split`` says: "one" (the most overstressed vertex that splits a
 "spread" (in decreasing order, skipping those that share an edge with a vertex split
 earlier in the pass; the 3D scenes' default, docs/solid.md "Crack passes in 3D") or "all";
 the displacement and the strength are copied to the new vertices
-through the parent map, exactly. The bordered factorisation of 2D crack passes is not
-used: every split mesh is factorised afresh.
+through the parent map, exactly. The split mesh inherits the factorisation of the
+equilibrium (``linalg.bordered.lineage``: the 3D engine appends the new vertices, numbered
+after the old ones, and keeps every tetrahedron's element matrix at the state carried
+over), as a 2D crack pass does.
 """
 import time
 
 import numpy as np
 
 from ..fracture.split import transfer_vertex_field
+from ..linalg import bordered
 from ..fracture.split3d import split_by_tensor_3d
 from ..geometry.solid import solid_mesh
 from .records import CrackPass
@@ -21,7 +24,7 @@ from .records import CrackPass
 __all__ = ["solid_crack_pass"]
 
 
-def solid_crack_pass(stepper, prob, x, strength, tensors, largest, timings):
+def solid_crack_pass(stepper, prob, x, strength, tensors, largest, tangent, timings):
     """Split the overstressed vertices of a 3D equilibrium.
 
     Parameters
@@ -38,6 +41,8 @@ def solid_crack_pass(stepper, prob, x, strength, tensors, largest, timings):
         Overstrain per vertex, shape (nv, 6).
     largest : float
         Their largest principal value (for the record).
+    tangent : SavedTangent or None
+        The tangent the equilibrium ended with: the split mesh's solves start from it.
     timings : Timings
 
     Returns
@@ -55,7 +60,8 @@ def solid_crack_pass(stepper, prob, x, strength, tensors, largest, timings):
     u = transfer_vertex_field(prob.u.vec.FV().NumPy().reshape(3, -1).T, res).T.reshape(-1)
     if strength is not None:
         strength = transfer_vertex_field(strength, res)    # copies inherit the vertex's strength
+    inherited = bordered.lineage(tangent.factor, tangent.state, res.parent) if tangent is not None else None
     with timings.timed("rebuild"):
         mesh = solid_mesh(res.arrays)
     split = stepper.problem(mesh, x, timings, u, check_mesh=False)
-    return CrackPass(split, res.nsplit, strength, None, positions, largest)
+    return CrackPass(split, res.nsplit, strength, inherited, positions, largest)

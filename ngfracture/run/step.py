@@ -223,7 +223,7 @@ class LoadStep:
             tensors = self.criterion.overstrain(prob.mesh, prob.u, strength, arrays=prob.arrays)
             largest = float(principal(tensors)[0].max(initial=0.0))
         if prob.dim == 3:
-            return solid_crack_pass(self, prob, x, strength, tensors, largest, timings)
+            return solid_crack_pass(self, prob, x, strength, tensors, largest, tangent, timings)
         t0 = time.perf_counter()
         # cracks judged at a critical distance grow from their tips (docs/criterion.md)
         if self.criterion.one_ring:
