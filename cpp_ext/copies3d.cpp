@@ -36,6 +36,46 @@ namespace ngfracture
       }
   }
 
+  void FoundRowsAtCopies (int64_t m, const int64_t * faces, const int64_t * point, const int64_t * vf,
+                          const int64_t * key_order, const int64_t * key_start, const int64_t * key_count,
+                          const double * unit, int64_t * slave, int64_t * master, int64_t * face, double * bary,
+                          double * normal, double * g, uint8_t * at_copy)
+  {
+    for (int64_t i = 0; i < m; i++)
+      {
+        int64_t s = slave[i], ps = point[s], * tri = master + 3 * i;
+        int corner = -1;                                  // the first corner at the slave's point
+        for (int k = 0; k < 3 && corner < 0; k++)
+          if (point[tri[k]] == ps)
+            corner = k;
+        at_copy[i] = corner >= 0 && ps >= 0;
+        if (!at_copy[i])
+          {
+            std::copy(faces + 3 * face[i], faces + 3 * face[i] + 3, tri);
+            continue;
+          }
+        int64_t copy = tri[corner];
+        if (vf[s] < vf[copy] || (vf[s] == vf[copy] && s < copy))
+          {
+            int64_t partner;
+            PartnerAt(1, faces, key_order, key_start, key_count, face + i, &s, &partner);
+            if (partner >= 0)
+              {
+                slave[i] = copy;
+                copy = s;
+                face[i] = partner;
+              }
+          }
+        std::copy(faces + 3 * face[i], faces + 3 * face[i] + 3, tri);
+        for (int k = 0; k < 3; k++)
+          {
+            normal[3 * i + k] = unit[3 * face[i] + k];
+            bary[3 * i + k] = tri[k] == copy ? 1.0 : 0.0;
+          }
+        g[i] = 0.0;
+      }
+  }
+
   void FoldedIncidences (const FoldInput & in, int64_t m, const uint8_t * pick, const int64_t * slave,
                          const int64_t * master, const double * bary, const double * normal, const int64_t * tied,
                          int64_t n_tied, double kink, std::vector<int64_t> & out_slave,

@@ -14,6 +14,17 @@ namespace ngfracture
   void PartnerAt (int64_t m, const int64_t * faces, const int64_t * key_order, const int64_t * key_start,
                   const int64_t * key_count, const int64_t * face, const int64_t * vertex, int64_t * out);
 
+  // copies3d.found_rows_at_copies in place on copies of the rows' arrays (m rows): a row
+  // whose face has a corner at the slave's point (point[] >= 0) is at a copy; in the other
+  // direction than the fixed rows' (the slave on the lower fragment, on one fragment the
+  // lower vertex) it becomes the copy's row on the face at the slave on the same points
+  // (PartnerAt) where there is one; then projected at the copy (bary 1 there, g 0) with
+  // the face's unit normal. master is faces[face] for every row.
+  void FoundRowsAtCopies (int64_t m, const int64_t * faces, const int64_t * point, const int64_t * vf,
+                          const int64_t * key_order, const int64_t * key_start, const int64_t * key_count,
+                          const double * unit, int64_t * slave, int64_t * master, int64_t * face, double * bary,
+                          double * normal, double * g, uint8_t * at_copy);
+
   // The mesh's boundary as copies3d.folded_rows_at_copies reads it (kinks3d.CopyIndex).
   struct FoldInput
   {

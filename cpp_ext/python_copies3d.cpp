@@ -47,6 +47,65 @@ numpy.ndarray of int64
     The first such face in key order (copies3d._partner_at's numpy loop).
 )doc");
 
+  m.def("FoundRowsAtCopies",
+        [] (LArr faces, LArr point, LArr vertex_fragment, LArr key_order, LArr key_start, LArr key_count, DArr unit,
+            LArr slave, LArr master, LArr face, DArr bary, DArr normal, DArr g)
+        {
+          const char * fn = "FoundRowsAtCopies";
+          Check(fn, "faces", faces, 2, 3);
+          int64_t nf = faces.shape(0), nv = point.shape(0), m = slave.shape(0);
+          Check(fn, "point", point, 1, 0);
+          Check(fn, "vertex_fragment", vertex_fragment, 1, 0, nv);
+          Check(fn, "key_order", key_order, 1, 0, nf);
+          Check(fn, "key_start", key_start, 1, 0, nf);
+          Check(fn, "key_count", key_count, 1, 0, nf);
+          Check(fn, "unit", unit, 2, 3, nf);
+          Check(fn, "slave", slave, 1, 0);
+          Check(fn, "master", master, 2, 3, m);
+          Check(fn, "face", face, 1, 0, m);
+          Check(fn, "bary", bary, 2, 3, m);
+          Check(fn, "normal", normal, 2, 3, m);
+          Check(fn, "g", g, 1, 0, m);
+          CheckRange(fn, "faces", faces, nv);
+          CheckRange(fn, "key_order", key_order, nf);
+          CheckRange(fn, "slave", slave, nv);
+          CheckRange(fn, "master", master, nv);
+          CheckRange(fn, "face", face, nf);
+          for (int64_t f = 0; f < nf; f++)
+            if (key_start.data()[f] < 0 || key_count.data()[f] < 0 || key_start.data()[f] + key_count.data()[f] > nf)
+              throw std::invalid_argument("ngfracture.FoundRowsAtCopies: key_start and key_count of face "
+                                          + std::to_string(f) + " leave key_order");
+          // the outputs: copies of the rows' arrays, changed in place
+          LArr S(m), M({ m, int64_t(3) }), Fc(m);
+          DArr B({ m, int64_t(3) }), N({ m, int64_t(3) }), G(m);
+          py::array_t<bool> at(m);
+          std::copy(slave.data(), slave.data() + m, S.mutable_data());
+          std::copy(master.data(), master.data() + 3 * m, M.mutable_data());
+          std::copy(face.data(), face.data() + m, Fc.mutable_data());
+          std::copy(bary.data(), bary.data() + 3 * m, B.mutable_data());
+          std::copy(normal.data(), normal.data() + 3 * m, N.mutable_data());
+          std::copy(g.data(), g.data() + m, G.mutable_data());
+          {
+            py::gil_scoped_release release;
+            FoundRowsAtCopies(m, faces.data(), point.data(), vertex_fragment.data(), key_order.data(),
+                              key_start.data(), key_count.data(), unit.data(), S.mutable_data(), M.mutable_data(),
+                              Fc.mutable_data(), B.mutable_data(), N.mutable_data(), G.mutable_data(),
+                              reinterpret_cast<uint8_t *>(at.mutable_data()));
+          }
+          return py::make_tuple(S, M, Fc, B, N, G, at);
+        },
+        py::arg("faces"), py::arg("point"), py::arg("vertex_fragment"), py::arg("key_order"), py::arg("key_start"),
+        py::arg("key_count"), py::arg("unit"), py::arg("slave"), py::arg("master"), py::arg("face"), py::arg("bary"),
+        py::arg("normal"), py::arg("g"),
+        R"doc(The rows of copies3d.found_rows_at_copies (new arrays) and which are at a copy.
+
+Returns
+-------
+tuple
+    slave, master, face, bary, normal, g and at_copy (bool), bit for bit the numpy
+    computation.
+)doc");
+
   m.def("FoldedIncidences",
         [] (LArr faces, LArr point, LArr copies, LArr vertex_fragment, LArr incident, LArr incidence, LArr face_key,
             LArr vertex_keys, DArr unit, py::array_t<bool, py::array::c_style | py::array::forcecast> pick,

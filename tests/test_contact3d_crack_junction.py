@@ -188,7 +188,7 @@ def test_found_rows_at_copies_take_the_fixed_rows_direction():
     pen = detect_penetrations_3d(X, a.tets, a.faces, zero, U)
     mine = np.isin(pen.vertex, low)
     assert np.count_nonzero(mine) == len(low) and np.allclose(pen.gap[mine], -1e-4, rtol=1e-12, atol=0)
-    rows, at_copy = found_rows_at_copies(X, a.faces, node_to_face_rows(X, a.faces, pen), zero)
+    rows, at_copy = found_rows_at_copies(X, a.faces, node_to_face_rows(X, a.faces, pen), np.zeros(len(X), np.int64))
     assert np.all(at_copy[mine])
     r = rows.subset(np.flatnonzero(mine))
     high = np.array([two[(point[two] == point[v]) & (two != v)][0] for v in pen.vertex[mine]])

@@ -1,7 +1,8 @@
 """The C++ kernels of the rows between copies of a point against their numpy reference, bit for bit.
 
 ``copies3d.behind_partner_rows`` (``BehindPartnerGaps``), ``wedges3d.wedge_rows``
-(``WedgeInside``), ``copies3d.folded_rows_at_copies`` (``FoldedIncidences``) and the
+(``WedgeInside``), ``copies3d.found_rows_at_copies`` (``FoundRowsAtCopies``),
+``copies3d.folded_rows_at_copies`` (``FoldedIncidences``) and the
 partner face of a (face, vertex) that found rows at copies and their re-linearisation
 look up (``PartnerAt``) compute in C++ what the numpy code below
 computes, every round of every 3D contact solve; the rows they make must be the same to the last bit (gaps and their
@@ -17,7 +18,7 @@ from ngfracture import _ngfracture as ext
 from ngfracture.contact.copies3d import behind_partner_rows, folded_rows_at_copies, found_rows_at_copies, rows_at_copy
 from ngfracture.contact.intsets import isin_ints, unique_ints
 from ngfracture.contact.kinks3d import KINK, expand_ranges, partner_faces
-from ngfracture.contact.rows3d import no_face_rows, node_to_face_rows
+from ngfracture.contact.rows3d import NodeToFaceRows, no_face_rows, node_to_face_rows
 from ngfracture.contact.setup3d import MeshSetup3d
 from ngfracture.contact.wedges3d import wedge_rows
 from ngfracture.geometry.pieces import fragmented_box
@@ -36,6 +37,30 @@ def reference_partner_at(index, face, vertex):
         hit = (shift < count) & (out < 0) & np.any(F[cand] == vertex[:, None], axis=1)
         out[hit] = cand[hit]
     return out
+
+
+def reference_found_rows_at_copies(rows, vertex_fragment, index):
+    """The numpy computation of copies3d.found_rows_at_copies."""
+    F = index.faces
+    vf = np.asarray(vertex_fragment, dtype=np.int64)
+    pid = index.point
+    same = pid[rows.master] == pid[rows.slave][:, None]
+    at_copy = same.any(axis=1) & (pid[rows.slave] >= 0)
+    slave, face, normal = rows.slave.copy(), rows.face.copy(), rows.normal.copy()
+    copy = rows.master[np.arange(len(rows)), same.argmax(axis=1)]
+    reverse = at_copy & ((vf[slave] < vf[copy]) | ((vf[slave] == vf[copy]) & (slave < copy)))
+    r = np.flatnonzero(reverse)
+    partner = reference_partner_at(index, face[r], slave[r])
+    r, partner = r[partner >= 0], partner[partner >= 0]
+    slave[r], copy[r], face[r] = copy[r], slave[r], partner
+    master = F[face]
+    normal[at_copy] = index.unit[face[at_copy]]
+    bary = rows.bary.copy()
+    bary[at_copy] = (master[at_copy] == copy[at_copy, None]).astype(np.float64)
+    g = rows.g.copy()
+    g[at_copy] = 0.0
+    return NodeToFaceRows(slave=slave, master=master, face=face, bary=bary, normal=normal, dist=rows.dist.copy(),
+                          g=g, nv=rows.nv), at_copy
 
 
 def reference_folded_rows_at_copies(rows, pick, vertex_fragment, tied, index):
@@ -196,6 +221,21 @@ def test_partner_at_equals_its_numpy_reference(blocks):
     m = len(slave)
     assert (found[:m] >= 0).all() and np.array_equal(found[m:2 * m], setup.partners[1])
     assert (found[2 * m:] < 0).any()
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_found_rows_at_copies_equal_their_numpy_reference(blocks, seed):
+    arrays, setup = blocks
+    U = configurations(arrays, setup, seed)
+    U[setup.vertex_fragment == seed % 2] += 0.2 / CELLS            # blocks pushed into their neighbours
+    index = setup.copy_index
+    detected = node_to_face_rows(arrays.points, arrays.faces, setup.detector.detect(U))
+    rows, at_copy = found_rows_at_copies(arrays.points, arrays.faces, detected, setup.vertex_fragment, index=index)
+    reference, reference_at = reference_found_rows_at_copies(detected, setup.vertex_fragment, index)
+    # rows at a copy in both directions, and rows elsewhere
+    assert 0 < reference_at.sum() < len(reference_at)
+    assert not np.array_equal(rows.slave, detected.slave)
+    assert np.array_equal(at_copy, reference_at) and same_rows(rows, reference)
 
 
 @pytest.mark.parametrize("seed", [0, 1, 2])

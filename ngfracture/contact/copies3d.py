@@ -100,22 +100,12 @@ def found_rows_at_copies(points, faces, rows, vertex_fragment, index=None):
     vf = np.asarray(vertex_fragment, dtype=np.int64)
     if index is None:
         index = CopyIndex(X, F)
-    pid = index.point
-    same = pid[rows.master] == pid[rows.slave][:, None]                  # [row, corner]
-    at_copy = same.any(axis=1) & (pid[rows.slave] >= 0)
-    slave, face, normal = rows.slave.copy(), rows.face.copy(), rows.normal.copy()
-    copy = rows.master[np.arange(len(rows)), same.argmax(axis=1)]
-    reverse = at_copy & ((vf[slave] < vf[copy]) | ((vf[slave] == vf[copy]) & (slave < copy)))
-    r = np.flatnonzero(reverse)
-    partner = _partner_at(index, face[r], slave[r])
-    r, partner = r[partner >= 0], partner[partner >= 0]
-    slave[r], copy[r], face[r] = copy[r], slave[r], partner
-    master = F[face]
-    normal[at_copy] = index.unit[face[at_copy]]          # the face's unit normal, computed as here
-    bary = rows.bary.copy()
-    bary[at_copy] = (master[at_copy] == copy[at_copy, None]).astype(np.float64)
-    g = rows.g.copy()
-    g[at_copy] = 0.0                                      # n . (X_s - X_t), the copies' points equal
+    # C++ (cpp_ext/copies3d.cpp), what numpy computed row by row: the first corner of the
+    # face at the slave's point, the fixed rows' direction (the copy's row on the partner
+    # face at the slave, where there is one), bary 1 at the copy, g 0, the face's unit normal
+    slave, master, face, bary, normal, g, at_copy = _ext.FoundRowsAtCopies(
+        F, index.point, vf, index.key_order, index.key_start, index.key_count, index.unit, rows.slave,
+        rows.master, rows.face, rows.bary, rows.normal, rows.g)
     out = NodeToFaceRows(slave=slave, master=master, face=face, bary=bary, normal=normal, dist=rows.dist.copy(),
                          g=g, nv=rows.nv)
     return out, at_copy
