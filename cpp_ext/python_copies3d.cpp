@@ -10,6 +10,19 @@ namespace py = pybind11;
 using namespace ngfracture;
 using namespace ngfracture::bindings;
 
+namespace
+{
+  // every face's run of faces on its points, [key_start, key_start + key_count), inside
+  // key_order (nf entries)
+  void CheckKeyRuns (const char * fn, const LArr & key_start, const LArr & key_count, int64_t nf)
+  {
+    for (int64_t f = 0; f < nf; f++)
+      if (key_start.data()[f] < 0 || key_count.data()[f] < 0 || key_start.data()[f] + key_count.data()[f] > nf)
+        throw std::invalid_argument(std::string("ngfracture.") + fn + ": key_start and key_count of face "
+                                    + std::to_string(f) + " leave key_order");
+  }
+}
+
 void ExportCopies3d (py::module & m)
 {
   m.def("PartnerAt",
@@ -25,10 +38,7 @@ void ExportCopies3d (py::module & m)
           Check(fn, "vertex", vertex, 1, 0, face.shape(0));
           CheckRange(fn, "key_order", key_order, nf);
           CheckRange(fn, "face", face, nf);
-          for (int64_t f = 0; f < nf; f++)
-            if (key_start.data()[f] < 0 || key_count.data()[f] < 0 || key_start.data()[f] + key_count.data()[f] > nf)
-              throw std::invalid_argument("ngfracture.PartnerAt: key_start and key_count of face " + std::to_string(f)
-                                          + " leave key_order");
+          CheckKeyRuns(fn, key_start, key_count, nf);
           py::array_t<int64_t> out(face.shape(0));
           {
             py::gil_scoped_release release;
@@ -71,10 +81,7 @@ numpy.ndarray of int64
           CheckRange(fn, "slave", slave, nv);
           CheckRange(fn, "master", master, nv);
           CheckRange(fn, "face", face, nf);
-          for (int64_t f = 0; f < nf; f++)
-            if (key_start.data()[f] < 0 || key_count.data()[f] < 0 || key_start.data()[f] + key_count.data()[f] > nf)
-              throw std::invalid_argument("ngfracture.FoundRowsAtCopies: key_start and key_count of face "
-                                          + std::to_string(f) + " leave key_order");
+          CheckKeyRuns(fn, key_start, key_count, nf);
           // the outputs: copies of the rows' arrays, changed in place
           LArr S(m), M({ m, int64_t(3) }), Fc(m);
           DArr B({ m, int64_t(3) }), N({ m, int64_t(3) }), G(m);
