@@ -27,6 +27,7 @@ from ngfracture.linalg.kkt import ConstrainedSolver
 from ngfracture import Simulation
 from ngfracture.mechanics.tangent import base_pins
 
+from bordered_util import check_random_solve
 from test_contact_fractured import crack_bands, plate_mesh
 from test_kkt_paths import random_kkt_load, whole_kkt_solution
 
@@ -164,19 +165,7 @@ def test_every_bordered_solve_of_a_plate_run_solves_its_kkt_system(monkeypatch):
         checked.append(len(self.factor._border))
         if len(checked) % 10 or self.path != "schur" or getattr(self, "_coarse", None) is None:
             return
-        rng = np.random.default_rng(len(checked))
-        K, ndof, free = self.factor.K, self.ndof, self.free
-        r = np.where(free, rng.standard_normal(ndof), 0.0)
-        du_fixed = np.zeros(ndof)
-        du_fixed[np.asarray(fixed_dofs)] = 1e-6 * rng.standard_normal(len(fixed_dofs))
-        h = 1e-6 * rng.standard_normal(self.m)
-        du, lam = self.solve(r, du_fixed, h)
-        force = (K @ du + self.C.T @ lam - r)[free]
-        force_scale = (abs(K) @ np.abs(du) + abs(self.C.T) @ np.abs(lam) + np.abs(r))[free]
-        assert np.linalg.norm(force) <= 1e-12 * np.linalg.norm(force_scale)
-        assert np.array_equal(du[~free], du_fixed[~free])
-        rows = self.C @ du - h
-        assert np.all(np.abs(rows) <= 1e-12 * (abs(self.C) @ np.abs(du) + np.abs(h)))
+        check_random_solve(self, fixed_dofs, len(checked))
 
     monkeypatch.setattr(ConstrainedSolver, "__init__", checking_init)
     result = Simulation(scenes.plate(maxh=0.05)).run()

@@ -30,6 +30,7 @@ from ngfracture.linalg.kkt import ConstrainedSolver
 from ngfracture.mechanics.tangent import base_pins
 from ngfracture.scenes import sphere3d
 
+from bordered_util import check_random_solve
 from split3d_util import cube_bar
 from test_kkt_paths import kkt_forward_tolerance, whole_kkt_solution
 
@@ -202,23 +203,11 @@ def test_every_tenth_bordered_solve_of_a_coarse_sphere_run_solves_its_kkt_system
         if (len(checked) - 1) % 10 or getattr(self, "_coarse", None) is None:
             return
         assert self._Z is None                               # the base's K^-1 on the rows' dofs
-        rng = np.random.default_rng(len(checked))
-        K, ndof, free = self.factor.K, self.ndof, self.free
-        fixed = np.asarray(fixed_dofs)
-        r = np.where(free, rng.standard_normal(ndof), 0.0)
-        du_fixed = np.zeros(ndof)
-        du_fixed[fixed] = 1e-6 * rng.standard_normal(len(fixed))
-        h = 1e-6 * rng.standard_normal(self.m)
-        du, lam = self.solve(r, du_fixed, h)
-        force = (K @ du + self.C.T @ lam - r)[free]
-        force_scale = (abs(K) @ np.abs(du) + abs(self.C.T) @ np.abs(lam) + np.abs(r))[free]
-        assert np.linalg.norm(force) <= 1e-12 * np.linalg.norm(force_scale)
-        assert np.array_equal(du[~free], du_fixed[~free])
-        rows = self.C @ du - h
-        assert np.all(np.abs(rows) <= 1e-12 * (abs(self.C) @ np.abs(du) + np.abs(h)))
+        r, du_fixed, h, du, lam = check_random_solve(self, fixed_dofs, len(checked))
         if not against_fresh or len(checked) != 11:
             return
         compared.append(len(self.factor._border))
+        K, fixed = self.factor.K, np.asarray(fixed_dofs)
         fresh = EliminatedFactor(K, fixed, self.factor.pins, schur_by_dofs=True)
         other = ConstrainedSolver(None, fixed, self.C, modes=kwargs.get("modes"), pins=self.factor.pins,
                                   factor=fresh, path="schur")
