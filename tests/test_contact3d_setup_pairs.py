@@ -28,7 +28,7 @@ from ngfracture.contact.edge_crossings3d import EdgeCrossingDetector
 from ngfracture.contact.edge_rows3d import two_faces
 from ngfracture.contact.intsets import unique_ints
 from ngfracture.contact.junctions3d import covered_pairs, fragment_pair_rows
-from ngfracture.contact.kinks3d import CopyIndex, copy_pairs, equal_key_pairs, partner_faces
+from ngfracture.contact.kinks3d import CopyIndex, copy_pairs, expand_ranges, partner_faces
 from ngfracture.contact.rows3d import NodeToFaceRows, lip_rows
 from ngfracture.contact.setup3d import vertex_fragments
 from ngfracture.contact.wedges3d import diagonal_edges
@@ -38,6 +38,14 @@ from test_contact3d_setup_kernels import BODIES, assert_same, box
 
 
 # -- the numpy references ---------------------------------------------------------------
+
+def equal_key_pairs(key):
+    """Every ordered pair (i, j) of positions of a sorted array with equal values, i == j
+    included: i increasing, then j."""
+    first = np.searchsorted(key, key)                                      # start of each value's run
+    size = np.searchsorted(key, key, side="right") - first
+    return expand_ranges(first, size)
+
 
 def reference_copy_pairs(index):
     """kinks3d.copy_pairs in numpy."""

@@ -28,7 +28,7 @@ from .. import _ngfracture as _ext
 from .intsets import isin_ints, sorted_members, unique_ints
 
 __all__ = ["KINK", "CopyIndex", "point_groups", "point_ids", "face_point_keys", "partner_faces", "copy_pairs",
-           "equal_key_pairs", "expand_ranges",
+           "expand_ranges",
            "sorted_members", "unique_ints", "isin_ints"]
 
 #: 1 - cos of the smallest angle between a lip's face and the face of its one row for which
@@ -237,27 +237,10 @@ def copy_pairs(index):
     s, t : numpy.ndarray of int64
         The pairs, point by point in the index's order.
     """
-    # C++ (cpp_ext/contact_setup3d.cpp): index.on at equal_key_pairs(index.group), the same
-    # arrays (tests/test_contact3d_setup_kernels.py keeps the numpy computation and compares)
+    # C++ (cpp_ext/contact_setup3d.cpp): index.on at every ordered pair of positions in a run
+    # of equal groups, the same arrays (tests/test_contact3d_setup_pairs.py keeps the numpy
+    # computation and compares)
     return _ext.CopyPairs(index.on, index.group)
-
-
-def equal_key_pairs(key):
-    """Every ordered pair (i, j) of positions of a sorted array with equal values, i == j included.
-
-    Parameters
-    ----------
-    key : numpy.ndarray, shape (m,)
-        Sorted values.
-
-    Returns
-    -------
-    i, j : numpy.ndarray of int
-        The pairs, i increasing, then j.
-    """
-    first = np.searchsorted(key, key)                                      # start of each value's run
-    size = np.searchsorted(key, key, side="right") - first
-    return expand_ranges(first, size)
 
 
 def expand_ranges(start, count):
