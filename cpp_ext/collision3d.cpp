@@ -463,6 +463,33 @@ namespace ngfracture
         }
     }
 
+    // hits sorted by (vertex, fragment, tet), as std::sort sorts them: a counting sort by
+    // vertex, then an insertion sort of every vertex's few hits (std::sort past 64; the
+    // pairs (vertex, fragment) are distinct, so the order is the same whatever the method)
+    void SortHits (std::vector<Hit> & hits, int64_t nv)
+    {
+      if (hits.empty()) return;
+      std::vector<int32_t> start(nv + 1, 0);
+      for (const Hit & h : hits) start[std::get<0>(h) + 1]++;
+      for (int64_t v = 0; v < nv; v++) start[v+1] += start[v];
+      std::vector<Hit> sorted(hits.size());
+      {
+        std::vector<int32_t> fill(start.begin(), start.end() - 1);
+        for (const Hit & h : hits) sorted[fill[std::get<0>(h)]++] = h;
+      }
+      for (int64_t v = 0; v < nv; v++)
+        if (start[v+1] - start[v] > 64)
+          std::sort(sorted.begin() + start[v], sorted.begin() + start[v+1]);
+        else for (int32_t i = start[v] + 1; i < start[v+1]; i++)
+          {
+            Hit x = sorted[i];
+            int32_t j = i;
+            for (; j > start[v] && x < sorted[j-1]; j--) sorted[j] = sorted[j-1];
+            sorted[j] = x;
+          }
+      hits.swap(sorted);
+    }
+
     // Every (boundary vertex, tetrahedron of another fragment) with the vertex in the
     // closed tetrahedron, and (lip vertex, tetrahedron of its own fragment not at the
     // vertex): each tetrahedron's box swept over the vertex grid. A pair found in a
@@ -534,7 +561,7 @@ namespace ngfracture
         }
       st.box_tests += box_tests;
       st.closed_seams = closed;
-      std::sort(hits.begin(), hits.end());
+      SortHits(hits, m.nv);
       return hits;
     }
 
@@ -564,10 +591,10 @@ namespace ngfracture
     // exactly, though not always v's averaged normal: where several cracks meet, a copy's
     // wedge can be bounded by faces that the averaged normal of a neighbouring copy does
     // not oppose, and v, in that wedge, is nearest to them.
-    std::vector<int32_t> PartnerFaces (const TetMesh3 & m, const Copies & copies, const Derived & D,
-                                       const VertexFaces & vfaces, int32_t v, int32_t F)
+    void PartnerFaces (const TetMesh3 & m, const Copies & copies, const Derived & D,
+                       const VertexFaces & vfaces, int32_t v, int32_t F, std::vector<int32_t> & out)
     {
-      std::vector<int32_t> out;
+      out.clear();
       const auto & grp = copies.group;
       auto others = [&] (int32_t f, int32_t c, int32_t & a, int32_t & b)
         {
@@ -594,7 +621,6 @@ namespace ngfracture
             }
         }
       std::sort(out.begin(), out.end());
-      return out;
     }
 
     // Every vertex w of the reference star of c (the vertices of the tetrahedra at c,
@@ -656,12 +682,11 @@ namespace ngfracture
           int32_t f = vfaces.at[i];
           const int32_t * T = m.faces + 3*f;
           if (!in_tet(T[0]) || !in_tet(T[1]) || !in_tet(T[2])) continue;
-          double e0[3], e1[3], n[3];
-          Sub(m.X + 3*T[1], m.X + 3*T[0], e0); Sub(m.X + 3*T[2], m.X + 3*T[0], e1); Cross(e0, e1, n);
-          double len = std::sqrt(Dot(n, n));
+          double e0[3], e1[3], n[3], nref[3];
+          Sub(m.X + 3*T[1], m.X + 3*T[0], e0); Sub(m.X + 3*T[2], m.X + 3*T[0], e1); Cross(e0, e1, nref);
+          double len = std::sqrt(Dot(nref, nref));
           if (!(len > 0)) continue;
-          for (int d = 0; d < 3; d++) n[d] /= len;
-          if (lips_only ? !IsLip(m, *lips_of, vfaces, f) : (tet && !StarOnSide(m, topo, v, n, 1.0))) continue;
+          for (int d = 0; d < 3; d++) nref[d] /= len;
           Sub(m.x + 3*T[1], m.x + 3*T[0], e0); Sub(m.x + 3*T[2], m.x + 3*T[0], e1); Cross(e0, e1, n);
           len = std::sqrt(Dot(n, n));
           if (!(len > 0)) continue;
@@ -669,7 +694,10 @@ namespace ngfracture
           Sub(m.x + 3*v, m.x + 3*t, r);
           double s = Dot(n, r) / len;
           if (!tet && !(s < 0)) continue;              // the whole star: faces v is behind
-          if (s > best_s || (s == best_s && f < best)) { best_s = s; best = f; }
+          if (!(s > best_s || (s == best_s && f < best))) continue;
+          // the tests on the mesh last: they decide only for a face that would be the best
+          if (lips_only ? !IsLip(m, *lips_of, vfaces, f) : (tet && !StarOnSide(m, topo, v, nref, 1.0))) continue;
+          best_s = s; best = f;
         }
       if (behind_only && !(best_s < 0)) best = -1;
       depth = best >= 0 ? std::max(0.0, -best_s) : 0.0;
@@ -705,6 +733,10 @@ namespace ngfracture
       fg.Visit(fg.Cell(p[0], 0), fg.Cell(p[1], 1), fg.Cell(p[2], 2), [&] (int32_t f)
         {
           if (D.ffrag[f] != F || (found >= 0 && f > found)) return;
+          // a point of the closed triangle lies in its closed box (exactly: the box of
+          // its corners): one outside is not held, without the exact predicates
+          for (int d = 0; d < 3; d++)
+            if (p[d] < D.flo[3*f+d] || p[d] > D.fhi[3*f+d]) return;
           if (!(Dot(&D.fnormal[3*f], &D.vnormal[3*v]) <= 0) && !IsPartner(partners, f)) return;
           const int32_t * T = m.faces + 3*f;
           if (AtVertex(T, v)) return;
@@ -926,6 +958,7 @@ namespace ngfracture
           incidence = &own;
         }
       const VertexFaces & vfaces = incidence->vfaces;
+      std::vector<int32_t> partners;                       // of the hit at hand
       for (size_t s = 0; s < hits.size(); s++)
         {
           auto [v, F, t] = hits[s];
@@ -968,8 +1001,8 @@ namespace ngfracture
               out.push_back(pen);
               continue;
             }
-          std::vector<int32_t> partners;
-          if (pen.twin >= 0) partners = PartnerFaces(m, copies, D, vfaces, v, F);
+          partners.clear();
+          if (pen.twin >= 0) PartnerFaces(m, copies, D, vfaces, v, F, partners);
           if (!MasterFace(m, D, fg, v, F, partners, pen)) continue;
           out.push_back(pen);
         }

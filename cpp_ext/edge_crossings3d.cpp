@@ -50,10 +50,11 @@ namespace ngfracture
         for (int d = 0; d < 3; d++) { r[d] = Cell(lo[d], d); r[3+d] = Cell(hi[d], d); }
       }
 
-      // cell size: the mean largest extent of a box, at least 2^-20 of the boxes' span,
-      // doubled while the boxes would fill more than 32 n + 2^20 cells; returns false
-      // (nothing hashed) when every box is a point
-      bool Build (const std::vector<double> & lo, const std::vector<double> & hi)
+      // The cells of boxes lo..hi: cell size the mean largest extent of a box, at least
+      // 2^-20 of the boxes' span, doubled while the boxes would fill more than 32 n + 2^20
+      // cells; range gets every box's first and last cell along x, y, z. Returns false
+      // (nothing to hash) when every box is a point.
+      bool Measure (const std::vector<double> & lo, const std::vector<double> & hi, std::vector<int32_t> & range)
       {
         size_t n = lo.size() / 3;
         double top[3] = { -INFINITY, -INFINITY, -INFINITY }, extent = 0;
@@ -72,12 +73,11 @@ namespace ngfracture
         h = n ? extent / double(n) : 0;
         if (!(h > 0) || !std::isfinite(h)) { h = 0; return false; }
         for (int d = 0; d < 3; d++) h = std::max(h, (top[d] - origin[d]) / double(1 << 20));
-        std::vector<int32_t> range(6 * n);
-        int64_t count = 0;
+        range.resize(6 * n);
         // boxes far larger than the mean would fill too many cells: coarser cells then
         for (bool fits = false; !fits; h *= fits ? 1.0 : 2.0)
           {
-            count = 0;
+            int64_t count = 0;
             for (size_t t = 0; t < n; t++)
               {
                 Range(&lo[3*t], &hi[3*t], &range[6*t]);
@@ -85,6 +85,18 @@ namespace ngfracture
                 count += int64_t(r[3] - r[0] + 1) * (r[4] - r[1] + 1) * (r[5] - r[2] + 1);
               }
             fits = count <= 32 * int64_t(n) + (int64_t(1) << 20);
+          }
+        return true;
+      }
+
+      // hashes items 0 .. n-1 with cell ranges `range` (6 each, in this grid's cells)
+      void Fill (const std::vector<int32_t> & range, size_t n)
+      {
+        int64_t count = 0;
+        for (size_t t = 0; t < n; t++)
+          {
+            const int32_t * r = &range[6*t];
+            count += int64_t(r[3] - r[0] + 1) * (r[4] - r[1] + 1) * (r[5] - r[2] + 1);
           }
         int bits = 4;
         while ((int64_t(1) << bits) < count) bits++;
@@ -101,7 +113,6 @@ namespace ngfracture
             Cells(r, [&] (int32_t i, int32_t j, int32_t k)
               { entries[fill[Bucket(i, j, k)]++] = Entry { { i, j, k }, int32_t(t), { r[0], r[1], r[2] } }; });
           }
-        return true;
       }
     };
 
@@ -258,25 +269,40 @@ namespace ngfracture
           lo[3*f+d] = std::min({ a, b, c });
           hi[3*f+d] = std::max({ a, b, c });
         }
+    // the cells are the faces' (size and origin from their boxes); the edges swept are
+    // hashed and every face visits its cells: each (edge, face) pair is tested in the
+    // first cell both boxes' ranges share, as a sweep of the edges over the faces would
     BoxHash grid;
-    if (!grid.Build(lo, hi)) { if (stats) *stats = st; return out; }
+    std::vector<int32_t> frange;
+    if (!grid.Measure(lo, hi, frange)) { if (stats) *stats = st; return out; }
     st.cell = grid.h;
     std::vector<std::pair<int32_t, int32_t>> pierces;   // (edge, face)
     int64_t ne = int64_t(edges_.size() / 2);
     // an interlocking pair is found from the sweep of either edge (a pierces a face at b and
     // b one at a): an edge whose two ends lie on closed lips is left to the other edge
     std::vector<char> closed = Closed(x);
+    std::vector<int32_t> swept, erange, own;            // the edges swept, their cells, fragments
+    std::vector<double> ebox;                           // their boxes, lo then hi
     for (int32_t e = 0; e < ne; e++)
       {
         const int32_t u = edges_[2*e], w = edges_[2*e+1];
         if (closed[u] && closed[w]) { st.closed_edges++; continue; }
         if (skip && (skip[u] || skip[w])) { st.skipped_edges++; continue; }
-        const int32_t own = fragment_[edge_faces_[edge_face_ptr_[e]]];
         const double * p = x + 3*u, * q = x + 3*w;
-        double elo[3], ehi[3];
-        int32_t r[6];
-        for (int d = 0; d < 3; d++) { elo[d] = std::min(p[d], q[d]); ehi[d] = std::max(p[d], q[d]); }
-        grid.Range(elo, ehi, r);
+        double b[6];
+        for (int d = 0; d < 3; d++) { b[d] = std::min(p[d], q[d]); b[3+d] = std::max(p[d], q[d]); }
+        swept.push_back(e);
+        own.push_back(fragment_[edge_faces_[edge_face_ptr_[e]]]);
+        ebox.insert(ebox.end(), b, b + 6);
+        erange.resize(erange.size() + 6);
+        grid.Range(b, b + 3, &erange[erange.size() - 6]);
+      }
+    if (swept.empty()) { if (stats) *stats = st; return out; }
+    grid.Fill(erange, swept.size());
+    for (int32_t f = 0; f < int32_t(nf_); f++)
+      {
+        const int32_t * r = &frange[6*f];
+        const int32_t * t = &faces_[3*f];
         BoxHash::Cells(r, [&] (int32_t i, int32_t j, int32_t k)
           {
             size_t bucket = grid.Bucket(i, j, k);
@@ -288,16 +314,17 @@ namespace ngfracture
                     || std::max(r[0], en.first[0]) != i || std::max(r[1], en.first[1]) != j
                     || std::max(r[2], en.first[2]) != k)
                   continue;
-                int32_t f = en.item;
-                const int32_t * t = &faces_[3*f];
-                if (Shares(t, u) || Shares(t, w) || (across_ && fragment_[f] == own)) continue;
+                const int32_t a = en.item, e = swept[a];
+                const int32_t u = edges_[2*e], w = edges_[2*e+1];
+                if (Shares(t, u) || Shares(t, w) || (across_ && fragment_[f] == own[a])) continue;
                 st.box_tests++;
+                const double * elo = &ebox[6*a], * ehi = elo + 3;
                 bool overlap = true;              // strict: a pierce point lies inside both boxes
                 for (int d = 0; d < 3; d++)
                   overlap &= elo[d] < hi[3*f+d] && lo[3*f+d] < ehi[d];
                 if (!overlap) continue;
                 st.exact_tests++;
-                if (SegmentPiercesTriangle(p, q, x + 3*t[0], x + 3*t[1], x + 3*t[2]))
+                if (SegmentPiercesTriangle(x + 3*u, x + 3*w, x + 3*t[0], x + 3*t[1], x + 3*t[2]))
                   pierces.emplace_back(e, f);
               }
           });

@@ -37,14 +37,20 @@ namespace ngfracture
     // one of IndependentRowsDense, at a cost proportional to the supports.
     struct SupportQR
     {
-      int64_t n;
+      int64_t n = 0, nq = 0;                     // columns, basis vectors
       std::vector<double> Q;                     // orthonormal basis, row by row (dense)
-      std::vector<std::vector<int32_t>> qsupp;   // support of every basis vector
+      std::vector<std::vector<int32_t>> qsupp;   // support of every basis vector (the first nq)
       std::vector<std::vector<int32_t>> colq;    // basis vectors whose support holds a column
       std::vector<char> mark;                    // per basis vector: to visit in this pass
-      std::vector<int32_t> merged;
+      std::vector<int32_t> merged, fresh;
 
-      explicit SupportQR (int64_t n_) : n(n_), colq(n_) { }
+      // an empty basis over n columns; the vectors keep their memory from the last use
+      void Reset (int64_t n_)
+      {
+        n = n_; nq = 0;
+        if (int64_t(colq.size()) < n) colq.resize(n);
+        for (int64_t c = 0; c < n; c++) colq[c].clear();
+      }
 
       static double Dot (const double * a, const std::vector<int32_t> & supp, const double * b)
       {
@@ -72,8 +78,6 @@ namespace ngfracture
       // Orthogonalise, visiting only the basis vectors that meet v's support.
       void Orthogonalise (double * v, std::vector<int32_t> & supp)
       {
-        int64_t nq = int64_t(qsupp.size());
-        std::vector<int32_t> fresh;
         for (int pass = 0; pass < 2; pass++)
           {
             mark.assign(nq, 0);
@@ -97,11 +101,13 @@ namespace ngfracture
       // Append v / |v| (v orthogonalised, its norm r) to the basis.
       void Append (const double * v, const std::vector<int32_t> & supp, double r)
       {
-        int64_t j = int64_t(qsupp.size());
-        Q.resize((j + 1) * n, 0.0);
+        int64_t j = nq++;
+        if (int64_t(Q.size()) < nq * n) Q.resize(nq * n);
         double * q = &Q[j*n];
+        std::fill(q, q + n, 0.0);
         for (int32_t c : supp) q[c] = v[c] / r;
-        qsupp.push_back(supp);
+        if (int64_t(qsupp.size()) < nq) qsupp.resize(nq);
+        qsupp[j] = supp;
         for (int32_t c : supp) colq[c].push_back(int32_t(j));
       }
     };
@@ -115,79 +121,117 @@ namespace ngfracture
       return -1;
     }
 
-    std::vector<int32_t> Support (const double * v, int64_t n)
+    // supp := the columns c < n where v[c] != 0, increasing
+    void Support (const double * v, int64_t n, std::vector<int32_t> & supp)
     {
-      std::vector<int32_t> supp;
+      supp.clear();
       for (int64_t c = 0; c < n; c++)
         if (v[c] != 0.0) supp.push_back(int32_t(c));
-      return supp;
+    }
+
+    // The memory of IndependentRows, kept from one component to the next (a component's
+    // vectors are small and many: allocating them each time cost as much as the QR).
+    struct QRWork
+    {
+      SupportQR qr;
+      std::vector<double> v, R, norm0, res;
+      std::vector<std::vector<int32_t>> supp, colrows;
+      std::vector<char> active;
+      std::vector<int32_t> touched, fresh;
+      std::vector<int64_t> stamp;
+    };
+
+    // vs[0 .. n) cleared (their memory kept)
+    void ClearFirst (std::vector<std::vector<int32_t>> & vs, int64_t n)
+    {
+      if (int64_t(vs.size()) < n) vs.resize(n);
+      for (int64_t i = 0; i < n; i++) vs[i].clear();
+    }
+
+    std::vector<int32_t> IndependentRowsIn (QRWork & w, const double * A, int64_t k, int64_t n,
+                                            const double * G, int64_t p, double rtol)
+    {
+      SupportQR & qr = w.qr;
+      qr.Reset(n);
+      std::vector<double> & v = w.v;
+      v.resize(n);
+      std::vector<int32_t> & vsupp = w.fresh;
+      for (int64_t i = 0; i < p; i++)
+        {
+          std::copy(G + i*n, G + (i+1)*n, v.begin());
+          Support(v.data(), n, vsupp);
+          double n0 = std::sqrt(SupportQR::Dot(v.data(), vsupp, v.data()));
+          if (!(n0 > 0)) continue;
+          qr.Orthogonalise(v.data(), vsupp);
+          double r = std::sqrt(SupportQR::Dot(v.data(), vsupp, v.data()));
+          if (r > rtol * n0) qr.Append(v.data(), vsupp, r);
+        }
+      // Residuals of the rows of A with the Dirichlet span removed.
+      std::vector<double> & R = w.R, & norm0 = w.norm0, & res = w.res;
+      R.assign(A, A + k*n);
+      norm0.assign(k, 0.0);
+      res.assign(k, 0.0);
+      ClearFirst(w.supp, k);
+      ClearFirst(w.colrows, n);
+      auto & supp = w.supp;
+      auto & colrows = w.colrows;
+      std::vector<char> & active = w.active;
+      active.assign(k, 1);
+      for (int64_t i = 0; i < k; i++)
+        {
+          Support(&R[i*n], n, supp[i]);
+          norm0[i] = std::sqrt(SupportQR::Dot(&R[i*n], supp[i], &R[i*n]));
+          if (!(norm0[i] > 0)) { active[i] = 0; continue; }
+          qr.Orthogonalise(&R[i*n], supp[i]);
+          res[i] = std::sqrt(SupportQR::Dot(&R[i*n], supp[i], &R[i*n])) / norm0[i];
+          for (int32_t c : supp[i]) colrows[c].push_back(int32_t(i));
+        }
+      std::vector<int32_t> picked;
+      std::vector<int32_t> & touched = w.touched, & fresh = w.fresh;
+      std::vector<int64_t> & stamp = w.stamp;
+      stamp.assign(k, -1);
+      while (true)
+        {
+          double best = 0;
+          for (int64_t i = 0; i < k; i++)
+            if (active[i]) best = std::max(best, res[i]);
+          if (!(best > rtol)) break;
+          int64_t j = FirstPivot(active, res, best);
+          active[j] = 0;
+          picked.push_back(int32_t(j));
+          double * q = &R[j*n];
+          qr.Orthogonalise(q, supp[j]);               // re-orthogonalise the pivot
+          double r = std::sqrt(SupportQR::Dot(q, supp[j], q));
+          int64_t jq = qr.nq;
+          qr.Append(q, supp[j], r);
+          const double * qq = &qr.Q[jq*n];
+          const auto & qs = qr.qsupp[jq];
+          // the active rows meeting q's support; the others change by zeros only
+          touched.clear();
+          for (int32_t c : qs)
+            for (int32_t i : colrows[c])
+              if (active[i] && stamp[i] != jq) { stamp[i] = jq; touched.push_back(i); }
+          for (int32_t i : touched)
+            {
+              double * ri = &R[int64_t(i)*n];
+              double alpha = -SupportQR::Dot(qq, qs, ri);
+              if (alpha == 0.0) continue;
+              for (int32_t c : qs) ri[c] += alpha * qq[c];
+              fresh.clear();
+              qr.Merge(supp[i], qs, fresh);
+              for (int32_t c : fresh) colrows[c].push_back(i);
+              res[i] = std::sqrt(SupportQR::Dot(ri, supp[i], ri)) / norm0[i];
+            }
+        }
+      return picked;
     }
   }
 
   std::vector<int32_t> IndependentRows (const double * A, int64_t k, int64_t n,
                                         const double * G, int64_t p, double rtol)
   {
-    SupportQR qr(n);
-    std::vector<double> v(n);
-    for (int64_t i = 0; i < p; i++)
-      {
-        std::copy(G + i*n, G + (i+1)*n, v.begin());
-        auto supp = Support(v.data(), n);
-        double n0 = std::sqrt(SupportQR::Dot(v.data(), supp, v.data()));
-        if (!(n0 > 0)) continue;
-        qr.Orthogonalise(v.data(), supp);
-        double r = std::sqrt(SupportQR::Dot(v.data(), supp, v.data()));
-        if (r > rtol * n0) qr.Append(v.data(), supp, r);
-      }
-    // Residuals of the rows of A with the Dirichlet span removed.
-    std::vector<double> R(A, A + k*n), norm0(k), res(k);
-    std::vector<std::vector<int32_t>> supp(k), colrows(n);
-    std::vector<char> active(k, 1);
-    for (int64_t i = 0; i < k; i++)
-      {
-        supp[i] = Support(&R[i*n], n);
-        norm0[i] = std::sqrt(SupportQR::Dot(&R[i*n], supp[i], &R[i*n]));
-        if (!(norm0[i] > 0)) { active[i] = 0; continue; }
-        qr.Orthogonalise(&R[i*n], supp[i]);
-        res[i] = std::sqrt(SupportQR::Dot(&R[i*n], supp[i], &R[i*n])) / norm0[i];
-        for (int32_t c : supp[i]) colrows[c].push_back(int32_t(i));
-      }
-    std::vector<int32_t> picked, touched, fresh;
-    std::vector<int64_t> stamp(k, -1);
-    while (true)
-      {
-        double best = 0;
-        for (int64_t i = 0; i < k; i++)
-          if (active[i]) best = std::max(best, res[i]);
-        if (!(best > rtol)) break;
-        int64_t j = FirstPivot(active, res, best);
-        active[j] = 0;
-        picked.push_back(int32_t(j));
-        double * q = &R[j*n];
-        qr.Orthogonalise(q, supp[j]);               // re-orthogonalise the pivot
-        double r = std::sqrt(SupportQR::Dot(q, supp[j], q));
-        int64_t jq = int64_t(qr.qsupp.size());
-        qr.Append(q, supp[j], r);
-        const double * qq = &qr.Q[jq*n];
-        const auto & qs = qr.qsupp[jq];
-        // the active rows meeting q's support; the others change by zeros only
-        touched.clear();
-        for (int32_t c : qs)
-          for (int32_t i : colrows[c])
-            if (active[i] && stamp[i] != jq) { stamp[i] = jq; touched.push_back(i); }
-        for (int32_t i : touched)
-          {
-            double * ri = &R[int64_t(i)*n];
-            double alpha = -SupportQR::Dot(qq, qs, ri);
-            if (alpha == 0.0) continue;
-            for (int32_t c : qs) ri[c] += alpha * qq[c];
-            fresh.clear();
-            qr.Merge(supp[i], qs, fresh);
-            for (int32_t c : fresh) colrows[c].push_back(i);
-            res[i] = std::sqrt(SupportQR::Dot(ri, supp[i], ri)) / norm0[i];
-          }
-      }
-    return picked;
+    QRWork w;
+    return IndependentRowsIn(w, A, k, n, G, p, rtol);
   }
 
   std::vector<int32_t> IndependentRowsDense (const double * A, int64_t k, int64_t n,
@@ -414,6 +458,8 @@ namespace ngfracture
               { return glabel[a] != glabel[b] ? glabel[a] < glabel[b] : a < b; });
 
     std::vector<int32_t> colmap(ndof, -1), cols;
+    QRWork work;                                  // the pivoted QR's memory, for every component
+    std::vector<double> A, Gd;
     size_t gpos = 0;
     for (size_t s0 = 0; s0 < rows.size(); )
       {
@@ -480,14 +526,15 @@ namespace ngfracture
           {
             // Pivoting prefers the lowest index among equal residuals: input order.
             std::sort(rows.begin() + s0, rows.begin() + s1);
-            std::vector<double> A(k * nc, 0.0), Gd(pg * nc, 0.0);
+            A.assign(k * nc, 0.0);
+            Gd.assign(pg * nc, 0.0);
             for (size_t s = s0; s < s1; s++)
               for (int64_t t = indptr[rows[s]]; t < indptr[rows[s]+1]; t++)
                 A[(s - s0) * nc + colmap[indices[t]]] += data[t];
             for (size_t s = g0; s < g1; s++)
               for (int64_t t = gindptr[grows[s]]; t < gindptr[grows[s]+1]; t++)
                 Gd[(s - g0) * nc + colmap[gindices[t]]] += gdata[t];
-            for (int32_t j : IndependentRows(A.data(), k, nc, Gd.data(), pg, rtol))
+            for (int32_t j : IndependentRowsIn(work, A.data(), k, nc, Gd.data(), pg, rtol))
               kept.push_back(rows[s0 + j]);
           }
         for (int32_t c : cols) colmap[c] = -1;
