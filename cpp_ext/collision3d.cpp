@@ -490,6 +490,76 @@ namespace ngfracture
       hits.swap(sorted);
     }
 
+    // The closed blocks of 2 x 2 x 2 cells of a dense grid (block (I, J, K) holds cells
+    // (2I .. 2I+1, 2J .. 2J+1, 2K .. 2K+1)): a tetrahedron of fragment F whose cells all
+    // lie in blocks closed for F finds nothing in them (each of their non-empty cells is
+    // closed with F among its fragments, ClosedCells), and is not swept cell by cell.
+    struct ClosedBlocks
+    {
+      int64_t span2 = 0;                       // blocks per axis (none: no closed cells)
+      // per block: -2 if its cells are empty, the number in ``sets`` of the fragments every
+      // non-empty cell of the block has in its set (padded with -1), or -1 where a
+      // non-empty cell is not closed or no fragment is in every set
+      std::vector<int32_t> block_set;
+      std::vector<std::array<int32_t,8>> sets;
+
+      ClosedBlocks () = default;
+      ClosedBlocks (const HashGrid & g, const std::vector<int32_t> & closed_set,
+                    const std::vector<std::array<int32_t,8>> & cell_sets)
+        : span2((g.span + 1) / 2), block_set(size_t(span2 * span2 * span2), -2)
+      {
+        for (int64_t b = 0; b < int64_t(block_set.size()); b++)
+          {
+            int64_t I = b / (span2 * span2), J = b / span2 % span2, K = b % span2;
+            std::array<int32_t,8> common;
+            int32_t & out = block_set[b];
+            for (int64_t i = 2*I; i < std::min(2*I + 2, g.span) && out != -1; i++)
+              for (int64_t j = 2*J; j < std::min(2*J + 2, g.span) && out != -1; j++)
+                for (int64_t k = 2*K; k < std::min(2*K + 2, g.span) && out != -1; k++)
+                  {
+                    int64_t c = g.Linear(i, j, k);
+                    if (g.first[c] == g.first[c+1]) continue;
+                    int32_t e = closed_set[c];
+                    if (e < 0) { out = -1; break; }
+                    if (out == -2) { common = cell_sets[e]; out = 0; continue; }
+                    // common := common and cell_sets[e], in common's order
+                    int n = 0;
+                    for (int32_t F : common)
+                      if (F >= 0 && std::find(cell_sets[e].begin(), cell_sets[e].end(), F) != cell_sets[e].end())
+                        common[n++] = F;
+                    std::fill(common.begin() + n, common.end(), -1);
+                    if (n == 0) out = -1;
+                  }
+            if (out == 0) { out = int32_t(sets.size()); sets.push_back(common); }
+          }
+      }
+
+      // every block that cells a[d] .. b[d] (not empty) lie in is closed for F
+      bool Hold (const int64_t * a, const int64_t * b, int32_t F) const
+      {
+        for (int64_t I = a[0] / 2; I <= b[0] / 2; I++)
+          for (int64_t J = a[1] / 2; J <= b[1] / 2; J++)
+            for (int64_t K = a[2] / 2; K <= b[2] / 2; K++)
+              {
+                int32_t e = block_set[(I * span2 + J) * span2 + K];
+                if (e == -2) continue;
+                if (e < 0 || std::find(sets[e].begin(), sets[e].end(), F) == sets[e].end()) return false;
+              }
+        return true;
+      }
+    };
+
+    // every vertex's cell along x, y, z, clamped to [-1, span]: Cell is monotone, so a
+    // tetrahedron's cells are those from its vertices' least to their largest
+    std::vector<int32_t> VertexCells (const TetMesh3 & m, const HashGrid & g)
+    {
+      std::vector<int32_t> vcell(3 * m.nv);
+      for (int64_t v = 0; v < m.nv; v++)
+        for (int d = 0; d < 3; d++)
+          vcell[3*v+d] = int32_t(std::clamp<int64_t>(g.Cell(m.x[3*v+d], d), -1, g.span));
+      return vcell;
+    }
+
     // Every (boundary vertex, tetrahedron of another fragment) with the vertex in the
     // closed tetrahedron, and (lip vertex, tetrahedron of its own fragment not at the
     // vertex): each tetrahedron's box swept over the vertex grid. A pair found in a
@@ -509,19 +579,27 @@ namespace ngfracture
       std::vector<int32_t> closed_set;
       std::vector<std::array<int32_t,8>> sets;
       if (!g.first.empty()) ClosedCells(g, points, decided, closed_set, sets);
+      const ClosedBlocks blocks = closed_set.empty() ? ClosedBlocks() : ClosedBlocks(g, closed_set, sets);
+      const std::vector<int32_t> vcell = VertexCells(m, g);
       for (int64_t t = 0; t < m.ne; t++)
         {
           const int32_t * T = m.tets + 4*t;
           const int32_t F = m.fragment[t];
           int orientation = 2;                              // not computed yet
-          double lo[3], hi[3];
           int64_t a[3], b[3];
+          for (int d = 0; d < 3; d++)
+            {
+              int32_t c0 = vcell[3*T[0]+d], c1 = vcell[3*T[1]+d], c2 = vcell[3*T[2]+d], c3 = vcell[3*T[3]+d];
+              a[d] = std::max(std::min(std::min(c0, c1), std::min(c2, c3)), 0);
+              b[d] = std::min<int64_t>(std::max(std::max(c0, c1), std::max(c2, c3)), g.span - 1);
+            }
+          if (a[0] > b[0] || a[1] > b[1] || a[2] > b[2]) continue;                    // no cell
+          if (!closed_set.empty() && blocks.Hold(a, b, F)) continue;
+          double lo[3], hi[3];
           for (int d = 0; d < 3; d++)
             {
               lo[d] = hi[d] = m.x[3*T[0]+d];
               for (int k = 1; k < 4; k++) { lo[d] = std::min(lo[d], m.x[3*T[k]+d]); hi[d] = std::max(hi[d], m.x[3*T[k]+d]); }
-              a[d] = std::max<int64_t>(g.Cell(lo[d], d), 0);
-              b[d] = std::min<int64_t>(g.Cell(hi[d], d), g.span - 1);
             }
           auto test = [&] (int32_t slot)
                   {

@@ -116,6 +116,34 @@ namespace ngfracture
       }
     };
 
+    // The edges a detection sweeps at x: neither both ends on closed lips nor an end to
+    // skip (those counted in st), with their fragments, boxes (lo then hi) and cells in grid.
+    struct Swept { std::vector<int32_t> edge, own, range; std::vector<double> box; };
+
+    Swept SweptEdges (const std::vector<int32_t> & edges, const std::vector<int32_t> & face_fragment,
+                      const std::vector<int32_t> & edge_faces, const std::vector<int64_t> & edge_face_ptr,
+                      const double * x, const std::vector<char> & closed, const uint8_t * skip,
+                      const BoxHash & grid, EdgeCrossingStats & st)
+    {
+      Swept sw;
+      int64_t ne = int64_t(edges.size() / 2);
+      for (int32_t e = 0; e < ne; e++)
+        {
+          const int32_t u = edges[2*e], w = edges[2*e+1];
+          if (closed[u] && closed[w]) { st.closed_edges++; continue; }
+          if (skip && (skip[u] || skip[w])) { st.skipped_edges++; continue; }
+          const double * p = x + 3*u, * q = x + 3*w;
+          double b[6];
+          for (int d = 0; d < 3; d++) { b[d] = std::min(p[d], q[d]); b[3+d] = std::max(p[d], q[d]); }
+          sw.edge.push_back(e);
+          sw.own.push_back(face_fragment[edge_faces[edge_face_ptr[e]]]);
+          sw.box.insert(sw.box.end(), b, b + 6);
+          sw.range.resize(sw.range.size() + 6);
+          grid.Range(b, b + 3, &sw.range[sw.range.size() - 6]);
+        }
+      return sw;
+    }
+
   }
 
   bool EdgeCrossingDetector3::Shares (const int32_t * f, int32_t v) const
@@ -277,28 +305,14 @@ namespace ngfracture
     if (!grid.Measure(lo, hi, frange)) { if (stats) *stats = st; return out; }
     st.cell = grid.h;
     std::vector<std::pair<int32_t, int32_t>> pierces;   // (edge, face)
-    int64_t ne = int64_t(edges_.size() / 2);
     // an interlocking pair is found from the sweep of either edge (a pierces a face at b and
     // b one at a): an edge whose two ends lie on closed lips is left to the other edge
     std::vector<char> closed = Closed(x);
-    std::vector<int32_t> swept, erange, own;            // the edges swept, their cells, fragments
-    std::vector<double> ebox;                           // their boxes, lo then hi
-    for (int32_t e = 0; e < ne; e++)
-      {
-        const int32_t u = edges_[2*e], w = edges_[2*e+1];
-        if (closed[u] && closed[w]) { st.closed_edges++; continue; }
-        if (skip && (skip[u] || skip[w])) { st.skipped_edges++; continue; }
-        const double * p = x + 3*u, * q = x + 3*w;
-        double b[6];
-        for (int d = 0; d < 3; d++) { b[d] = std::min(p[d], q[d]); b[3+d] = std::max(p[d], q[d]); }
-        swept.push_back(e);
-        own.push_back(fragment_[edge_faces_[edge_face_ptr_[e]]]);
-        ebox.insert(ebox.end(), b, b + 6);
-        erange.resize(erange.size() + 6);
-        grid.Range(b, b + 3, &erange[erange.size() - 6]);
-      }
+    const Swept sw = SweptEdges(edges_, fragment_, edge_faces_, edge_face_ptr_, x, closed, skip, grid, st);
+    const std::vector<int32_t> & swept = sw.edge, & own = sw.own;
+    const std::vector<double> & ebox = sw.box;
     if (swept.empty()) { if (stats) *stats = st; return out; }
-    grid.Fill(erange, swept.size());
+    grid.Fill(sw.range, swept.size());
     for (int32_t f = 0; f < int32_t(nf_); f++)
       {
         const int32_t * r = &frange[6*f];

@@ -9,8 +9,9 @@
 // interlock: a pierces a face f at b, b pierces a face g at a, and f, g are of different
 // fragments or share no point.
 //
-// Search: a spatial hash of the boundary faces' bounding boxes (cells of the mean largest
-// extent of a face's box), swept by every edge's box; a pair (edge, face) is tested once,
+// Search: cells of the mean largest extent of a boundary face's bounding box; the boxes
+// of the edges swept are hashed into them and every face visits the cells its box
+// overlaps (fewer entries than hashing every face); a pair (edge, face) is tested once,
 // in the first grid cell the two boxes share, after a strict box test; then the exact
 // pierce test; for every piercing (a, f), the three edges b of f against the faces at a.
 // An interlocking pair is found from the sweep of either of its edges, so an edge whose

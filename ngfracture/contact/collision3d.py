@@ -46,7 +46,10 @@ Up to 2^22 cells the grid is an array of ranges over all cells, filled by a coun
 swept in increasing order, so the first one holding a pair (vertex, fragment) is the
 smallest, and later tetrahedra of that fragment do not test the pair again. Closed seams
 are decided before the sweep; a cell whose vertices are all decided for the fragments
-of its vertices (and none is a lip vertex) is skipped by the tetrahedra of those fragments.
+of its vertices (and none is a lip vertex) is skipped by the tetrahedra of those fragments,
+and a tetrahedron whose cells all lie in blocks of 2 x 2 x 2 cells closed for its fragment
+(every non-empty cell there so skipped) is not swept cell by cell; its cells are read from
+its vertices' cells (the cell of a coordinate does not decrease with it).
 
 Master face. For a pair whose vertex lies in a tetrahedron at its copy t on F (a crack
 lip, or where several cracks meet): among the boundary faces of that tetrahedron at t,

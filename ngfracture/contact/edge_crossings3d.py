@@ -33,12 +33,13 @@ edges pierce none of the corner's faces): node-to-face rows hold it. Coincident 
 pierce (the signs are strict), so an intact body or a closed crack reports nothing, and
 nor do faces that slide over each other in their common plane.
 
-Search, O(n) expected (``cpp_ext/edge_crossings3d.cpp``). The faces' bounding boxes are
-hashed into cells of the mean largest extent of a box (a spatial hash: a counting sort of
-the cells' hashes; the cell is doubled while the boxes would fill more than 32 n + 2^20
-cells, so that a few huge faces among small ones cost time, not memory); every edge
-sweeps the cells its box overlaps, and a pair (edge, face) is tested once, in the first
-cell the two boxes share, when they share no point and their boxes overlap strictly (a
+Search, O(n) expected (``cpp_ext/edge_crossings3d.cpp``). The cells are those of the faces'
+bounding boxes: the mean largest extent of a box (doubled while the boxes would fill more
+than 32 n + 2^20 cells, so that a few huge faces among small ones cost time, not memory).
+The boxes of the edges swept are hashed into them (a spatial hash: a counting sort of the
+cells' hashes) and every face visits the cells its box overlaps; a pair (edge, face) is
+tested once, in the first cell the two boxes share, when they share no point and their
+boxes overlap strictly (a
 pierce point lies strictly inside both: boxes that only touch cannot hold one). Then the
 exact pierce test, and for every piercing (a, f) the three edges b of f against the faces
 at a. A pair is found from the sweep of either of its edges (a pierces a face at b and b
