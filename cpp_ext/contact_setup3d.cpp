@@ -332,6 +332,52 @@ namespace ngfracture
       }
   }
 
+  namespace
+  {
+    // The boundary edges by their sorted pair of points (stable) and every run of equal
+    // pairs: order, the run of every edge and where every run begins (one past the last).
+    struct EdgeRuns
+    {
+      std::vector<int64_t> order, run_of, run_start;
+    };
+
+    EdgeRuns EdgesByPoints (int64_t nE, const int64_t * E, const int64_t * pid, int64_t n_points)
+    {
+      EdgeRuns r;
+      std::vector<int64_t> p0(nE), p1(nE), start;
+      for (int64_t e = 0; e < nE; e++)
+        {
+          int64_t x = pid[E[2 * e]], y = pid[E[2 * e + 1]];
+          p0[e] = std::min(x, y);
+          p1[e] = std::max(x, y);
+        }
+      r.order = CountingOrder(nE, n_points, p0, start);
+      auto higher = [&p1] (int64_t x, int64_t y) { return p1[x] < p1[y]; };
+      for (int64_t q = 0; q < n_points; q++)
+        if (start[q + 1] - start[q] > 64)
+          std::stable_sort(r.order.begin() + start[q], r.order.begin() + start[q + 1], higher);
+        else if (start[q + 1] - start[q] > 1)
+          InsertionSort(r.order, start[q], start[q + 1], higher);
+      r.run_of.resize(nE);
+      for (int64_t i = 0; i < nE; i++)
+        {
+          if (!i || p0[r.order[i]] != p0[r.order[i - 1]] || p1[r.order[i]] != p1[r.order[i - 1]])
+            r.run_start.push_back(i);
+          r.run_of[r.order[i]] = r.run_start.size() - 1;
+        }
+      r.run_start.push_back(nE);
+      return r;
+    }
+
+    // b's ends in the order of a's points
+    void PushEndsInOrder (const int64_t * E, const int64_t * pid, int64_t ea, int64_t eb, std::vector<int64_t> & ends_b)
+    {
+      bool flip = pid[E[2 * eb]] != pid[E[2 * ea]];
+      ends_b.push_back(E[2 * eb + (flip ? 1 : 0)]);
+      ends_b.push_back(E[2 * eb + (flip ? 0 : 1)]);
+    }
+  }
+
   void DiagonalEdgePairs (int64_t nE, const int64_t * E, const int64_t * at, const int64_t * vf,
                           const int64_t * pid, int64_t n_points, const int64_t * face_key,
                           std::vector<int64_t> & a, std::vector<int64_t> & b, std::vector<int64_t> & ends_b)
@@ -339,38 +385,16 @@ namespace ngfracture
     a.clear();
     b.clear();
     ends_b.clear();
-    // the edges by their sorted pair of points (stable), and every run of equal pairs
-    std::vector<int64_t> p0(nE), p1(nE), start;
-    for (int64_t e = 0; e < nE; e++)
-      {
-        int64_t x = pid[E[2 * e]], y = pid[E[2 * e + 1]];
-        p0[e] = std::min(x, y);
-        p1[e] = std::max(x, y);
-      }
-    std::vector<int64_t> order = CountingOrder(nE, n_points, p0, start);
-    auto higher = [&p1] (int64_t x, int64_t y) { return p1[x] < p1[y]; };
-    for (int64_t q = 0; q < n_points; q++)
-      if (start[q + 1] - start[q] > 64)
-        std::stable_sort(order.begin() + start[q], order.begin() + start[q + 1], higher);
-      else if (start[q + 1] - start[q] > 1)
-        InsertionSort(order, start[q], start[q + 1], higher);
-    std::vector<int64_t> run_of(nE), run_start;
-    for (int64_t i = 0; i < nE; i++)
-      {
-        if (!i || p0[order[i]] != p0[order[i - 1]] || p1[order[i]] != p1[order[i - 1]])
-          run_start.push_back(i);
-        run_of[order[i]] = run_start.size() - 1;
-      }
-    run_start.push_back(nE);
+    EdgeRuns runs = EdgesByPoints(nE, E, pid, n_points);
     for (int64_t ea = 0; ea < nE; ea++)
       {
         const int64_t * fa = at + 2 * ea;
         if (fa[0] < 0 || fa[1] < 0)
           continue;
-        int64_t r = run_of[ea];
-        for (int64_t i = run_start[r]; i < run_start[r + 1]; i++)   // b increasing: a stable run
+        int64_t r = runs.run_of[ea];
+        for (int64_t i = runs.run_start[r]; i < runs.run_start[r + 1]; i++)   // b increasing: a stable run
           {
-            int64_t eb = order[i];
+            int64_t eb = runs.order[i];
             const int64_t * fb = at + 2 * eb;
             if (vf[E[2 * ea]] == vf[E[2 * eb]] || fb[0] < 0 || fb[1] < 0)
               continue;
@@ -382,9 +406,42 @@ namespace ngfracture
               continue;
             a.push_back(ea);
             b.push_back(eb);
-            bool flip = pid[E[2 * eb]] != pid[E[2 * ea]];
-            ends_b.push_back(E[2 * eb + (flip ? 1 : 0)]);
-            ends_b.push_back(E[2 * eb + (flip ? 0 : 1)]);
+            PushEndsInOrder(E, pid, ea, eb, ends_b);
+          }
+      }
+  }
+
+  void EdgeCopyPairs (int64_t nE, const int64_t * E, const int64_t * at, const int64_t * pid, int64_t n_points,
+                      const int64_t * face_key, std::vector<int64_t> & a, std::vector<int64_t> & b,
+                      std::vector<int64_t> & ends_b, std::vector<uint8_t> & partner)
+  {
+    a.clear();
+    b.clear();
+    ends_b.clear();
+    partner.clear();
+    EdgeRuns runs = EdgesByPoints(nE, E, pid, n_points);
+    for (int64_t ea = 0; ea < nE; ea++)
+      {
+        const int64_t * fa = at + 2 * ea;
+        if (fa[0] < 0 || fa[1] < 0)
+          continue;
+        int64_t r = runs.run_of[ea];
+        for (int64_t i = runs.run_start[r]; i < runs.run_start[r + 1]; i++)   // b increasing: a stable run
+          {
+            int64_t eb = runs.order[i];
+            const int64_t * fb = at + 2 * eb;
+            if (eb == ea || fb[0] < 0 || fb[1] < 0)
+              continue;
+            uint8_t shared[2];
+            for (int l = 0; l < 2; l++)
+              shared[l] = face_key[fb[l]] == face_key[fa[0]] || face_key[fb[l]] == face_key[fa[1]];
+            if (shared[0] && shared[1])
+              continue;                                   // the partner-face rows are the whole condition
+            a.push_back(ea);
+            b.push_back(eb);
+            PushEndsInOrder(E, pid, ea, eb, ends_b);
+            partner.push_back(shared[0]);
+            partner.push_back(shared[1]);
           }
       }
   }

@@ -79,6 +79,15 @@ namespace ngfracture
                           const int64_t * pid, int64_t n_points, const int64_t * face_key,
                           std::vector<int64_t> & a, std::vector<int64_t> & b, std::vector<int64_t> & ends_b);
 
+  // wedges3d.edge_copies: the ordered pairs (a, b) of distinct boundary edges on the same
+  // two points (pid >= 0 at every end), on any fragments, both with two faces, with a
+  // face of b whose key is none of a's faces' (a face of b that is no partner face of a);
+  // sorted by a, then b. ends_b: b's ends in the order of a's points; partner (2 per
+  // pair): whether b's face k has the key of one of a's faces.
+  void EdgeCopyPairs (int64_t nE, const int64_t * E, const int64_t * at, const int64_t * pid, int64_t n_points,
+                      const int64_t * face_key, std::vector<int64_t> & a, std::vector<int64_t> & b,
+                      std::vector<int64_t> & ends_b, std::vector<uint8_t> & partner);
+
   // setup3d.vertex_fragments: per vertex the fragment of the last tetrahedron at it, or -1;
   // corner k of tetrahedron e at tets[e * row + k * col]
   void VertexFragments (int64_t nv, int64_t ne, const int64_t * tets, int64_t row, int64_t col,

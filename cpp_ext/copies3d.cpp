@@ -218,4 +218,51 @@ namespace ngfracture
           }
       }
   }
+
+  void ReflexWedgeGaps (int64_t m, const double * x, const int64_t * faces, const int64_t * a, const int64_t * b,
+                        const int64_t * fb, const uint8_t * partner, double tol, std::vector<int64_t> & pair,
+                        std::vector<double> & gap)
+  {
+    pair.clear();
+    gap.clear();
+    for (int64_t p = 0; p < m; p++)
+      {
+        double unit[2][3], g[2][2];
+        bool ok = true;
+        for (int k = 0; k < 2; k++)
+          {
+            double n[3];
+            AreaVector(x, faces + 3 * fb[2 * p + k], n);
+            double length = NumpyNorm(n);
+            ok = ok && length > 0;                        // a face squeezed flat has no plane
+            double scale = length > 0 ? length : 1.0;
+            for (int c = 0; c < 3; c++)
+              unit[k][c] = n[c] / scale;
+          }
+        if (!ok)
+          continue;
+        // reflex: the corner of B's second face off the edge strictly in front of the
+        // first's plane (WedgeInside's test of a convex or flat wedge, negated)
+        const int64_t * second = faces + 3 * fb[2 * p + 1];
+        int64_t third = (second[0] + second[1] + second[2]) - (b[2 * p] + b[2 * p + 1]);
+        double d[3];
+        Difference(x, third, b[2 * p], d);
+        if (!(EinsumDot(unit[0], d) > 0))
+          continue;
+        double least = 0.0;
+        for (int k = 0; k < 2; k++)
+          for (int e = 0; e < 2; e++)
+            {
+              Difference(x, a[2 * p + e], b[2 * p + e], d);
+              g[k][e] = EinsumDot(unit[k], d);
+              if (!partner[2 * p + k])
+                least = std::min(least, g[k][e]);
+            }
+        if (least < -tol)
+          {
+            pair.push_back(p);
+            gap.insert(gap.end(), { g[0][0], g[0][1], g[1][0], g[1][1] });
+          }
+      }
+  }
 }

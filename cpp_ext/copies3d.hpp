@@ -66,5 +66,15 @@ namespace ngfracture
   void WedgeInside (int64_t m, const double * x, const int64_t * faces, const int64_t * a, const int64_t * b,
                     const int64_t * fb, double tol, std::vector<int64_t> & pair, std::vector<int64_t> & nearer,
                     std::vector<double> & gap);
+
+  // The pairs of copies of a boundary edge (a, b, b's faces fb, partner: whether b's face
+  // k is coincident with a face at a; wedges3d.edge_copies) at x whose B wedge at b is
+  // reflex (the corner of fb[1] off the edge strictly in front of fb[0]'s plane) and an
+  // end of a lies behind the plane of a face of b that is no partner face deeper than
+  // tol (gap n_k . (x_a_e - x_b_e), unit normals at x; no rows where a face is squeezed
+  // flat). pair: their numbers, increasing; gap: g[k][e] for k, e in 0, 1 (4 per pair).
+  void ReflexWedgeGaps (int64_t m, const double * x, const int64_t * faces, const int64_t * a, const int64_t * b,
+                        const int64_t * fb, const uint8_t * partner, double tol, std::vector<int64_t> & pair,
+                        std::vector<double> & gap);
 }
 #endif

@@ -254,4 +254,58 @@ gap : numpy.ndarray, shape (k, 2)
     The gaps of a's two ends to that face's plane at x, bit for bit the numpy
     computation of wedges3d.wedge_rows.
 )doc");
+
+  m.def("ReflexWedgeGaps",
+        [] (DArr x, LArr faces, LArr a, LArr b, LArr b_faces, py::array_t<bool, py::array::c_style | py::array::forcecast> partner,
+            double tol)
+        {
+          const char * fn = "ReflexWedgeGaps";
+          Check(fn, "x", x, 2, 3);
+          Check(fn, "faces", faces, 2, 3);
+          Check(fn, "a", a, 2, 2);
+          Check(fn, "b", b, 2, 2, a.shape(0));
+          Check(fn, "b_faces", b_faces, 2, 2, a.shape(0));
+          if (partner.ndim() != 2 || partner.shape(0) != a.shape(0) || partner.shape(1) != 2)
+            throw std::invalid_argument("ngfracture.ReflexWedgeGaps: partner must have shape (m, 2) like a");
+          int64_t nv = x.shape(0), nf = faces.shape(0);
+          CheckRange(fn, "faces", faces, nv);
+          CheckRange(fn, "a", a, nv);
+          CheckRange(fn, "b", b, nv);
+          CheckRange(fn, "b_faces", b_faces, nf);
+          for (py::ssize_t p = 0; p < a.shape(0); p++)
+            for (int k = 0; k < 2; k++)
+              {
+                const int64_t * f = faces.data() + 3 * b_faces.data()[2 * p + k];
+                for (int e = 0; e < 2; e++)
+                  {
+                    int64_t v = b.data()[2 * p + e];
+                    if (f[0] != v && f[1] != v && f[2] != v)
+                      throw std::invalid_argument("ngfracture.ReflexWedgeGaps: b_faces[" + std::to_string(p) + ", "
+                                                  + std::to_string(k) + "] does not hold edge b");
+                  }
+              }
+          std::vector<int64_t> pair;
+          std::vector<double> gap;
+          {
+            py::gil_scoped_release release;
+            ReflexWedgeGaps(a.shape(0), x.data(), faces.data(), a.data(), b.data(), b_faces.data(),
+                            reinterpret_cast<const uint8_t *>(partner.data()), tol, pair, gap);
+          }
+          py::array_t<double> G = ToNumpy(gap, 4);
+          if (gap.empty())
+            G = py::array_t<double>(std::vector<py::ssize_t>{ 0, 4 });
+          return py::make_tuple(ToNumpy(pair), G);
+        },
+        py::arg("x"), py::arg("faces"), py::arg("a"), py::arg("b"), py::arg("b_faces"), py::arg("partner"),
+        py::arg("tol"),
+        R"doc(The pairs of copies of an edge whose a lies behind a non-partner face of B's reflex wedge deeper than tol.
+
+Returns
+-------
+pair : numpy.ndarray of int64
+    The pairs hit, increasing.
+gap : numpy.ndarray, shape (k, 4)
+    The gaps n_k . (x_a_e - x_b_e) of a's ends to the planes of b's two faces at x, in
+    the order (k, e) = (0, 0), (0, 1), (1, 0), (1, 1).
+)doc");
 }

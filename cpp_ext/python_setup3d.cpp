@@ -229,6 +229,54 @@ ends_b : numpy.ndarray of int64, shape (m, 2)
     b's ends, the one at a's first end's point first.
 )doc");
 
+  m.def("EdgeCopyPairs",
+        [] (LArr edges, LArr at, LArr pid, LArr face_key)
+        {
+          const char * fn = "EdgeCopyPairs";
+          Check(fn, "edges", edges, 2, 2);
+          int64_t nE = edges.shape(0), nf = face_key.shape(0);
+          Check(fn, "faces_at_edge", at, 2, 2, nE);
+          Check(fn, "point", pid, 1, 0);
+          Check(fn, "face_key", face_key, 1, 0);
+          CheckRange(fn, "edges", edges, pid.shape(0));
+          for (py::ssize_t i = 0; i < at.size(); i++)
+            if (at.data()[i] < -1 || at.data()[i] >= nf)
+              throw std::invalid_argument("ngfracture.EdgeCopyPairs: faces_at_edge has an entry outside [-1, "
+                                          + std::to_string(nf) + ")");
+          int64_t n_points = 0;
+          for (py::ssize_t i = 0; i < edges.size(); i++)
+            {
+              int64_t q = pid.data()[edges.data()[i]];
+              if (q < 0)
+                throw std::invalid_argument("ngfracture.EdgeCopyPairs: edges has a vertex of no point (point -1)");
+              n_points = std::max(n_points, q + 1);
+            }
+          std::vector<int64_t> a, b, ends_b;
+          std::vector<uint8_t> partner;
+          {
+            py::gil_scoped_release release;
+            EdgeCopyPairs(nE, edges.data(), at.data(), pid.data(), n_points, face_key.data(), a, b, ends_b, partner);
+          }
+          py::array_t<int64_t> B = ToNumpy(ends_b, 2);
+          py::array_t<bool> P(std::vector<py::ssize_t>{ py::ssize_t(a.size()), 2 });
+          std::copy(partner.begin(), partner.end(), reinterpret_cast<uint8_t *>(P.mutable_data()));
+          if (ends_b.empty())
+            B = py::array_t<int64_t>(std::vector<py::ssize_t>{ 0, 2 });
+          return py::make_tuple(ToNumpy(a), ToNumpy(b), B, P);
+        },
+        py::arg("edges"), py::arg("faces_at_edge"), py::arg("point"), py::arg("face_key"),
+        R"doc(The pairs of wedges3d.edge_copies.
+
+Returns
+-------
+a, b : numpy.ndarray of int64
+    The edges a and b of every pair, sorted by a, then b.
+ends_b : numpy.ndarray of int64, shape (m, 2)
+    b's ends, the one at a's first end's point first.
+partner : numpy.ndarray of bool, shape (m, 2)
+    Whether b's face k (faces_at_edge[b, k]) is coincident with a face at a.
+)doc");
+
   m.def("VertexFragments",
         [] (int64_t nv, py::array_t<int64_t, py::array::forcecast> tets, LArr fragment)
         {

@@ -2,7 +2,8 @@
 
 ``copies3d.behind_partner_rows`` (``BehindPartnerGaps``), ``wedges3d.wedge_rows``
 (``WedgeInside``), ``copies3d.found_rows_at_copies`` (``FoundRowsAtCopies``),
-``copies3d.folded_rows_at_copies`` (``FoldedIncidences``) and the
+``copies3d.folded_rows_at_copies`` (``FoldedIncidences``), ``wedges3d.reflex_wedge_rows``
+(``ReflexWedgeGaps``) with its pairs ``wedges3d.edge_copies`` (``EdgeCopyPairs``) and the
 partner face of a (face, vertex) that found rows at copies and their re-linearisation
 look up (``PartnerAt``) compute in C++ what the numpy code below
 computes, every round of every 3D contact solve; the rows they make must be the same to the last bit (gaps and their
@@ -20,8 +21,9 @@ from ngfracture.contact.intsets import isin_ints, unique_ints
 from ngfracture.contact.kinks3d import KINK, expand_ranges, partner_faces
 from ngfracture.contact.rows3d import NodeToFaceRows, no_face_rows, node_to_face_rows
 from ngfracture.contact.setup3d import MeshSetup3d
-from ngfracture.contact.wedges3d import wedge_rows
+from ngfracture.contact.wedges3d import edge_copies, reflex_wedge_rows, wedge_rows
 from ngfracture.geometry.pieces import fragmented_box
+from sector_blocks import sector_blocks
 
 CELLS, PIECES = 4, 2
 
@@ -151,6 +153,55 @@ def reference_wedge_rows(pairs, displacement, tol, index, vertex_fragment):
     return rows_at_copy(a[pair, end], face, corner, gap[pair, nearer[pair], end], index)
 
 
+def reference_edge_copies(edges, faces_at_edge, index):
+    """The numpy loop of wedges3d.edge_copies: (a, ends of b in a's order, b's faces, partner flags)."""
+    E, at, pid, key = edges, faces_at_edge, index.point, index.face_key
+    points = np.sort(pid[E], axis=1)
+    a, ends, faces, partner = [], [], [], []
+    for ea in range(len(E)):
+        if (at[ea] < 0).any():
+            continue
+        for eb in np.flatnonzero((points == points[ea]).all(axis=1)):
+            if eb == ea or (at[eb] < 0).any():
+                continue
+            shared = np.isin(key[at[eb]], key[at[ea]])
+            if shared.all():
+                continue
+            a.append(E[ea])
+            ends.append(E[eb, ::-1] if pid[E[eb, 0]] != pid[E[ea, 0]] else E[eb])
+            faces.append(at[eb])
+            partner.append(shared)
+    return tuple(np.array(v).reshape(-1, 2) for v in (a, ends, faces, partner))
+
+
+def reference_reflex_wedge_rows(pairs, displacement, tol, index):
+    """The numpy computation of wedges3d.reflex_wedge_rows."""
+    X, F = index.points, index.faces
+    nv = len(X)
+    x = X + np.asarray(displacement, dtype=np.float64)
+    a, b, fb = pairs.a, pairs.b, pairs.b_faces
+    normals, ok = [], np.ones(len(a), dtype=bool)
+    for k in range(2):
+        tri = x[F[fb[:, k]]]
+        n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+        length = np.linalg.norm(n, axis=1)
+        ok &= length > 0
+        normals.append(n / np.where(length > 0, length, 1.0)[:, None])
+    third = F[fb[:, 1]].sum(axis=1) - b.sum(axis=1)
+    reflex = np.einsum("ij,ij->i", normals[0], x[third] - x[b[:, 0]]) > 0
+    gap = np.stack([np.stack([np.einsum("ij,ij->i", normals[k], x[a[:, e]] - x[b[:, e]]) for e in range(2)], axis=1)
+                    for k in range(2)], axis=1)                              # (pair, face, end)
+    least = np.where(pairs.partner[:, :, None], 0.0, gap).min(axis=(1, 2))
+    hit = np.flatnonzero(ok & reflex & (np.minimum(least, 0.0) < -tol))
+    pair, side, end = np.nonzero(~pairs.partner[hit][:, :, None] & np.ones((1, 1, 2), dtype=bool))
+    if not len(pair):
+        return no_face_rows(nv)
+    p = hit[pair]
+    face = fb[p, side]
+    corner = np.argmax(F[face] == b[p, end][:, None], axis=1)
+    return rows_at_copy(a[p, end], face, corner, gap[p, side, end], index)
+
+
 @pytest.fixture(scope="module")
 def blocks():
     """The blocks with every cut plane bent by 0.2 along grid lines a quarter in (faces turned by 11 degrees
@@ -203,6 +254,31 @@ def test_wedge_rows_equal_their_numpy_reference(blocks, seed, tol):
     U = configurations(arrays, setup, seed)
     args = setup.diagonal_edges, U, tol, setup.copy_index, setup.vertex_fragment
     rows, reference = wedge_rows(*args), reference_wedge_rows(*args)
+    assert len(reference) > 0
+    assert same_rows(rows, reference)
+
+
+def test_edge_copies_equal_their_numpy_reference(blocks):
+    _, setup = blocks
+    pairs = setup.edge_copies
+    a, ends, faces, partner = reference_edge_copies(setup.edge_detector.edges, setup.faces_at_edge, setup.copy_index)
+    assert len(a) > 0 and partner.any() and not partner.all(axis=1).any()
+    assert np.array_equal(pairs.a, a) and np.array_equal(pairs.b, ends)
+    assert np.array_equal(pairs.b_faces, faces) and np.array_equal(pairs.partner, partner)
+    assert pairs.a.dtype == pairs.b.dtype == pairs.b_faces.dtype == np.int64 and pairs.partner.dtype == bool
+    none = edge_copies(np.zeros((0, 2), np.int64), np.zeros((0, 2), np.int64), setup.copy_index)
+    assert len(none) == 0 and none.partner.shape == (0, 2)
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+@pytest.mark.parametrize("tol", [0.0, 1e-3])
+def test_reflex_wedge_rows_equal_their_numpy_reference(seed, tol):
+    # the fragmented box's wedges are of 90 degrees: three blocks with one of 240 instead
+    arrays, fragment = sector_blocks(CELLS // 2, np.linspace(0.0, 0.5, CELLS + 1))
+    setup = MeshSetup3d(arrays.points, arrays.tets, arrays.faces, fragment)
+    U = configurations(arrays, setup, seed)
+    args = setup.edge_copies, U, tol, setup.copy_index
+    rows, reference = reflex_wedge_rows(*args), reference_reflex_wedge_rows(*args)
     assert len(reference) > 0
     assert same_rows(rows, reference)
 
@@ -266,6 +342,7 @@ def test_no_rows_where_nothing_moved(blocks):
     U = np.zeros_like(arrays.points)
     assert len(behind_partner_rows(setup.partners, U, 0.0, setup.copy_index)) == 0
     assert len(wedge_rows(setup.diagonal_edges, U, 0.0, setup.copy_index, setup.vertex_fragment)) == 0
+    assert len(reflex_wedge_rows(setup.edge_copies, U, 0.0, setup.copy_index)) == 0
 
 
 def test_bad_input_names_the_argument(blocks):
@@ -281,3 +358,10 @@ def test_bad_input_names_the_argument(blocks):
     other[0, 1] = next(f for f in range(len(F)) if not set(d.b[0]) <= set(F[f]))
     with pytest.raises(ValueError, match=r"b_faces\[0, 1\] does not hold edge b"):
         ext.WedgeInside(x, F, d.a, d.b, other, 0.0)
+    e = setup.edge_copies
+    with pytest.raises(ValueError, match="partner must have shape"):
+        ext.ReflexWedgeGaps(x, F, e.a, e.b, e.b_faces, e.partner[:-1], 0.0)
+    other = e.b_faces.copy()
+    other[0, 0] = next(f for f in range(len(F)) if not set(e.b[0]) <= set(F[f]))
+    with pytest.raises(ValueError, match=r"b_faces\[0, 0\] does not hold edge b"):
+        ext.ReflexWedgeGaps(x, F, e.a, e.b, other, e.partner, 0.0)

@@ -88,7 +88,7 @@ from .mixed_rows import MixedRows
 from .redundancy import holds_on_columns
 from .rows3d import NodeToFaceRows, no_face_rows, node_to_face_rows, relinearise_node_to_face
 from .setup3d import FaceKeys, MeshSetup3d
-from .wedges3d import wedge_rows
+from .wedges3d import reflex_wedge_rows, wedge_rows
 
 __all__ = ["ActiveSet3d", "FaceKeys", "fixed_rows_3d"]
 
@@ -351,8 +351,10 @@ class ActiveSet3d(ActiveSet):
     def _with_rows_at_copies(self, found, codes, U, pen):
         """The found rows and their key codes with the rows at copies that X + U violates
         deeper than ``copy_tol`` and they lack: a copy behind a partner face's plane
-        at its copy (:func:`~ngfracture.contact.copies3d.behind_partner_rows`), and junction
-        edges in a diagonal neighbour's wedge (:func:`~ngfracture.contact.wedges3d.wedge_rows`);
+        at its copy (:func:`~ngfracture.contact.copies3d.behind_partner_rows`), junction
+        edges in a diagonal neighbour's wedge (:func:`~ngfracture.contact.wedges3d.wedge_rows`)
+        and edge copies behind a face of another copy's reflex wedge
+        (:func:`~ngfracture.contact.wedges3d.reflex_wedge_rows`);
         in the first round, also the rows at copies that the warm start names
         (:func:`~ngfracture.contact.copies3d.rows_at_copies_of`). None for a pair of
         copies the scene's rows tie (:attr:`tied`). A slave that the detection
@@ -362,7 +364,8 @@ class ActiveSet3d(ActiveSet):
         a, setup = self.geometry.arrays, self.setup
         nv = len(a.points)
         parts = [behind_partner_rows(setup.partners, U, self.copy_tol, setup.copy_index),
-                 wedge_rows(setup.diagonal_edges, U, self.copy_tol, setup.copy_index, setup.vertex_fragment)]
+                 wedge_rows(setup.diagonal_edges, U, self.copy_tol, setup.copy_index, setup.vertex_fragment),
+                 reflex_wedge_rows(setup.edge_copies, U, self.copy_tol, setup.copy_index)]
         if self.warm:
             # the rows at copies the solve before imposed, which the warm start names
             warm = self._key_codes(sorted(self.warm))

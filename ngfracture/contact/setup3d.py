@@ -23,7 +23,7 @@ from .edge_rows3d import two_faces
 from .junctions3d import covered_pairs, fragment_pair_rows
 from .kinks3d import CopyIndex
 from .rows3d import NodeToFaceRows, lip_rows, node_to_face_rows
-from .wedges3d import diagonal_edges
+from .wedges3d import diagonal_edges, edge_copies
 
 __all__ = ["FaceKeys", "MeshSetup3d", "MeshSetups", "fixed_rows", "vertex_fragments"]
 
@@ -269,6 +269,9 @@ class MeshSetup3d:
     diagonal_edges : ngfracture.contact.wedges3d.DiagonalEdges
         The copies of junction edges on fragments that share no face there
         (:func:`~ngfracture.contact.wedges3d.diagonal_edges`).
+    edge_copies : ngfracture.contact.wedges3d.EdgeCopies
+        The pairs of copies of a boundary edge with a face of one that is no partner face
+        of the other (:func:`~ngfracture.contact.wedges3d.edge_copies`).
     copy_index : ngfracture.contact.kinks3d.CopyIndex
     vertex_fragment : numpy.ndarray of int64
     rows : NodeToFaceRows
@@ -296,6 +299,7 @@ class MeshSetup3d:
         self.partners = partner_incidences(self.copy_index, self.vertex_fragment)
         self.diagonal_edges = diagonal_edges(self.edge_detector.edges, self.faces_at_edge, self.vertex_fragment,
                                              self.copy_index)
+        self.edge_copies = edge_copies(self.edge_detector.edges, self.faces_at_edge, self.copy_index)
         self.codec = FaceKeys(self.faces, self.edge_detector.edges)
         self.rows, self.keys = fixed_rows(self.points, self.faces, self.vertex_fragment, self.codec,
                                           self.detector, self.copy_index)

@@ -22,6 +22,17 @@ form (:func:`~ngfracture.contact.copies3d.found_rows_at_copies`), so that the ac
 re-linearises them as it does those. Out of B's wedge, the edge line keeps out of it
 through one face or the other: a union, of which the row keeps the one nearer to hold
 (docs/contact.md, "Rows at copies found by their planes").
+
+Where B's wedge at b is reflex (wider than pi) its complement is convex: the intersection of
+the half-spaces in front of its two faces, and every other copy a of the edge must keep out
+of B through both. Where a and B share a face at the edge, the rows at copies hold a
+against it (partner faces); the other face of B there is coincident with a face of a third
+copy, and nothing holds a in front of it. :func:`edge_copies` lists, once per mesh, every
+ordered pair of copies (a, b) of a boundary edge with a face of b that is no partner face
+of a; :func:`reflex_wedge_rows` gives, where B's wedge at b is reflex and an end of a lies
+behind the plane of such a face deeper than ``tol``, both ends of a a row on every such
+face: the exact first-order condition along the edge, as the gap n . (x_a(s) - x_b(s)) is
+linear along it.
 """
 from dataclasses import dataclass
 
@@ -32,7 +43,7 @@ from .copies3d import rows_at_copy
 from .intsets import isin_ints
 from .rows3d import no_face_rows
 
-__all__ = ["DiagonalEdges", "diagonal_edges", "wedge_rows"]
+__all__ = ["DiagonalEdges", "EdgeCopies", "diagonal_edges", "edge_copies", "wedge_rows", "reflex_wedge_rows"]
 
 
 @dataclass(frozen=True)
@@ -157,3 +168,109 @@ def _reverse_also_inside(pairs, inside, vertex_fragment):
     code = pairs.edge_a[inside] * n + pairs.edge_b[inside]
     reverse = pairs.edge_b[inside] * n + pairs.edge_a[inside]
     return isin_ints(reverse, code) & (vf[pairs.a[inside, 0]] < vf[pairs.b[inside, 0]])
+
+
+@dataclass(frozen=True)
+class EdgeCopies:
+    """Ordered pairs of copies of a boundary edge where b has a face that is no partner face of a.
+
+    Parameters
+    ----------
+    a : numpy.ndarray of int64, shape (m, 2)
+        The ends of edge a.
+    b : numpy.ndarray of int64, shape (m, 2)
+        Their copies on edge b: ``b[:, k]`` at the reference point of ``a[:, k]``.
+    b_faces : numpy.ndarray of int64, shape (m, 2)
+        The two boundary faces of b's fragment at edge b.
+    partner : numpy.ndarray of bool, shape (m, 2)
+        Whether ``b_faces[:, k]`` is coincident with a face at edge a (at most one is).
+    """
+    a: np.ndarray
+    b: np.ndarray
+    b_faces: np.ndarray
+    partner: np.ndarray
+
+    def __len__(self):
+        return len(self.a)
+
+
+def edge_copies(edges, faces_at_edge, index):
+    """The ordered pairs of copies of one boundary edge with a face of b that is no partner face of a.
+
+    Copies on one fragment count (the lips of a crack inside it). Pairs where both faces
+    of b are coincident with faces at a are left out: the partner-face rows there are the
+    whole condition.
+
+    Parameters
+    ----------
+    edges : numpy.ndarray of int, shape (nE, 2)
+        Boundary edges.
+    faces_at_edge : numpy.ndarray of int, shape (nE, 2)
+        The two boundary faces at every edge (-1 where an edge has other than two).
+    index : ngfracture.contact.kinks3d.CopyIndex
+        The index of the mesh's reference points and boundary faces.
+
+    Returns
+    -------
+    EdgeCopies
+        Sorted by edge a, then edge b.
+
+    Raises
+    ------
+    ValueError
+        Naming the array: a wrong shape, a face number out of range, an edge with a vertex
+        on no boundary face (no reference point in ``index``).
+    """
+    E = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
+    at = np.asarray(faces_at_edge, dtype=np.int64).reshape(-1, 2)
+    if not len(E):
+        return EdgeCopies(*(np.zeros((0, 2), np.int64) for _ in range(3)), np.zeros((0, 2), dtype=bool))
+    # C++ (cpp_ext/contact_setup3d.cpp): the edges on the same two points pairwise (runs of
+    # diagonal_edges' sort), each with two faces, not both of b's faces' keys among a's
+    a, b, ends_b, partner = _ext.EdgeCopyPairs(E, at, index.point, index.face_key)
+    return EdgeCopies(E[a], ends_b, at[b], partner)
+
+
+def reflex_wedge_rows(pairs, displacement, tol, index):
+    """Rows for the ends of edge copies behind a face of another copy's reflex wedge deeper than ``tol``.
+
+    Parameters
+    ----------
+    pairs : EdgeCopies
+        :func:`edge_copies` of the mesh.
+    displacement : numpy.ndarray, shape (nv, 3)
+        Displacements U: the configuration X + U tested.
+    tol : float
+        Depth (a length) of an end of a behind the plane of a face of b that is no partner
+        face of a, where B's wedge at b is reflex, that makes rows.
+    index : ngfracture.contact.kinks3d.CopyIndex
+        The index of the mesh's reference points X and boundary faces.
+
+    Returns
+    -------
+    NodeToFaceRows
+        For every such pair, the rows of both ends of a on every face of b that is no
+        partner face of a (the complement of a reflex wedge is the intersection of the
+        half-spaces in front of its faces; the active set imposes those that bind), by
+        pair, face, end: projected at the end's copy on b (``g`` 0, ``dist`` the end's gap
+        at X + U), the face's unit normal of the reference configuration.
+    """
+    X, F = index.points, index.faces
+    nv = len(X)
+    if not len(pairs):
+        return no_face_rows(nv)
+    x = X + np.asarray(displacement, dtype=np.float64)
+    # C++ (cpp_ext/copies3d.cpp): per pair B's two unit normals at x (a face squeezed flat
+    # has no plane: no rows), B's wedge reflex (the corner of its second face off the edge
+    # strictly in front of the first's plane), the gaps of a's ends to both planes measured
+    # from their copies on b, and the pairs with one below -tol on a face no partner of a
+    hit, gap = _ext.ReflexWedgeGaps(x, F, pairs.a, pairs.b, pairs.b_faces, pairs.partner, float(tol))
+    if not len(hit):
+        return no_face_rows(nv)
+    new = ~pairs.partner[hit]                                       # (k, 2): b's faces that are no partner
+    pair, side = np.nonzero(new)
+    pair, side, end = np.repeat(pair, 2), np.repeat(side, 2), np.tile([0, 1], len(pair))
+    p = hit[pair]
+    face = pairs.b_faces[p, side]
+    corner = np.argmax(F[face] == pairs.b[p, end][:, None], axis=1)
+    return rows_at_copy(pairs.a[p, end], face, corner, gap[pair, 2 * side + end], index)
