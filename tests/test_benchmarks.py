@@ -9,7 +9,7 @@ import pytest
 from conftest import child_env
 
 ROOT = Path(__file__).resolve().parent.parent
-BENCHMARKS = ["contact", "contact3d", "crack", "edges3d", "ensemble", "linear3d", "lshape", "meshcheck", "objectivity", "scenes", "schur",
+BENCHMARKS = ["contact", "contact3d", "crack", "edges3d", "ensemble", "linear3d", "lshape", "meshcheck", "objectivity", "scenes", "schur", "sphere3d",
               "solid"]
 
 

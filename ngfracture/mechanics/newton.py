@@ -483,11 +483,12 @@ class NewtonSolver:
 
     def _factor(self, K, rows, support):
         """A fresh K^+ of the tangent K for the general rows of ``rows``
-        (linalg.iterative.make_factor)."""
+        (linalg.iterative.make_factor); full Newton on a nonlinear model factorises it for
+        one system."""
         prob = self.problem
         return make_factor(K, rows.fixed_dofs, support.pins, self.linear_solver, self.inverse, dim=prob.dim,
                            points=prob.arrays.points, pattern=prob.tangent_pattern(),
-                           rows=rows.C.shape[0])
+                           rows=rows.C.shape[0], one_system=self.method == "full" and prob.nonlinear)
 
     def _converged(self, status, k, norm, prev, force_scale, r):
         """Whether iterate k (increment ``norm``, the one before ``prev``) ends the load step:
