@@ -95,14 +95,17 @@ def run_case(fine, steps, cpu_limit, resume, repeat):
     wall0, cpu0_unit, solver = cpu_unit(scene, repeat)
     records, start = [], {}
 
-    def progress(record):
+    def progress(record):        # then ``accepted``, which may stop the run
         now = time.process_time()
         records.append({"step": record["step"], "x_over_xc": record["x"] / x_c,
                         "split_vertices": record["split_vertices"], "fragments": record["fragments"],
                         "wall": time.perf_counter() - start["wall"], "cpu": now - start["cpu"],
                         "factorisations": counts.factorisations})
+
+    def accepted(step):
+        records[-1].update(retries=step.record["retries"], relax_passes=step.record["relax_passes"])
         print(json.dumps(records[-1]), file=sys.stderr, flush=True)
-        if (steps is not None and len(records) >= steps) or (cpu_limit is not None and now - start["cpu"] >= cpu_limit):
+        if (steps is not None and len(records) >= steps) or (cpu_limit is not None and records[-1]["cpu"] >= cpu_limit):
             raise Stop
 
     with tempfile.TemporaryDirectory() as tmp, LinalgCounts() as counts:
@@ -114,18 +117,15 @@ def run_case(fine, steps, cpu_limit, resume, repeat):
                                 progress=progress)
         start.update(wall=time.perf_counter(), cpu=time.process_time())
         try:
-            result = simulation.run()
-            reason = result.reason
+            reason = simulation.run(on_step=accepted).reason
         except Stop:
             reason = "stopped"
-        history = json.loads((out / "summary.json").read_text())["history"] if (out / "summary.json").exists() else []
     wall1, cpu1_unit, _ = cpu_unit(scene, repeat)
-    return summary(fine, scene, records, history, reason, 0.5 * (wall0 + wall1), 0.5 * (cpu0_unit + cpu1_unit), solver)
+    return summary(fine, scene, records, reason, 0.5 * (wall0 + wall1), 0.5 * (cpu0_unit + cpu1_unit), solver)
 
 
-def summary(fine, scene, records, history, reason, t_unit, cpu_t_unit, solver):
-    """The case's dict from its progress records (cumulative seconds) and its history."""
-    by_step = {h["step"]: h for h in history}
+def summary(fine, scene, records, reason, t_unit, cpu_t_unit, solver):
+    """The case's dict from its records (cumulative seconds and split vertices)."""
     wall = np.diff([0.0] + [r["wall"] for r in records])
     cpu = np.diff([0.0] + [r["cpu"] for r in records])
     fact = np.diff([0] + [r["factorisations"] for r in records])
@@ -136,8 +136,7 @@ def summary(fine, scene, records, history, reason, t_unit, cpu_t_unit, solver):
             "t_unit": t_unit, "cpu_t_unit": cpu_t_unit, "step": steps,
             "x_over_xc": [r["x_over_xc"] for r in records], "split_vertices": [r["split_vertices"] for r in records],
             "fragments": [r["fragments"] for r in records],
-            "retries": [by_step.get(s, {}).get("retries") for s in steps],
-            "relax_passes": [by_step.get(s, {}).get("relax_passes") for s in steps],
+            "retries": [r.get("retries") for r in records], "relax_passes": [r.get("relax_passes") for r in records],
             "step_wall": wall.tolist(), "step_cpu": cpu.tolist(), "step_factorisations": fact.tolist(),
             "cpu": total, "solve_equivalents": total / cpu_t_unit,
             "solve_equivalents_per_step": total / cpu_t_unit / max(len(records), 1)}
