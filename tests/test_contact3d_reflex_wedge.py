@@ -18,10 +18,16 @@ is shared with C, no partner face of A. The line's one edge has a copy on each b
 - The row re-linearised where the copies meet, against its gap n_f(x) . (x_a - x_b) at
   configurations h away: the difference falls as h^2 (the frozen normal is the exact
   linearisation there).
+- A's edge shortened instead (its ends inside B, found deep by the node-to-face detection
+  on a face at their copy whose plane they are on): the active set's candidates still have
+  the two rows on B's face at 120 (the other rows at copies leave such a slave to its
+  detected row, which holds it only in front of one face of the wedge).
 """
 import numpy as np
 import pytest
 
+from ngfracture.contact.active_set import Geometry
+from ngfracture.contact.active_set3d import ActiveSet3d
 from ngfracture.contact.copies3d import behind_partner_rows
 from ngfracture.contact.rows3d import relinearise_node_to_face
 from ngfracture.contact.setup3d import MeshSetup3d
@@ -158,3 +164,19 @@ def test_linearisation_error_is_second_order(blocks, seed):
         errors.append(np.abs(gap(U) - (row.C @ U.T.ravel() + row.g)))
     ratio = np.array(errors[:-1]) / np.array(errors[1:])
     assert np.all((ratio > 3.5) & (ratio < 4.5)), ratio
+
+
+def test_rows_kept_for_ends_found_deep(blocks):
+    arrays, setup = blocks
+    U = motion(arrays, setup, EPS * np.array([-1.0, 0.5]), EPS * np.array([-1.0, 2.0]), stretch=-2 * EPS)
+    vf = setup.vertex_fragment
+    rows = reflex_wedge_rows(setup.edge_copies, U, 1e-9, setup.copy_index)
+    assert len(rows) == 2
+    pen = setup.detector.detect(U)
+    deep = set(np.asarray(pen.vertex)[pen.gap < -1e-9].tolist())
+    assert set(rows.slave.tolist()) <= deep                     # both ends inside B
+    geometry = Geometry(arrays=arrays, fragment=vf[arrays.tets[:, 0]], seams=None,
+                        fixed=np.zeros(0, dtype=np.int64))
+    active = ActiveSet3d(geometry, 1e-12, copy_tol=1e-9)
+    candidates = active.update(U, {"collision": 0.0})
+    assert set(active.codec.codes(rows).tolist()) <= set(candidates.keys.codes.tolist())

@@ -43,8 +43,9 @@ Candidates, each identified by its key ("f", slave, master vertices sorted; "e",
   complementarity problem chooses the set, while it has been wanted or imposed in the
   solve (a row the problem released must stay visible to the next problem). Found the
   same way, from the planes at copies of a point: a copy behind the plane of a partner
-  face at its copy, and the ends of a junction edge inside the wedge of a diagonal
-  neighbour's copy of it, deeper than ``copy_tol``
+  face at its copy, the ends of a junction edge inside the wedge of a diagonal
+  neighbour's copy of it, and the ends of an edge copy behind a face of another copy's
+  reflex wedge, deeper than ``copy_tol``
   (:meth:`ActiveSet3d._with_rows_at_copies`; docs/contact.md, "Rows at copies found by
   their planes").
 
@@ -174,8 +175,9 @@ class ActiveSet3d(ActiveSet):
         Depth (a length) of a crossing of two edges that makes an edge-to-edge row
         (default ``penetration_tol``); once a row, it is judged by ``penetration_tol``.
     copy_tol : float, optional
-        Depth (a length) of a copy behind a partner face's plane at its copy, or of a
-        junction edge in a diagonal neighbour's wedge, that makes a row
+        Depth (a length) of a copy behind a partner face's plane at its copy, of a
+        junction edge in a diagonal neighbour's wedge, or of an edge copy behind a face of
+        another copy's reflex wedge, that makes a row
         (:meth:`_with_rows_at_copies`; default ``penetration_tol``).
     **options
         ``rank_tol``, ``pdas_rounds``, ``max_updates``, ``warm`` of ActiveSet (``tol`` and
@@ -360,12 +362,17 @@ class ActiveSet3d(ActiveSet):
         copies the scene's rows tie (:attr:`tied`). A slave that the detection
         (``pen``) finds deeper than ``penetration_tol`` gets none: its detected row holds it
         (in a prediction whole lips pass through each other, and rows linearised there
-        would hold planes far from where the lips come back to)."""
+        would hold planes far from where the lips come back to). The reflex-wedge rows
+        are kept for such a slave: inside a reflex wedge the detected row, on one face at
+        the copy, can be satisfied while the slave is behind the other face (the coarse
+        free sphere: a copy on the plane of the face its detected row holds, 1.0e-5 deep
+        in the other fragment, 1.3e-5 behind the wedge's other face)."""
         a, setup = self.geometry.arrays, self.setup
         nv = len(a.points)
+        reflex = reflex_wedge_rows(setup.edge_copies, U, self.copy_tol, setup.copy_index)
         parts = [behind_partner_rows(setup.partners, U, self.copy_tol, setup.copy_index),
                  wedge_rows(setup.diagonal_edges, U, self.copy_tol, setup.copy_index, setup.vertex_fragment),
-                 reflex_wedge_rows(setup.edge_copies, U, self.copy_tol, setup.copy_index)]
+                 reflex]
         if self.warm:
             # the rows at copies the solve before imposed, which the warm start names
             warm = self._key_codes(sorted(self.warm))
@@ -376,7 +383,11 @@ class ActiveSet3d(ActiveSet):
         copy = more.master[np.arange(len(more)), np.argmax(more.bary, axis=1)]
         deep = unique_ints(np.asarray(pen.vertex, dtype=np.int64)[pen.gap < -self.penetration_tol])
         keep = ~isin_ints(np.minimum(more.slave, copy) * nv + np.maximum(more.slave, copy), self.tied)
-        return self._with_new(found, codes, more.subset(np.flatnonzero(keep & ~isin_ints(more.slave, deep))))
+        exempt = np.zeros(len(more), dtype=bool)
+        start = len(parts[0]) + len(parts[1])
+        exempt[start:start + len(reflex)] = True
+        return self._with_new(found, codes,
+                              more.subset(np.flatnonzero(keep & (exempt | ~isin_ints(more.slave, deep)))))
 
     def _with_new(self, rows, codes, more):
         """``rows`` and their key ``codes`` followed by the rows of ``more`` whose keys they
