@@ -23,13 +23,14 @@ namespace ngfracture::bindings
   // every entry of a in [0, bound)
   inline void CheckRange (const char * fn, const char * name, const LArr & a, int64_t bound)
   {
-    // one pass without an early exit (it vectorises): the check runs on every call of
-    // the round's kernels, over arrays as long as the boundary's faces
+    // one pass without an early exit, the flags or-ed into an integer (so it vectorises):
+    // the check runs on every call of the round's kernels, over arrays as long as the
+    // boundary's faces
     const int64_t * p = a.data();
-    bool out = false;
+    int64_t out = 0;
     for (pybind11::ssize_t i = 0; i < a.size(); i++)
       out |= (p[i] < 0) | (p[i] >= bound);
-    if (out)
+    if (out != 0)
       throw std::invalid_argument(std::string("ngfracture.") + fn + ": " + name + " has an entry outside [0, "
                                   + std::to_string(bound) + ")");
   }
