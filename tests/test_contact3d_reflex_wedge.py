@@ -2,8 +2,9 @@
 ``edge_copies`` and ``reflex_wedge_rows``).
 
 Three blocks around the line x = y = 0, z in [0, H], meshed apart (``sector_blocks``): A on
-the angles [0, 60] degrees, C on [60, 120], B on [120, 360], a reflex wedge of 240 degrees. A shares its face at 0 degrees with B and its face at 60 with C; B's face at 120
-is shared with C, no partner face of A. The line's one edge has a copy on each block.
+the angles [0, 60] degrees, C on [60, 120], B on [120, 360], a reflex wedge of 240 degrees.
+A shares its face at 0 degrees with B and its face at 60 with C; B's face at 120 is shared
+with C, no partner face of A. The line's one edge has a copy on each block.
 
 - A moved by eps (-1, 1/2) and stretched along the line (its ends out of the blocks'
   z range), C by eps (-1, 2), B held: every partner face holds (A in front of B's face at

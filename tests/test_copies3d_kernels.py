@@ -10,7 +10,9 @@ computes, every round of every 3D contact solve; the rows they make must be the 
 zeros, the order of the rows), on configurations where many rows fire: a body cut into
 2 x 2 x 2 blocks (junction lines of four blocks, a point of eight) whose vertices are
 moved at random by up to a fifth of the element size, some pairs of copies left
-together (gap exactly 0), some faces squeezed flat (no plane).
+together (gap exactly 0), some faces squeezed flat (no plane); for the reflex-wedge rows,
+whose wedges of 90 degrees there never fire, three blocks around a line with a wedge of
+240 degrees (``sector_blocks``) moved the same way.
 """
 import numpy as np
 import pytest
