@@ -32,7 +32,6 @@ Usage: PYTHONPATH=. OMP_NUM_THREADS=1 python benchmarks/sphere3d.py [--fine 0.15
 """
 import argparse
 import json
-import math
 import shutil
 import sys
 import tempfile
@@ -42,6 +41,7 @@ from pathlib import Path
 import numpy as np
 
 import benchmark_json
+from contact3d import unit_solve
 
 #: the default fine values: the default mesh (0.075) and two coarsenings
 DEFAULT_FINE = [0.15, 0.106, 0.075]
@@ -54,34 +54,13 @@ class Stop(Exception):
 
 
 def cpu_unit(scene, repeat):
-    """(wall, CPU, solver) of the best of ``repeat`` unit solves: benchmarks/solid.py
-    ``unit_solve`` (one factorisation and one solve of the first increment's linear
-    elasticity, one thread), timed in CPU seconds as well."""
-    import ngsolve
-    from ngfracture.linalg.factor import EliminatedFactor
-    from ngfracture.linalg.iterative import problem_inverse
+    """(wall, CPU, solver) of the best of ``repeat`` unit solves of the first increment's
+    linear elasticity: benchmarks/contact3d.py ``unit_solve`` (one factorisation and one
+    solve, one thread)."""
     from ngfracture.mechanics.problem import ElasticProblem
     prob = ElasticProblem(scene.mesh, scene.material, order=1)
     scene.apply_load(prob, scene.dx)
-    rows = prob.assemble_constraints()
-    support = prob.support(rows)
-    prob.form.AssembleLinearization(prob.u.vec)
-    K, rhs = prob.form.mat, np.ones(prob.fes.ndof)
-    best_wall, best_cpu, solver = math.inf, math.inf, None
-    before = ngsolve.GetNumThreads()
-    ngsolve.SetNumThreads(1)
-    try:
-        for _ in range(repeat):
-            t0, c0 = time.perf_counter(), time.process_time()
-            factor = EliminatedFactor(K, rows.fixed_dofs, support.pins, inverse=problem_inverse("auto", prob.dim))
-            factor.factorise()
-            x = factor.solve(rhs)
-            best_wall, best_cpu = min(best_wall, time.perf_counter() - t0), min(best_cpu, time.process_time() - c0)
-            solver = factor.inverse
-            assert np.all(np.isfinite(x))
-    finally:
-        ngsolve.SetNumThreads(before)
-    return best_wall, best_cpu, solver
+    return unit_solve(prob, repeat)
 
 
 def run_case(fine, steps, cpu_limit, resume, repeat):
