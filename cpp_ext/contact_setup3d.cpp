@@ -378,13 +378,13 @@ namespace ngfracture
     }
   }
 
-  void DiagonalEdgePairs (int64_t nE, const int64_t * E, const int64_t * at, const int64_t * vf,
-                          const int64_t * pid, int64_t n_points, const int64_t * face_key,
-                          std::vector<int64_t> & a, std::vector<int64_t> & b, std::vector<int64_t> & ends_b)
+  // Every ordered pair (ea, eb) of distinct edges on the same two points, each with two
+  // faces, eb increasing within ea (a stable run of EdgesByPoints): the loop of
+  // DiagonalEdgePairs and EdgeCopyPairs, which differ in the pairs they keep
+  template <class Visit>
+  void ForEdgeCopyPairs (int64_t nE, const int64_t * E, const int64_t * at, const int64_t * pid,
+                         int64_t n_points, Visit visit)
   {
-    a.clear();
-    b.clear();
-    ends_b.clear();
     EdgeRuns runs = EdgesByPoints(nE, E, pid, n_points);
     for (int64_t ea = 0; ea < nE; ea++)
       {
@@ -392,23 +392,37 @@ namespace ngfracture
         if (fa[0] < 0 || fa[1] < 0)
           continue;
         int64_t r = runs.run_of[ea];
-        for (int64_t i = runs.run_start[r]; i < runs.run_start[r + 1]; i++)   // b increasing: a stable run
+        for (int64_t i = runs.run_start[r]; i < runs.run_start[r + 1]; i++)
           {
             int64_t eb = runs.order[i];
             const int64_t * fb = at + 2 * eb;
-            if (vf[E[2 * ea]] == vf[E[2 * eb]] || fb[0] < 0 || fb[1] < 0)
-              continue;
-            bool shared = false;
-            for (int k = 0; k < 2; k++)
-              for (int l = 0; l < 2; l++)
-                shared = shared || face_key[fa[k]] == face_key[fb[l]];
-            if (shared)
-              continue;
-            a.push_back(ea);
-            b.push_back(eb);
-            PushEndsInOrder(E, pid, ea, eb, ends_b);
+            if (eb != ea && fb[0] >= 0 && fb[1] >= 0)
+              visit(ea, eb, fa, fb);
           }
       }
+  }
+
+  void DiagonalEdgePairs (int64_t nE, const int64_t * E, const int64_t * at, const int64_t * vf,
+                          const int64_t * pid, int64_t n_points, const int64_t * face_key,
+                          std::vector<int64_t> & a, std::vector<int64_t> & b, std::vector<int64_t> & ends_b)
+  {
+    a.clear();
+    b.clear();
+    ends_b.clear();
+    ForEdgeCopyPairs(nE, E, at, pid, n_points, [&] (int64_t ea, int64_t eb, const int64_t * fa, const int64_t * fb)
+      {
+        if (vf[E[2 * ea]] == vf[E[2 * eb]])
+          return;
+        bool shared = false;
+        for (int k = 0; k < 2; k++)
+          for (int l = 0; l < 2; l++)
+            shared = shared || face_key[fa[k]] == face_key[fb[l]];
+        if (shared)
+          return;
+        a.push_back(ea);
+        b.push_back(eb);
+        PushEndsInOrder(E, pid, ea, eb, ends_b);
+      });
   }
 
   void EdgeCopyPairs (int64_t nE, const int64_t * E, const int64_t * at, const int64_t * pid, int64_t n_points,
@@ -419,31 +433,19 @@ namespace ngfracture
     b.clear();
     ends_b.clear();
     partner.clear();
-    EdgeRuns runs = EdgesByPoints(nE, E, pid, n_points);
-    for (int64_t ea = 0; ea < nE; ea++)
+    ForEdgeCopyPairs(nE, E, at, pid, n_points, [&] (int64_t ea, int64_t eb, const int64_t * fa, const int64_t * fb)
       {
-        const int64_t * fa = at + 2 * ea;
-        if (fa[0] < 0 || fa[1] < 0)
-          continue;
-        int64_t r = runs.run_of[ea];
-        for (int64_t i = runs.run_start[r]; i < runs.run_start[r + 1]; i++)   // b increasing: a stable run
-          {
-            int64_t eb = runs.order[i];
-            const int64_t * fb = at + 2 * eb;
-            if (eb == ea || fb[0] < 0 || fb[1] < 0)
-              continue;
-            uint8_t shared[2];
-            for (int l = 0; l < 2; l++)
-              shared[l] = face_key[fb[l]] == face_key[fa[0]] || face_key[fb[l]] == face_key[fa[1]];
-            if (shared[0] && shared[1])
-              continue;                                   // the partner-face rows are the whole condition
-            a.push_back(ea);
-            b.push_back(eb);
-            PushEndsInOrder(E, pid, ea, eb, ends_b);
-            partner.push_back(shared[0]);
-            partner.push_back(shared[1]);
-          }
-      }
+        uint8_t shared[2];
+        for (int l = 0; l < 2; l++)
+          shared[l] = face_key[fb[l]] == face_key[fa[0]] || face_key[fb[l]] == face_key[fa[1]];
+        if (shared[0] && shared[1])
+          return;                                         // the partner-face rows are the whole condition
+        a.push_back(ea);
+        b.push_back(eb);
+        PushEndsInOrder(E, pid, ea, eb, ends_b);
+        partner.push_back(shared[0]);
+        partner.push_back(shared[1]);
+      });
   }
 
   void VertexFragments (int64_t nv, int64_t ne, const int64_t * tets, int64_t row, int64_t col,
