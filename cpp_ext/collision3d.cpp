@@ -1054,11 +1054,11 @@ namespace ngfracture
             }
           double depth = 0;
           int32_t sep = t_copy >= 0 ? SeparatingFace(m, vfaces, T, v, t_copy, m.tets + 4*t, depth) : -1;
-          // none, and three or more copies of the point on F (cracks meeting inside F): v's
-          // wedge can lie across the plane of the lip it crossed into t's wedge; that lip
-          // still separates v if v is behind it (the nearest face of F may be the coincident
-          // lip of another copy, v in front of it)
-          if (sep < 0 && t_copy >= 0 && copies.CountOn(D.vfrag, v, F) >= 3)
+          // none, and two or more copies of the point on F (a crack inside F, or cracks
+          // meeting inside F): v's wedge can lie across the plane of the lip it crossed
+          // into t's wedge; that lip still separates v if v is behind it (the nearest face
+          // of F may be the coincident lip of another copy, v in front of it)
+          if (sep < 0 && t_copy >= 0 && copies.CountOn(D.vfrag, v, F) >= 2)
             sep = SeparatingFace(m, vfaces, T, v, t_copy, m.tets + 4*t, depth, &copies);
           // none, three or more copies on F, and the holding tetrahedron has no face on the
           // boundary at t: v slid past the faces of the tetrahedra at t deeper into t's star

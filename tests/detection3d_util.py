@@ -7,8 +7,8 @@ on its twin (its first copy on the fragment, other than itself) is a closed seam
 holding tetrahedron of a pair is the smallest. Master faces (collision3d's docstring): in
 a tetrahedron at a copy t of the vertex, the face of that tetrahedron at t with the
 vertex's reference star outside its plane that the vertex is least deep behind; if none
-passes and three copies of the point lie on the fragment, the lip of that tetrahedron at
-t the vertex is least deep behind if it is behind one; else, where that tetrahedron has no
+passes and two or more copies of the point lie on the fragment, the lip of that
+tetrahedron at t the vertex is least deep behind if it is behind one; else, where that tetrahedron has no
 boundary face at t and three copies lie on the fragment, the lip at t (of any tetrahedron)
 that the vertex is least deep behind; else the nearest face of the fragment
 opposing the vertex's normal or coincident with one of its faces (partner faces). Import with ``PYTHONPATH=.:tests``.
@@ -147,7 +147,7 @@ class MasterReference:
         on_block = int(np.count_nonzero(np.all(X == X[a], axis=1) & (self.vf == f)))
         if not len(sep):
             lips = at[[self.points_count[self.points[g]] > 1 for g in at]]
-            if len(lips) and on_block >= 3 and self.signed(a, t[0], lips).max() < 0:
+            if len(lips) and on_block >= 2 and self.signed(a, t[0], lips).max() < 0:
                 sep, by_lip = lips, True
         if not len(sep) and not len(at) and on_block >= 3:
             # a tetrahedron with no boundary face at the copy, three copies on the fragment:

@@ -1,4 +1,4 @@
-"""The detection's lip rule at points of three copies on one fragment (docs/contact.md,
+"""The detection's lip rule at points of two or more copies on one fragment (docs/contact.md,
 "Points of several copies"; ``SeparatingFace(..., lips_only)`` in cpp_ext/collision3d.cpp).
 
 The body is the junction cube of ``test_contact3d_crack_junction.py``: two cracks inside
@@ -14,6 +14,10 @@ at the top the free face is nearer than the lip (a rule over every face of the
 tetrahedron would take it). The whole detection must equal the brute-force reference of
 ``detection3d_util`` (the rules of collision3d's docstring).
 
+The same with the plane x = 1/2 cut through the whole cube (``cut_cube``): W0 is a piece
+of its own, and the points of the line have two copies on the other piece (the lips of the
+crack y = 1/2 inside it); the rule is the same there.
+
 Deeper in the star: the copy moved into a tetrahedron at t with no face on the boundary
 gets the boundary face at t it is least deep behind, where the nearest face rule takes
 one it is deeper behind.
@@ -25,9 +29,10 @@ import pytest
 
 from ngfracture.contact.collision3d import detect_penetrations_3d
 from ngfracture.contact.rows3d import node_to_face_rows
+from ngfracture.geometry.structured import box_mesh
 
 from detection3d_util import MasterReference, brute_force_pairs
-from test_contact3d_crack_junction import N, junction_cube, wedge_labels
+from test_contact3d_crack_junction import GRID, N, junction_cube, opened, plane_faces, wedge_labels
 
 H = 1.0 / N                 # the cell size
 EPS = 1e-3                  # the vertex moves by about EPS cells
@@ -64,6 +69,21 @@ def exact_signed(x, face, p):
 CASES = {"inner point": (0.75, 1, (0.4, 0.1, 0.1)), "top point": (1.0, 2, (0.1, 0.1, 0.3))}
 
 
+def cut_cube():
+    """The junction cube's cracks with the plane x = 1/2 cut through the whole cube: the half
+    x < 1/2 is piece 1, the half x > 1/2 (with the crack y = 1/2 inside it) piece 0."""
+    a = box_mesh(GRID, GRID, GRID)
+    a = opened(a, plane_faces(a, 0, 0.5, lambda c: np.ones(len(c), bool)), lambda p: np.zeros(p.shape[:-1], bool))
+    return opened(a, plane_faces(a, 1, 0.5, lambda c: (c[:, 2] > 0.5) & (c[:, 0] > 0.5) & (c[:, 0] < 0.75)),
+                  lambda p: (p[..., 0] == 0.75) | (p[..., 2] == 0.5))
+
+
+# the body and its piece per tetrahedron: three copies of the line's points on one piece, or
+# two on the piece x > 1/2 and one on the piece x < 1/2
+BODIES = {"one piece": (junction_cube, lambda a, labels: np.zeros(len(a.tets), np.int64)),
+          "cut through": (cut_cube, lambda a, labels: (labels == 0).astype(np.int64))}
+
+
 def holding_tet(a, labels, v, t, wedge):
     """The tetrahedron of ``wedge`` at copy t whose boundary faces at t all fail v's star
     test and include a lip; asserts there is one."""
@@ -75,12 +95,15 @@ def holding_tet(a, labels, v, t, wedge):
     raise AssertionError(f"no tetrahedron of wedge {wedge} at copy {t} fails the star test")
 
 
+@pytest.mark.parametrize("body", sorted(BODIES))
 @pytest.mark.parametrize("case", sorted(CASES))
-def test_the_master_is_the_lip_the_vertex_is_least_deep_behind(case):
+def test_the_master_is_the_lip_the_vertex_is_least_deep_behind(case, body):
     z, wedge, weights = CASES[case]
-    a = junction_cube()
+    make, pieces = BODIES[body]
+    a = make()
     X, T, F = a.points, a.tets, a.faces
     labels = wedge_labels(a)
+    piece = pieces(a, labels)
     copies = copies_of(X, z)
     side = [set(labels[np.any(T == c, axis=1)].tolist()) for c in copies]
     assert len(copies) == 3 and sorted(map(tuple, side)) == [(0,), (1,), (2,)]
@@ -90,7 +113,7 @@ def test_the_master_is_the_lip_the_vertex_is_least_deep_behind(case):
     U = np.zeros_like(X)
     U[v] = EPS * sum(w * (X[u] - X[t]) for w, u in zip(weights, others))
     x = X + U
-    ref = MasterReference(X, U, T, F, np.zeros(len(T), np.int64))
+    ref = MasterReference(X, U, T, F, piece)
     lips = [f for f in at if ref.points_count[ref.points[f]] > 1]
     assert len(lips) == 1 and len(at) == (1 if z < 1 else 2)
     lip = lips[0]
@@ -100,7 +123,7 @@ def test_the_master_is_the_lip_the_vertex_is_least_deep_behind(case):
         top = next(f for f in at if f != lip)
         assert 0.0 < -exact_signed(x, F[top], x[v]) < depth / 2
 
-    pen = detect_penetrations_3d(X, T, F, np.zeros(len(T), np.int64), displacement=U)
+    pen = detect_penetrations_3d(X, T, F, piece, displacement=U)
     i = np.flatnonzero(pen.vertex == v)
     assert len(i) == 1
     i = int(i[0])
@@ -113,14 +136,14 @@ def test_the_master_is_the_lip_the_vertex_is_least_deep_behind(case):
 
     # the brute-force reference: the same pairs, the same master faces, the same key
     assert ref.at_copy(v, 0, T[k]) == (lip, pytest.approx(-depth, rel=1e-15), True)
-    vertex, fragment, tet, closed = brute_force_pairs(X, T, F, np.zeros(len(T), np.int64), U)
+    vertex, fragment, tet, closed = brute_force_pairs(X, T, F, piece, U)
     assert np.array_equal(pen.vertex, vertex) and np.array_equal(pen.fragment, fragment)
     assert np.array_equal(pen.tet, tet) and pen.stats["closed_seams"] == closed
     crossed, behind = ref.check(pen, 1e-15)
     assert behind == 1
     key = node_to_face_rows(X, F, pen).keys()[i]
     assert key == ("f", v, *sorted(F[lip].tolist()))
-    print(f"\n{case}: {len(pen)} pairs, {crossed} at a copy, {behind} by the lip rule; depth {depth:.6g} "
+    print(f"\n{case}, {body}: {len(pen)} pairs, {crossed} at a copy, {behind} by the lip rule; depth {depth:.6g} "
           f"(detected - exact {-pen.gap[i] - depth:.3g}), nearest face {d.min():.6g}, {closed} closed seams")
 
 

@@ -59,13 +59,15 @@ that depth (0 if v is not behind it), the projection the nearest point of the fa
 are the faces v's wedge can have crossed: the lip between the two copies, or, where three
 or more copies meet, the lip of t towards a third copy that v slid past; not a face of t
 that v's wedge lies across (the side face that the edge of a lip pushed across the crack
-lies on). If no face passes that test and three or more copies of the point lie on F (a
-junction of cracks inside F), the lip of that tetrahedron at t (a face with another
-boundary face on its three points) that v is least deep behind, if v is behind one: there
-v's wedge can lie across the plane of the lip it crossed into t's wedge, and the nearest
-face is the coincident lip at the third copy, which v is in front of (the coarse confined
-sphere at x = 2.70e-3: v 1.4e-5 behind the lip at t, reported 2.35e-5 deep on the lip at
-the third copy, whose row did not hold it). If neither gives a face, the holding
+lies on). If no face passes that test and two or more copies of the point lie on F (a
+crack inside F, or a junction of cracks inside F), the lip of that tetrahedron at t (a
+face with another boundary face on its three points) that v is least deep behind, if v is
+behind one: there v's wedge can lie across the plane of the lip it crossed into t's
+wedge, and the nearest face is the coincident lip at another copy, which v is in front of
+(the coarse confined sphere at x = 2.70e-3: v 1.4e-5 behind the lip at t, reported
+2.35e-5 deep on the lip at the third copy, whose row did not hold it; the coarse free
+sphere's step after x = 1.931e-3, two copies on F: v 8.85e-6 behind the crack face at
+t). If neither gives a face, the holding
 tetrahedron has no boundary face at t and three or more copies lie on F (v slid past the
 faces of the tetrahedra at t deeper into t's star where several cracks meet): the lip at
 t, of any tetrahedron, that v is least deep behind, if v is behind one; the nearest face
