@@ -229,11 +229,9 @@ def test_run_confined(tmp_path):
 
 @pytest.mark.slow
 @pytest.mark.xfail(strict=True, reason="the coarse free run is not shown to reach the end of its load range "
-                   "(4.14e-3): with the reflex-wedge rows it passes "
-                   "x = 3.242e-3 (step 26, 24 fragments) with every step's invariants, not "
-                   "run further; two attempts of its step 8 end on a vertex 8.85e-6 inside another piece where "
-                   "the detection's master is a coincident lip the vertex is in front of (docs/limitations.md, "
-                   "docs/solid.md, 'The sphere scenes')")
+                   "(4.14e-3): its step 31 (x = 2.660e-3) fails after three attempts on a vertex inside another "
+                   "piece, slid along a crack lip's plane past the crack's front edge, which no node-to-edge row "
+                   "holds (docs/limitations.md, docs/solid.md, 'The sphere scenes')")
 def test_run_free(tmp_path):
     """sphere3d_free on the coarse mesh: the same invariants per step, and it falls apart
     (the core and at least two glass pieces), as the 2D disintegration."""
