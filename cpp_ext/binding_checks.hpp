@@ -4,6 +4,7 @@
 #ifndef NGFRACTURE_BINDING_CHECKS_HPP
 #define NGFRACTURE_BINDING_CHECKS_HPP
 #include <python_comp.hpp>
+#include <cstdint>
 #include <stdexcept>
 #include <string>
 
@@ -23,14 +24,18 @@ namespace ngfracture::bindings
   // every entry of a in [0, bound)
   inline void CheckRange (const char * fn, const char * name, const LArr & a, int64_t bound)
   {
-    // one pass without an early exit, the flags or-ed into an integer (so it vectorises):
-    // the check runs on every call of the round's kernels, over arrays as long as the
-    // boundary's faces
-    const int64_t * p = a.data();
-    int64_t out = 0;
-    for (pybind11::ssize_t i = 0; i < a.size(); i++)
-      out |= (p[i] < 0) | (p[i] >= bound);
-    if (out != 0)
+    // one pass without an early exit or compares (the check runs on every call of the
+    // round's kernels, over arrays as long as the boundary's faces): the sign bit of p is
+    // set for p < 0, that of (bound - 1) - p (unsigned, no overflow) for p >= bound, so the
+    // or of both over all entries has its top bit set exactly if an entry is outside
+    // (subtractions and ors, which vectorise without 64-bit compares)
+    const uint64_t * p = reinterpret_cast<const uint64_t *>(a.data());
+    const uint64_t last = uint64_t(bound) - 1;
+    const pybind11::ssize_t n = a.size();      // out of the loop: a call into numpy
+    uint64_t out = 0;
+    for (pybind11::ssize_t i = 0; i < n; i++)
+      out |= p[i] | (last - p[i]);
+    if (out >> 63)
       throw std::invalid_argument(std::string("ngfracture.") + fn + ": " + name + " has an entry outside [0, "
                                   + std::to_string(bound) + ")");
   }
@@ -39,7 +44,8 @@ namespace ngfracture::bindings
   inline void CheckSorted (const char * fn, const char * name, const LArr & a)
   {
     const int64_t * p = a.data();
-    for (pybind11::ssize_t i = 1; i < a.size(); i++)
+    const pybind11::ssize_t n = a.size();
+    for (pybind11::ssize_t i = 1; i < n; i++)
       if (p[i] < p[i - 1])
         throw std::invalid_argument(std::string("ngfracture.") + fn + ": " + name + " is not sorted");
   }

@@ -98,7 +98,7 @@ tuple
           Check("FragmentPairEntries", "copies", copies, 1, 0);
           CheckRange("FragmentPairEntries", "faces", faces, nv);
           CheckRange("FragmentPairEntries", "key_order", key_order, nf);
-          for (py::ssize_t i = 0; i < faces.size(); i++)
+          for (py::ssize_t i = 0, n_faces = faces.size(); i < n_faces; i++)
             if (pid.data()[faces.data()[i]] < 0 || pid.data()[faces.data()[i]] >= copies.shape(0))
               throw std::invalid_argument("ngfracture.FragmentPairEntries: a face's vertex has no point");
           PairEntriesInput in { nv, nf, faces.data(), vf.data(), pid.data(), key_order.data(), key_sorted.data(),
@@ -194,12 +194,12 @@ slave, face, corner : numpy.ndarray of int64
           Check(fn, "point", pid, 1, 0, nv);
           Check(fn, "face_key", face_key, 1, 0);
           CheckRange(fn, "edges", edges, nv);
-          for (py::ssize_t i = 0; i < at.size(); i++)
+          for (py::ssize_t i = 0, n_at = at.size(); i < n_at; i++)
             if (at.data()[i] < -1 || at.data()[i] >= nf)
               throw std::invalid_argument("ngfracture.DiagonalEdgePairs: faces_at_edge has an entry outside [-1, "
                                           + std::to_string(nf) + ")");
           int64_t n_points = 0;
-          for (py::ssize_t i = 0; i < edges.size(); i++)
+          for (py::ssize_t i = 0, n_edges = edges.size(); i < n_edges; i++)
             {
               int64_t q = pid.data()[edges.data()[i]];
               if (q < 0)
@@ -239,12 +239,12 @@ ends_b : numpy.ndarray of int64, shape (m, 2)
           Check(fn, "point", pid, 1, 0);
           Check(fn, "face_key", face_key, 1, 0);
           CheckRange(fn, "edges", edges, pid.shape(0));
-          for (py::ssize_t i = 0; i < at.size(); i++)
+          for (py::ssize_t i = 0, n_at = at.size(); i < n_at; i++)
             if (at.data()[i] < -1 || at.data()[i] >= nf)
               throw std::invalid_argument("ngfracture.EdgeCopyPairs: faces_at_edge has an entry outside [-1, "
                                           + std::to_string(nf) + ")");
           int64_t n_points = 0;
-          for (py::ssize_t i = 0; i < edges.size(); i++)
+          for (py::ssize_t i = 0, n_edges = edges.size(); i < n_edges; i++)
             {
               int64_t q = pid.data()[edges.data()[i]];
               if (q < 0)

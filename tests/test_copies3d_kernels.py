@@ -353,6 +353,15 @@ def test_bad_input_names_the_argument(blocks):
     slave, face, corner = setup.partners
     with pytest.raises(ValueError, match="slave has an entry outside"):
         ext.BehindPartnerGaps(x, F, slave + len(x), face, corner, 0.0)
+    # the range check's edges: -1, nv and the extremes of int64 out, nv - 1 in
+    for bad in (-1, len(x), np.iinfo(np.int64).max, np.iinfo(np.int64).min):
+        wrong = slave.copy()
+        wrong[-1] = bad
+        with pytest.raises(ValueError, match=rf"slave has an entry outside \[0, {len(x)}\)"):
+            ext.BehindPartnerGaps(x, F, wrong, face, corner, 0.0)
+    last = slave.copy()
+    last[-1] = len(x) - 1
+    ext.BehindPartnerGaps(x, F, last, face, corner, 0.0)
     with pytest.raises(ValueError, match="corner has the wrong shape"):
         ext.BehindPartnerGaps(x, F, slave, face, corner[:-1], 0.0)
     d = setup.diagonal_edges
