@@ -56,6 +56,7 @@ import numpy as np
 
 from .. import _ngfracture as _ext
 from .kinks3d import KINK, CopyIndex
+from .rows import take_rows
 from .rows3d import NodeToFaceRows, no_face_rows
 
 __all__ = ["found_rows_at_copies", "folded_rows_at_copies", "two_sided_rows", "partner_incidences",
@@ -214,12 +215,12 @@ def two_sided_rows(rows, points, displacement, index, margin=0.0):
     partner = _partner_at(index, rows.face[at], rows.slave[at])
     at, partner = at[partner >= 0], partner[partner >= 0]
     x = X + np.asarray(displacement)
-    tri = x[index.faces[partner]]
+    tri = take_rows(x, take_rows(index.faces, partner))
     area = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
     length = np.linalg.norm(area, axis=1)
     ok = length > 1e-16 * np.linalg.norm(index.area2[partner], axis=1)      # not squeezed flat
     reverse = -area / np.where(ok, length, 1.0)[:, None]
-    d = x[rows.slave[at]] - x[corner[at]]
+    d = take_rows(x, rows.slave[at]) - take_rows(x, corner[at])
     gap = np.einsum("ij,ij->i", reverse, d)
     tighter = ok & (gap < rows.dist[at] - margin)
     if not tighter.any():
@@ -252,13 +253,14 @@ def rows_at_copy(slave, face, corner, dist, index):
     """
     bary = np.zeros((len(slave), 3))
     bary[np.arange(len(slave)), corner] = 1.0
-    return NodeToFaceRows(slave=slave, master=index.faces[face], face=face, bary=bary, normal=index.unit[face],
+    return NodeToFaceRows(slave=slave, master=take_rows(index.faces, face), face=face, bary=bary,
+                          normal=take_rows(index.unit, face),
                           dist=dist, g=np.zeros(len(slave)), nv=len(index.points))
 
 
 def _plane_gaps(x, faces, face, slave, copy):
     """n_f . (x_s - x_t) with the faces' unit normals at x; 0 on a face squeezed flat (no plane)."""
-    tri = x[faces[face]]
+    tri = take_rows(x, take_rows(faces, face))
     area = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
     length = np.linalg.norm(area, axis=1)
     return np.where(length > 0, np.einsum("ij,ij->i", area, x[slave] - x[copy]) / np.where(length > 0, length, 1.0),

@@ -41,6 +41,7 @@ import numpy as np
 
 from .. import _ngfracture as _ext
 from .kinks3d import KINK, CopyIndex
+from .rows import take_rows
 from .rows3d import NodeToFaceRows, face_gap_rows, fragment_twin_rows, no_face_rows
 
 __all__ = ["fragment_pair_rows", "covered_pairs"]
@@ -128,7 +129,7 @@ def fragment_pair_rows(points, faces, vertex_fragment, index=None):
         return fallback
     bary = np.zeros((len(slave), 3))
     bary[np.arange(len(slave)), k] = 1.0
-    master, normal = F[face], index.unit[face]
+    master, normal = take_rows(F, face), take_rows(index.unit, face)
     _, g = face_gap_rows(X, slave, master, bary, normal)
     rows = NodeToFaceRows(slave=slave, master=master, face=face, bary=bary, normal=normal, dist=g.copy(), g=g, nv=nv)
     return NodeToFaceRows.stack([rows, fallback]) if len(fallback) else rows

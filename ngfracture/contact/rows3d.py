@@ -63,7 +63,7 @@ import scipy.sparse as sp
 
 from .. import _ngfracture as _ext
 from .kinks3d import KINK, CopyIndex, copy_pairs, expand_ranges, isin_ints, partner_faces
-from .rows import RowTable
+from .rows import RowTable, take_rows
 
 __all__ = ["NodeToFaceRows", "no_face_rows", "node_to_face_rows", "twin_rows", "fragment_twin_rows", "lip_rows", "face_gap_rows",
            "relinearise_node_to_face"]
@@ -305,9 +305,9 @@ def node_to_face_rows(points, faces, penetrations, slave=None):
     if face.size and (face.min() < 0 or face.max() >= len(F)):
         raise ValueError(f"penetrations.face holds face numbers outside [0, {len(F)})")
     s = _vertices(np.asarray(pen.vertex)[keep], "penetrations.vertex", nv, (len(face),))
-    bary = _coordinates(np.asarray(pen.bary)[keep], "penetrations.bary", len(face))
-    normal = _coordinates(np.asarray(pen.normal)[keep], "penetrations.normal", len(face))
-    master = F[face]
+    bary = _coordinates(take_rows(np.asarray(pen.bary), keep), "penetrations.bary", len(face))
+    normal = _coordinates(take_rows(np.asarray(pen.normal), keep), "penetrations.normal", len(face))
+    master = take_rows(F, face)
     return NodeToFaceRows(slave=s, master=master, face=face, bary=bary.copy(), normal=normal.copy(),
                           dist=np.asarray(pen.gap, dtype=np.float64)[keep].copy(),
                           g=_gap_offset(X, s, master, bary, normal), nv=nv)

@@ -22,6 +22,7 @@ from .edge_crossings3d import EdgeCrossingDetector
 from .edge_rows3d import two_faces
 from .junctions3d import covered_pairs, fragment_pair_rows
 from .kinks3d import CopyIndex
+from .rows import take_rows
 from .rows3d import NodeToFaceRows, lip_rows, node_to_face_rows
 from .wedges3d import diagonal_edges, edge_copies
 
@@ -84,7 +85,7 @@ class FaceKeys:
             If a row's master is not the vertex set of its face.
         """
         sets = self.face_set[np.asarray(rows.face, dtype=np.int64)]
-        if not np.array_equal(self.triples[sets], np.sort(rows.master, axis=1)):
+        if not np.array_equal(take_rows(self.triples, sets), np.sort(rows.master, axis=1)):
             raise ValueError("FaceKeys.codes: a row's master is not the vertex set of its face")
         return np.asarray(rows.slave, dtype=np.int64) * self.n + sets
 

@@ -41,6 +41,7 @@ import numpy as np
 from .. import _ngfracture as _ext
 from .copies3d import rows_at_copy
 from .intsets import isin_ints
+from .rows import take_rows
 from .rows3d import no_face_rows
 
 __all__ = ["DiagonalEdges", "EdgeCopies", "diagonal_edges", "edge_copies", "wedge_rows", "reflex_wedge_rows"]
@@ -109,7 +110,7 @@ def diagonal_edges(edges, faces_at_edge, vertex_fragment, index):
     # sorted by (a, b). The same arrays as the numpy computation that
     # tests/test_contact3d_setup_kernels.py keeps and compares
     a, b, ends_b = _ext.DiagonalEdgePairs(E, at, vf, pid, index.face_key)
-    return DiagonalEdges(E[a], ends_b, at[b], a, b)
+    return DiagonalEdges(take_rows(E, a), ends_b, take_rows(at, b), a, b)
 
 
 def wedge_rows(pairs, displacement, tol, index, vertex_fragment):
@@ -228,7 +229,7 @@ def edge_copies(edges, faces_at_edge, index):
     # C++ (cpp_ext/contact_setup3d.cpp): the edges on the same two points pairwise (runs of
     # diagonal_edges' sort), each with two faces, not both of b's faces' keys among a's
     a, b, ends_b, partner = _ext.EdgeCopyPairs(E, at, index.point, index.face_key)
-    return EdgeCopies(E[a], ends_b, at[b], partner)
+    return EdgeCopies(take_rows(E, a), ends_b, take_rows(at, b), partner)
 
 
 def reflex_wedge_rows(pairs, displacement, tol, index):
