@@ -537,9 +537,11 @@ namespace ngfracture
       // every block that cells a[d] .. b[d] (not empty) lie in is closed for F
       bool Hold (const int64_t * a, const int64_t * b, int32_t F) const
       {
-        for (int64_t I = a[0] / 2; I <= b[0] / 2; I++)
-          for (int64_t J = a[1] / 2; J <= b[1] / 2; J++)
-            for (int64_t K = a[2] / 2; K <= b[2] / 2; K++)
+        // the blocks' range once (cells are >= 0 here: a shift, not a signed division)
+        const int64_t I0 = a[0] >> 1, I1 = b[0] >> 1, J0 = a[1] >> 1, J1 = b[1] >> 1, K0 = a[2] >> 1, K1 = b[2] >> 1;
+        for (int64_t I = I0; I <= I1; I++)
+          for (int64_t J = J0; J <= J1; J++)
+            for (int64_t K = K0; K <= K1; K++)
               {
                 int32_t e = block_set[(I * span2 + J) * span2 + K];
                 if (e == -2) continue;
@@ -601,7 +603,8 @@ namespace ngfracture
               lo[d] = hi[d] = m.x[3*T[0]+d];
               for (int k = 1; k < 4; k++) { lo[d] = std::min(lo[d], m.x[3*T[k]+d]); hi[d] = std::max(hi[d], m.x[3*T[k]+d]); }
             }
-          auto test = [&] (int32_t slot)
+          // inlined at both calls: it runs once per box test, most of a prediction's sweep
+          auto test = [&] (int32_t slot) __attribute__((always_inline))
                   {
                     box_tests++;
                     const GridPoint & q = points[slot];
