@@ -359,7 +359,10 @@ class ActiveSet3d(ActiveSet):
         (:func:`~ngfracture.contact.wedges3d.reflex_wedge_rows`);
         in the first round, also the rows at copies that the warm start names
         (:func:`~ngfracture.contact.copies3d.rows_at_copies_of`). None for a pair of
-        copies the scene's rows tie (:attr:`tied`). A slave that the detection
+        copies the scene's rows tie (:attr:`tied`), but for the warm rows: the solve
+        before imposed them beside the tie (the sphere's normal row of a core vertex on a
+        face at its glass copy), and without them the pair has no normal row in the first
+        round. A slave that the detection
         (``pen``) finds deeper than ``penetration_tol`` gets none: its detected row holds it
         (in a prediction whole lips pass through each other, and rows linearised there
         would hold planes far from where the lips come back to). The reflex-wedge rows
@@ -382,9 +385,13 @@ class ActiveSet3d(ActiveSet):
             return found, codes
         copy = more.master[np.arange(len(more)), np.argmax(more.bary, axis=1)]
         deep = unique_ints(np.asarray(pen.vertex, dtype=np.int64)[pen.gap < -self.penetration_tol])
-        keep = ~isin_ints(np.minimum(more.slave, copy) * nv + np.maximum(more.slave, copy), self.tied)
-        exempt = np.zeros(len(more), dtype=bool)
         start = len(parts[0]) + len(parts[1])
+        # the warm rows were imposed beside the tie in the solve before: a pair's one row
+        # there (the detection finds it only once the copy is deep again)
+        warm_rows = np.zeros(len(more), dtype=bool)
+        warm_rows[start + len(reflex):] = True
+        keep = warm_rows | ~isin_ints(np.minimum(more.slave, copy) * nv + np.maximum(more.slave, copy), self.tied)
+        exempt = np.zeros(len(more), dtype=bool)
         exempt[start:start + len(reflex)] = True
         return self._with_new(found, codes,
                               more.subset(np.flatnonzero(keep & (exempt | ~isin_ints(more.slave, deep)))))
