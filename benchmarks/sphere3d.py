@@ -41,7 +41,7 @@ from pathlib import Path
 import numpy as np
 
 import benchmark_json
-from contact3d import unit_solve
+from contact3d import LinalgCounts, unit_solve
 
 #: the default fine values: the default mesh (0.075) and two coarsenings
 DEFAULT_FINE = [0.15, 0.106, 0.075]
@@ -67,8 +67,6 @@ def run_case(fine, steps, cpu_limit, resume, repeat):
     """One case (see the module docstring): a dict of its numbers."""
     from ngfracture import Simulation, scenes
     from ngfracture.run.control import StepControl
-    sys.path.insert(0, str(Path(__file__).parent))
-    from contact3d import LinalgCounts
     scene = scenes.SCENES["sphere3d"](fine=fine)
     x_c = scene.parameters["first_crack_exact"]
     wall0, cpu0_unit, solver = cpu_unit(scene, repeat)
