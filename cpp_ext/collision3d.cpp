@@ -56,17 +56,31 @@ namespace ngfracture
           };
         if (Dense ())
           {
-            // counting sort over all cells; cells outside the grid are never visited
+            // counting sort over all cells; cells outside the grid are never visited: every
+            // item's cells clipped to the grid once (the same cells in the same order)
+            std::vector<int32_t> clip(6 * n);
+            for (size_t t = 0; t < n; t++)
+              for (int d = 0; d < 3; d++)
+                {
+                  clip[6*t+d] = int32_t(std::clamp<int64_t>(Cell(lo[3*t+d], d), 0, span));
+                  clip[6*t+3+d] = int32_t(std::clamp<int64_t>(Cell(hi[3*t+d], d), -1, span - 1));
+                }
+            auto clipped = [&] (size_t t, auto && f)
+              {
+                const int32_t * r = &clip[6*t];
+                for (int64_t i = r[0]; i <= r[3]; i++)
+                  for (int64_t j = r[1]; j <= r[4]; j++)
+                    for (int64_t k = r[2]; k <= r[5]; k++)
+                      f(Linear(i, j, k));
+              };
             first.assign(size_t(span * span * span) + 1, 0);
             for (size_t t = 0; t < n; t++)
-              cells(t, [&] (int64_t i, int64_t j, int64_t k)
-                { if (Valid(i) && Valid(j) && Valid(k)) first[Linear(i, j, k) + 1]++; });
+              clipped(t, [&] (int64_t c) { first[c + 1]++; });
             for (size_t c = 1; c < first.size(); c++) first[c] += first[c-1];
             items.resize(first.back());
             std::vector<int32_t> fill(first.begin(), first.end() - 1);
             for (size_t t = 0; t < n; t++)
-              cells(t, [&] (int64_t i, int64_t j, int64_t k)
-                { if (Valid(i) && Valid(j) && Valid(k)) items[fill[Linear(i, j, k)]++] = int32_t(t); });
+              clipped(t, [&] (int64_t c) { items[fill[c]++] = int32_t(t); });
             return;
           }
         std::vector<std::pair<uint64_t,int32_t>> keyed;
@@ -209,6 +223,7 @@ namespace ngfracture
       std::vector<int32_t> vfrag, ffrag, bverts;
       std::vector<uint8_t> lip;    // the vertex has a copy on its own fragment (a lip of a crack inside it)
       std::vector<int64_t> start, at;     // the tetrahedra at vertex v: at[start[v] .. start[v+1])
+      std::vector<int64_t> frag_tets;     // tetrahedra per fragment (empty: a fragment number < 0 or > ne)
     };
 
     // What the search needs at the current positions: the topology, the boundary vertices'
@@ -247,6 +262,19 @@ namespace ngfracture
         for (int64_t t = 0; t < m.ne; t++)
           for (int k = 0; k < 4; k++) at[fill[m.tets[4*t+k]]++] = t;
       }
+      D.frag_tets.clear();
+      int32_t nfrag = 0;
+      bool counted = true;
+      for (int64_t t = 0; t < m.ne && counted; t++)
+        {
+          counted = m.fragment[t] >= 0 && m.fragment[t] <= m.ne;
+          if (counted) nfrag = std::max(nfrag, m.fragment[t] + 1);
+        }
+      if (counted)
+        {
+          D.frag_tets.assign(nfrag, 0);
+          for (int64_t t = 0; t < m.ne; t++) D.frag_tets[m.fragment[t]]++;
+        }
       D.ffrag.assign(m.nf, -1);
       for (int64_t f = 0; f < m.nf; f++)
         {
@@ -256,6 +284,9 @@ namespace ngfracture
           for (int64_t s = start[F[0]]; s < start[F[0]+1] && D.ffrag[f] < 0; s++)
             {
               const int32_t * T = m.tets + 4*at[s];
+              // the tetrahedra at F[0] that lack F[1] or F[2] (most) are not counted
+              auto has = [T] (int32_t w) { return T[0] == w || T[1] == w || T[2] == w || T[3] == w; };
+              if (!has(F[1]) || !has(F[2])) continue;
               int held = 0;
               for (int k = 0; k < 3; k++)
                 held += (T[0] == F[k]) + (T[1] == F[k]) + (T[2] == F[k]) + (T[3] == F[k]);
@@ -562,6 +593,59 @@ namespace ngfracture
       return vcell;
     }
 
+    // The fragments whose tetrahedra find nothing at x (dense grid with closed cells):
+    // every non-empty cell of the fragment's box of cells (its vertices' cells, clamped to
+    // the grid; every tetrahedron of it sweeps only cells in there) is closed with the
+    // fragment among its fragments (ClosedCells), so the sweep skips each of those cells
+    // for each of its tetrahedra. A fragment whose box has more cells than four per
+    // tetrahedron is not checked (a check dearer than its sweep; it is swept tetrahedron
+    // by tetrahedron).
+    // ``tets`` the tetrahedra per fragment (Topology::frag_tets; empty: none is skipped).
+    std::vector<uint8_t> ClosedFragments (const TetMesh3 & m, const HashGrid & g, const std::vector<int32_t> & vfrag,
+                                          const std::vector<int64_t> & tets, const std::vector<int32_t> & vcell,
+                                          const std::vector<int32_t> & closed_set,
+                                          const std::vector<std::array<int32_t,8>> & sets)
+    {
+      const int32_t nfrag = int32_t(tets.size());
+      if (closed_set.empty() || nfrag == 0) return {};
+      std::vector<std::array<int32_t,6>> box(nfrag, { INT32_MAX, INT32_MAX, INT32_MAX, INT32_MIN, INT32_MIN, INT32_MIN });
+      for (int64_t v = 0; v < m.nv; v++)
+        {
+          int32_t F = vfrag[v];
+          if (F < 0) continue;
+          for (int d = 0; d < 3; d++)
+            {
+              box[F][d] = std::min(box[F][d], vcell[3*v+d]);
+              box[F][3+d] = std::max(box[F][3+d], vcell[3*v+d]);
+            }
+        }
+      std::vector<uint8_t> closed(nfrag, 0);
+      for (int32_t F = 0; F < nfrag; F++)
+        {
+          if (tets[F] == 0) continue;
+          int64_t a[3], b[3], cells = 1;
+          for (int d = 0; d < 3; d++)
+            {
+              a[d] = std::max<int64_t>(box[F][d], 0);
+              b[d] = std::min<int64_t>(box[F][3+d], g.span - 1);
+              cells *= std::max<int64_t>(b[d] - a[d] + 1, 0);
+            }
+          if (cells > 4 * tets[F]) continue;
+          bool all = true;
+          for (int64_t i = a[0]; i <= b[0] && all; i++)
+            for (int64_t j = a[1]; j <= b[1] && all; j++)
+              for (int64_t k = a[2]; k <= b[2] && all; k++)
+                {
+                  int64_t c = g.Linear(i, j, k);
+                  if (g.first[c] == g.first[c+1]) continue;
+                  int32_t e = closed_set[c];
+                  all = e >= 0 && std::find(sets[e].begin(), sets[e].end(), F) != sets[e].end();
+                }
+          closed[F] = all;
+        }
+      return closed;
+    }
+
     // Every (boundary vertex, tetrahedron of another fragment) with the vertex in the
     // closed tetrahedron, and (lip vertex, tetrahedron of its own fragment not at the
     // vertex): each tetrahedron's box swept over the vertex grid. A pair found in a
@@ -571,7 +655,7 @@ namespace ngfracture
     // order). The twin is looked up only for a pair found. Pairs in ``decided`` are not
     // tested (DecideClosedSeams). ``points`` are the grid's items (GridPoint, slot by slot).
     std::vector<Hit> SweepTets (const TetMesh3 & m, const Copies & copies, const std::vector<int32_t> & vfrag,
-                                const HashGrid & g, const std::vector<GridPoint> & points,
+                                const std::vector<int64_t> & frag_tets, const HashGrid & g, const std::vector<GridPoint> & points,
                                 Decided & decided, Collision3Stats & st)
     {
       std::vector<Hit> hits;
@@ -583,10 +667,12 @@ namespace ngfracture
       if (!g.first.empty()) ClosedCells(g, points, decided, closed_set, sets);
       const ClosedBlocks blocks = closed_set.empty() ? ClosedBlocks() : ClosedBlocks(g, closed_set, sets);
       const std::vector<int32_t> vcell = VertexCells(m, g);
+      const std::vector<uint8_t> skip = ClosedFragments(m, g, vfrag, frag_tets, vcell, closed_set, sets);
       for (int64_t t = 0; t < m.ne; t++)
         {
           const int32_t * T = m.tets + 4*t;
           const int32_t F = m.fragment[t];
+          if (!skip.empty() && skip[F]) continue;
           int orientation = 2;                              // not computed yet
           int64_t a[3], b[3];
           for (int d = 0; d < 3; d++)
@@ -672,8 +758,10 @@ namespace ngfracture
     // exactly, though not always v's averaged normal: where several cracks meet, a copy's
     // wedge can be bounded by faces that the averaged normal of a neighbouring copy does
     // not oppose, and v, in that wedge, is nearest to them.
+    // ``own`` is scratch space (the other two points of every face at v).
     void PartnerFaces (const TetMesh3 & m, const Copies & copies, const Derived & D,
-                       const VertexFaces & vfaces, int32_t v, int32_t F, std::vector<int32_t> & out)
+                       const VertexFaces & vfaces, int32_t v, int32_t F, std::vector<int32_t> & out,
+                       std::vector<std::pair<int32_t,int32_t>> & own)
     {
       out.clear();
       const auto & grp = copies.group;
@@ -684,6 +772,13 @@ namespace ngfracture
           a = grp[T[(k+1)%3]]; b = grp[T[(k+2)%3]];
           if (a > b) std::swap(a, b);
         };
+      own.clear();
+      for (int64_t j = vfaces.start[v]; j < vfaces.start[v+1]; j++)
+        {
+          int32_t c, d;
+          others(vfaces.at[j], v, c, d);
+          own.emplace_back(c, d);
+        }
       int32_t g = grp[v];
       for (int64_t s = copies.start[g]; s < copies.start[g+1]; s++)
         {
@@ -693,12 +788,8 @@ namespace ngfracture
             {
               int32_t f = vfaces.at[i], a, b;
               others(f, t, a, b);
-              for (int64_t j = vfaces.start[v]; j < vfaces.start[v+1]; j++)
-                {
-                  int32_t h = vfaces.at[j], c, d;
-                  others(h, v, c, d);
-                  if (a == c && b == d) { out.push_back(f); break; }
-                }
+              for (const auto & [c, d] : own)
+                if (a == c && b == d) { out.push_back(f); break; }
             }
         }
       std::sort(out.begin(), out.end());
@@ -1016,7 +1107,7 @@ namespace ngfracture
         }
       Decided decided(m.nv);
       int64_t closed = DecideClosedSeams(m, T, copies, decided);
-      std::vector<Hit> hits = SweepTets(m, copies, D.vfrag, vg, points, decided, st);
+      std::vector<Hit> hits = SweepTets(m, copies, D.vfrag, T.frag_tets, vg, points, decided, st);
       st.closed_seams += closed;
       if (hits.empty()) { if (stats) *stats = st; return out; }
 
@@ -1040,6 +1131,7 @@ namespace ngfracture
         }
       const VertexFaces & vfaces = incidence->vfaces;
       std::vector<int32_t> partners;                       // of the hit at hand
+      std::vector<std::pair<int32_t,int32_t>> scratch;
       for (size_t s = 0; s < hits.size(); s++)
         {
           auto [v, F, t] = hits[s];
@@ -1083,7 +1175,7 @@ namespace ngfracture
               continue;
             }
           partners.clear();
-          if (pen.twin >= 0) PartnerFaces(m, copies, D, vfaces, v, F, partners);
+          if (pen.twin >= 0) PartnerFaces(m, copies, D, vfaces, v, F, partners, scratch);
           if (!MasterFace(m, D, fg, v, F, partners, pen)) continue;
           out.push_back(pen);
         }

@@ -16,7 +16,8 @@ namespace ngfracture
     // A spatial hash of boxes: the cells (i, j, k) of size h from origin that each box
     // overlaps, bucketed by a hash of the cell (a counting sort). An entry holds its cell
     // and its box's first cell, so that a scan of a bucket reads it alone: entries of
-    // other cells in the bucket (hash collisions) are told apart by their cell.
+    // other cells in the bucket (hash collisions) are told apart by their cell. It also
+    // holds its item's group (the swept edge's fragment), which rejects most entries first.
     struct BoxHash
     {
       struct Entry
@@ -24,6 +25,7 @@ namespace ngfracture
         int32_t cell[3];               // the cell of this entry
         int32_t item;
         int32_t first[3];              // the item's first cell along x, y, z
+        int32_t group;                 // the item's group (Fill's ``group``)
       };
       double origin[3] = { 0, 0, 0 }, h = 0;
       int shift = 64;
@@ -89,8 +91,9 @@ namespace ngfracture
         return true;
       }
 
-      // hashes items 0 .. n-1 with cell ranges `range` (6 each, in this grid's cells)
-      void Fill (const std::vector<int32_t> & range, size_t n)
+      // hashes items 0 .. n-1 with cell ranges `range` (6 each, in this grid's cells) and
+      // groups `group`
+      void Fill (const std::vector<int32_t> & range, const std::vector<int32_t> & group, size_t n)
       {
         int64_t count = 0;
         for (size_t t = 0; t < n; t++)
@@ -111,7 +114,7 @@ namespace ngfracture
           {
             const int32_t * r = &range[6*t];
             Cells(r, [&] (int32_t i, int32_t j, int32_t k)
-              { entries[fill[Bucket(i, j, k)]++] = Entry { { i, j, k }, int32_t(t), { r[0], r[1], r[2] } }; });
+              { entries[fill[Bucket(i, j, k)]++] = Entry { { i, j, k }, int32_t(t), { r[0], r[1], r[2] }, group[t] }; });
           }
       }
     };
@@ -312,25 +315,28 @@ namespace ngfracture
     const std::vector<int32_t> & swept = sw.edge, & own = sw.own;
     const std::vector<double> & ebox = sw.box;
     if (swept.empty()) { if (stats) *stats = st; return out; }
-    grid.Fill(sw.range, swept.size());
+    grid.Fill(sw.range, own, swept.size());
     for (int32_t f = 0; f < int32_t(nf_); f++)
       {
         const int32_t * r = &frange[6*f];
         const int32_t * t = &faces_[3*f];
+        const int32_t frag = fragment_[f];
         BoxHash::Cells(r, [&] (int32_t i, int32_t j, int32_t k)
           {
             size_t bucket = grid.Bucket(i, j, k);
             for (int64_t s = grid.start[bucket]; s < grid.start[bucket+1]; s++)
               {
                 const BoxHash::Entry & en = grid.entries[s];
-                // this cell, and the first cell both boxes' ranges share
-                if (en.cell[0] != i || en.cell[1] != j || en.cell[2] != k
+                // with across_ an edge of the face's own fragment is no pair (tested first:
+                // most entries); this cell, and the first cell both boxes' ranges share
+                if ((across_ && en.group == frag)
+                    || en.cell[0] != i || en.cell[1] != j || en.cell[2] != k
                     || std::max(r[0], en.first[0]) != i || std::max(r[1], en.first[1]) != j
                     || std::max(r[2], en.first[2]) != k)
                   continue;
                 const int32_t a = en.item, e = swept[a];
                 const int32_t u = edges_[2*e], w = edges_[2*e+1];
-                if (Shares(t, u) || Shares(t, w) || (across_ && fragment_[f] == own[a])) continue;
+                if (Shares(t, u) || Shares(t, w)) continue;
                 st.box_tests++;
                 const double * elo = &ebox[6*a], * ehi = elo + 3;
                 bool overlap = true;              // strict: a pierce point lies inside both boxes

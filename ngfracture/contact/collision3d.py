@@ -49,7 +49,8 @@ are decided before the sweep; a cell whose vertices are all decided for the frag
 of its vertices (and none is a lip vertex) is skipped by the tetrahedra of those fragments,
 and a tetrahedron whose cells all lie in blocks of 2 x 2 x 2 cells closed for its fragment
 (every non-empty cell there so skipped) is not swept cell by cell; its cells are read from
-its vertices' cells (the cell of a coordinate does not decrease with it).
+its vertices' cells (the cell of a coordinate does not decrease with it). A fragment
+whose box of cells holds only empty cells and cells closed for it is not swept at all.
 
 Master face. For a pair whose vertex lies in a tetrahedron at its copy t on F (a crack
 lip, or where several cracks meet): among the boundary faces of that tetrahedron at t,
