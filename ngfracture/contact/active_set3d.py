@@ -55,8 +55,9 @@ Candidates, each identified by its key ("f", slave, master vertices sorted; "e",
   (:meth:`ActiveSet3d._edge_to_edge`), kept as found rows are; and node-to-edge rows
   (:mod:`~ngfracture.contact.clipped3d`, edge rows of a degenerate edge (v, v)): a vertex
   found deeper than ``penetration_tol`` whose projection on its master face is clipped to
-  an edge or corner, where no node-to-face candidate of the pair reads its depth
-  (:meth:`ActiveSet3d._with_node_to_edge`), kept as found rows are.
+  an edge or corner, where the node-to-face candidates of the pair all hold and fall short
+  of its depth (:meth:`ActiveSet3d._with_node_to_edge`), kept as found rows are, a pair
+  found again taking the new row.
 
 The candidates of a round are a :class:`~ngfracture.contact.mixed_rows.MixedRows` table:
 the node-to-face rows (fixed, then found), then the edge rows.
@@ -362,8 +363,8 @@ class ActiveSet3d(ActiveSet):
     def _with_node_to_edge(self, found, codes, U, pen):
         """The edge rows ``found`` and their key ``codes`` with the node-to-edge rows of the
         detected pairs (``pen``, at X + U) whose projection is clipped to an edge or corner of
-        the master face and whose depth no node-to-face candidate reads to ``penetration_tol``
-        (:mod:`~ngfracture.contact.clipped3d`); none where every such depth is read."""
+        the master face and whose node-to-face candidates all hold and fall short of its depth
+        by more than ``penetration_tol`` (:mod:`~ngfracture.contact.clipped3d`)."""
         a = self.geometry.arrays
         pick = unseen_pairs(pen, a.faces, (self.seam_rows, self.n2s), a.points, U, self.setup.vertex_fragment,
                             self.penetration_tol)
