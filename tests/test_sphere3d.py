@@ -229,9 +229,10 @@ def test_run_confined(tmp_path):
 
 @pytest.mark.slow
 @pytest.mark.xfail(strict=True, reason="the coarse free run is not shown to reach the end of its load range "
-                   "(4.14e-3): it passes x = 3.130e-3 (step 39) with every step's invariants, not measured further; "
-                   "a vertex that slides along a crack lip's plane past the crack's front edge into the piece has "
-                   "no node-to-edge row to hold it (docs/limitations.md, docs/solid.md, 'The sphere scenes')")
+                   "(4.14e-3): it passes x = 3.130e-3 (step 39) with every step's invariants, not measured further "
+                   "(the node-to-edge rows give the same meshes to step 33, the displacements equal to rounding); "
+                   "a vertex past a crack's front edge that nothing presses against the lip it slid along is not "
+                   "held (docs/limitations.md, docs/solid.md, 'The sphere scenes')")
 def test_run_free(tmp_path):
     """sphere3d_free on the coarse mesh: the same invariants per step, and it falls apart
     (the core and at least two glass pieces), as the 2D disintegration."""

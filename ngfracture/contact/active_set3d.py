@@ -52,7 +52,12 @@ Candidates, each identified by its key ("f", slave, master vertices sorted; "e",
 - *edge* rows (:mod:`~ngfracture.contact.edge_rows3d`): pairs of boundary edges of two
   fragments that cross at the configuration of the last solve deeper than ``edge_tol``
   where no end of either edge lies deeper than ``penetration_tol`` in the other's fragment
-  (:meth:`ActiveSet3d._edge_to_edge`), kept as found rows are.
+  (:meth:`ActiveSet3d._edge_to_edge`), kept as found rows are; and node-to-edge rows
+  (:mod:`~ngfracture.contact.clipped3d`, edge rows of a degenerate edge (v, v)): a vertex
+  found deeper than ``penetration_tol`` whose projection on its master face is clipped to
+  an edge or corner, where the node-to-face candidates of the pair all hold and fall short
+  of its depth (:meth:`ActiveSet3d._with_node_to_edge`), kept as found rows are, a pair
+  found again taking the new row.
 
 The candidates of a round are a :class:`~ngfracture.contact.mixed_rows.MixedRows` table:
 the node-to-face rows (fixed, then found), then the edge rows.
@@ -81,6 +86,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from .active_set import ActiveSet, Candidates, RowKeys, refreshed
+from .clipped3d import node_edge_rows, unseen_pairs
 from .copies3d import (behind_partner_rows, folded_rows_at_copies, found_rows_at_copies, rows_at_copies_of,
                        two_sided_rows)
 from .edge_rows3d import EdgeRows, edge_rows, no_edge_rows, relinearise_edge_rows
@@ -244,9 +250,13 @@ class ActiveSet3d(ActiveSet):
         self.n2s = NodeToFaceRows.stack([self.n2s.subset(retained), found.subset(new)])
         self.n2s_keys = RowKeys(np.concatenate([n2s_codes[retained], found_codes[new]]), self.codec)
         found, found_codes = self._edge_to_edge(U, pen, timings)
+        found, found_codes = self._with_node_to_edge(found, found_codes, U, pen)
         edge_codes = self.edge_keys.codes
         kept = self._retained(edge_codes, found_codes)
-        fresh = np.flatnonzero(~isin_ints(found_codes, edge_codes))
+        # a node-to-edge row found again takes the detection's direction (its re-linearisation
+        # keeps the old one, which the solve may have left behind)
+        kept = kept[~(isin_ints(edge_codes[kept], found_codes) & self.codec.is_node_edge(edge_codes[kept]))]
+        fresh = np.flatnonzero(~isin_ints(found_codes, edge_codes[kept]))
         self.edges = EdgeRows.stack([self.edges.subset(kept), found.subset(fresh)])
         self.edge_keys = RowKeys(np.concatenate([edge_codes[kept], found_codes[fresh]]), self.codec)
         rows = MixedRows([NodeToFaceRows.stack([self.seam_rows, self.n2s]), self.edges])
@@ -349,6 +359,20 @@ class ActiveSet3d(ActiveSet):
         rows, kept = edge_rows(X, self.geometry.arrays.faces, edges, self.setup.faces_at_edge, pairs, U)
         deep = np.flatnonzero(rows.dist < -self.edge_tol)
         return rows.subset(deep), self.codec.edge_codes(pairs[kept[deep]])
+
+    def _with_node_to_edge(self, found, codes, U, pen):
+        """The edge rows ``found`` and their key ``codes`` with the node-to-edge rows of the
+        detected pairs (``pen``, at X + U) whose projection is clipped to an edge or corner of
+        the master face and whose node-to-face candidates all hold and fall short of its depth
+        by more than ``penetration_tol`` (:mod:`~ngfracture.contact.clipped3d`)."""
+        a = self.geometry.arrays
+        pick = unseen_pairs(pen, a.faces, (self.seam_rows, self.n2s), a.points, U, self.setup.vertex_fragment,
+                            self.penetration_tol)
+        if not len(pick):
+            return found, codes
+        more = node_edge_rows(a.points, a.faces, pen, pick, U)
+        return (EdgeRows.stack([found, more]),
+                np.concatenate([codes, self.codec.node_edge_codes(more.edge_a[:, 0], more.edge_b)]))
 
     def _with_rows_at_copies(self, found, codes, U, pen):
         """The found rows and their key codes with the rows at copies that X + U violates

@@ -30,6 +30,13 @@ clipped to its triangle holds the triangle's edge. Nearly parallel edges (the si
 angle below :data:`PARALLEL`) have no well-defined common normal: the detection makes no row
 for them (where parallel edges overlap, the vertex of one lies inside the other's fragment
 and a node-to-face row holds it), and a re-linearisation keeps the old s, t and n.
+
+A row whose edge a is a vertex twice, a = (v, v), is a node-to-edge row
+(:mod:`~ngfracture.contact.clipped3d`): g = n . (x_v - x_b(t)), key ("n", v, b0, b1), b a
+corner twice for a node-to-corner row. Its re-linearisation keeps t and n, the
+detection's: the direction from v to the edge is defined while v is off the edge, not
+once the row holds v on it (where v is found deep again, the active set takes the new
+detection's row, :meth:`~ngfracture.contact.active_set3d.ActiveSet3d.update`).
 """
 from dataclasses import dataclass
 import functools
@@ -88,13 +95,15 @@ class EdgeRows(RowTable):
         return C
 
     def keys(self):
-        """The key of every row, ("e", a0, a1, b0, b1).
+        """The key of every row, ("e", a0, a1, b0, b1); ("n", v, b0, b1) for a node-to-edge row
+        (a = (v, v), :mod:`~ngfracture.contact.clipped3d`).
 
         Returns
         -------
         list of tuple
         """
-        return [("e", a0, a1, b0, b1) for (a0, a1), (b0, b1) in zip(self.edge_a.tolist(), self.edge_b.tolist())]
+        return [("n", a0, b0, b1) if a0 == a1 else ("e", a0, a1, b0, b1)
+                for (a0, a1), (b0, b1) in zip(self.edge_a.tolist(), self.edge_b.tolist())]
 
 
 def _vertices_weights(rows):
@@ -266,7 +275,7 @@ def relinearise_edge_rows(rows, points, displacement):
     a, b = rows.edge_a, rows.edge_b
     s, t, n, sine = _closest(x[a[:, 0]], x[a[:, 1]], x[b[:, 0]], x[b[:, 1]])
     n = np.where(((n * rows.normal).sum(1) < 0)[:, None], -n, n)
-    well = sine >= PARALLEL
+    well = (sine >= PARALLEL) & (a[:, 0] != a[:, 1])          # node-to-edge rows keep theirs
     st = np.where(well[:, None], np.stack([s, t], axis=1), rows.st)
     n = np.where(well[:, None], n, rows.normal)
     dist, g = _gaps(X, x, a, b, st, n)

@@ -37,7 +37,12 @@ class FaceKeys:
     (codes are equal exactly where keys are; :mod:`ngfracture.contact.active_set3d`). An
     edge-to-edge row's key ("e", a0, a1, b0, b1) (:mod:`ngfracture.contact.edge_rows3d`) is
     the negative code -1 - (i * nE + j), with i < j the numbers of its edges among the nE
-    sorted boundary edges: codes of the two kinds never meet, and -1 is no key.
+    sorted boundary edges. A node-to-edge row's key ("n", v, b0, b1)
+    (:mod:`ngfracture.contact.clipped3d`; b0 = b1 for a corner) is the code
+    -2 - nE^2 - (v (nE + nb) + j), with j the number of the edge (b0, b1) among the
+    boundary edges, or nE + b0 for a corner, and nb one more than the largest vertex of a
+    face: below every edge code (>= -nE^2 + nE). Codes of the three kinds never meet, and
+    -1 is no key.
 
     Parameters
     ----------
@@ -62,6 +67,7 @@ class FaceKeys:
         # every run, bit for bit; tests/test_contact3d_setup_kernels.py compares)
         _, self.face_set, self.triples = _ext.SortedTripleRanks(F, int(F.max(initial=-1)) + 1)
         self.n = max(len(self.triples), 1)
+        self.nb = int(F.max(initial=-1)) + 1
         self._lookup = None
         self._face_of_set = None
         self.edges = np.zeros((0, 2), dtype=np.int64) if edges is None else np.asarray(edges, dtype=np.int64)
@@ -90,8 +96,8 @@ class FaceKeys:
         return np.asarray(rows.slave, dtype=np.int64) * self.n + sets
 
     def codes_of(self, keys):
-        """The codes of keys given as tuples ("f", slave, a, b, c) or ("e", a0, a1, b0, b1); -1 for
-        a key of no face or edges.
+        """The codes of keys given as tuples ("f", slave, a, b, c), ("e", a0, a1, b0, b1) or
+        ("n", v, b0, b1); -1 for a key of no face, edges or edge (corner).
 
         Parameters
         ----------
@@ -110,6 +116,8 @@ class FaceKeys:
             if k[0] == "e":
                 i, j = edge.get(k[1:3], -1), edge.get(k[3:5], -1)
                 return -1 - (i * ne + j) if 0 <= i < j else -1
+            if k[0] == "n":
+                return int(self.node_edge_codes([k[1]], [k[2:4]])[0])
             return (k[1] * self.n + look[k[2:]]) if k[2:] in look else -1
         return np.fromiter((code(k) for k in keys), dtype=np.int64, count=len(keys))
 
@@ -154,8 +162,49 @@ class FaceKeys:
         pairs = np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
         return -1 - (pairs[:, 0] * len(self.edges) + pairs[:, 1])
 
+    def node_edge_codes(self, slave, edge):
+        """The codes of node-to-edge keys ("n", v, b0, b1).
+
+        Parameters
+        ----------
+        slave : array_like of int, shape (m,)
+            The vertices v.
+        edge : array_like of int, shape (m, 2)
+            Their edges (b0, b1), sorted boundary edges of the mesh or a corner twice.
+
+        Returns
+        -------
+        numpy.ndarray of int64
+            -1 where ``edge`` is neither.
+        """
+        slave = np.asarray(slave, dtype=np.int64)
+        b = np.asarray(edge, dtype=np.int64).reshape(-1, 2)
+        ne, nb = len(self.edges), self.nb
+        # the edges are sorted (rows increasing): their codes b0 nb + b1 increase
+        key = self.edges[:, 0] * nb + self.edges[:, 1]
+        at = np.minimum(np.searchsorted(key, b[:, 0] * nb + b[:, 1]), max(ne - 1, 0))
+        found = (key[at] == b[:, 0] * nb + b[:, 1]) if ne else np.zeros(len(b), dtype=bool)
+        j = np.where(b[:, 0] == b[:, 1], ne + b[:, 0], np.where(found, at, -1))
+        valid = (j >= 0) & (b.min(axis=1, initial=0) >= 0) & (b.max(axis=1, initial=0) < nb) \
+            & (slave >= 0) & (slave < nb)
+        return np.where(valid, -2 - ne * ne - (slave * (ne + nb) + j), -1)
+
+    def is_node_edge(self, codes):
+        """Which codes are of node-to-edge keys.
+
+        Parameters
+        ----------
+        codes : numpy.ndarray of int64
+
+        Returns
+        -------
+        numpy.ndarray of bool
+        """
+        return np.asarray(codes, dtype=np.int64) <= -2 - len(self.edges) ** 2
+
     def decode(self, codes):
-        """The key tuples ("f", slave, master vertices sorted; "e", edge a, edge b) of codes.
+        """The key tuples ("f", slave, master vertices sorted; "e", edge a, edge b; "n", vertex,
+        edge) of codes.
 
         Parameters
         ----------
@@ -173,7 +222,15 @@ class FaceKeys:
         codes = np.asarray(codes, dtype=np.int64)
         slave, sets = np.divmod(np.maximum(codes, 0), self.n)
         keys = [("f", s, a, b, c) for s, (a, b, c) in zip(slave.tolist(), self.triples[sets].tolist())]
-        edge = np.flatnonzero(codes < 0)
+        ne = len(self.edges)
+        node = np.flatnonzero(self.is_node_edge(codes))
+        if len(node):
+            v, j = np.divmod(-2 - ne * ne - codes[node], ne + self.nb)
+            b = np.repeat((j - ne)[:, None], 2, axis=1)                 # a corner twice
+            b[j < ne] = self.edges[j[j < ne]]
+            for r, s, (b0, b1) in zip(node.tolist(), v.tolist(), b.tolist()):
+                keys[r] = ("n", s, b0, b1)
+        edge = np.flatnonzero((codes < 0) & (codes > -2 - ne * ne))
         if len(edge):
             i, j = np.divmod(-1 - codes[edge], max(len(self.edges), 1))
             if not np.all((i < j) & (j < len(self.edges))):
