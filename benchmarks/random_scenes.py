@@ -1,6 +1,13 @@
 """Many random scenes (ngfracture.studies.random_scenes): how each ended, and any invariant broken.
 
     python benchmarks/random_scenes.py --cases 40 --seed 1 --json out/random.json
+    python benchmarks/random_scenes.py --solids --cases 20 --seed 1 --json out/random3d.json
+
+``--solids`` draws the 3D scenes of ngfracture.studies.random_solids (boxes with spherical
+holes and a slot) and checks every accepted step's reference volume to the last bit
+(math.fsum of the tetrahedra), no inverted tetrahedron and the overlap between fragments
+(exact intersections of the deformed tetrahedra, ngfracture.output.overlap3d) at most
+1e-10 of the volume.
 
 Every case runs in its own process (``--timeout`` seconds at most) with every accepted step
 checked independently of the engine (tests/invariant_util.py: reference area with
@@ -56,9 +63,45 @@ def one_case(seed, max_steps):
     return record
 
 
-def run_case(seed, max_steps, timeout):
+def one_solid_case(seed, max_steps):
+    """Run one 3D case in this process; returns its record."""
+    warnings.simplefilter("ignore")
+    import math
+    import numpy as np
+    import ngfracture as nf
+    from ngfracture.fracture.strain import vertex_displacement
+    from ngfracture.geometry.solid import solid_to_arrays, tet_volumes
+    from ngfracture.output.overlap3d import fragment_overlap_volume
+    from ngfracture.studies import random_solids
+
+    params = random_solids.draw(seed)
+    record = {"seed": seed, "params": params}
+    t0 = time.perf_counter()
+    scene = random_solids.scene(**params)
+    volume = math.fsum(tet_volumes(solid_to_arrays(scene.mesh).points, solid_to_arrays(scene.mesh).tets))
+    violations = []
+
+    def check(step):
+        a, prob = step.problem.arrays, step.problem
+        x = a.points + vertex_displacement(prob.u)
+        _, piece = prob.fragments()
+        overlap = fragment_overlap_volume(x, a.tets, np.asarray(piece)[a.tets[:, 0]], body_volume=volume).volume
+        for name, bad in (("volume", math.fsum(tet_volumes(a.points, a.tets)) != volume),
+                          ("inverted", tet_volumes(x, a.tets).min() <= 0), ("overlap", overlap > 1e-10 * volume)):
+            if bad:
+                violations.append({"step": step.state.step, "check": name, "overlap": overlap})
+
+    result = nf.Simulation(scene, nf.StepControl(max_steps=max_steps), pictures="none").run(on_step=check)
+    s = result.summary
+    record.update(reason=result.reason, message=result.message, failure=s.get("failure"), steps=s["n_steps"],
+                  tetrahedra=scene.mesh.ne, fragments=s["n_fragments"], seconds=time.perf_counter() - t0,
+                  violations=violations)
+    return record
+
+
+def run_case(seed, max_steps, timeout, solids=False):
     """One case in a child process, with a time limit."""
-    cmd = [sys.executable, __file__, "--one", str(seed), "--max-steps", str(max_steps)]
+    cmd = [sys.executable, __file__, "--one", str(seed), "--max-steps", str(max_steps)] + (["--solids"] if solids else [])
     try:
         proc = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
     except subprocess.TimeoutExpired:
@@ -86,18 +129,20 @@ def main():
     parser.add_argument("--max-steps", type=int, default=40)
     parser.add_argument("--timeout", type=float, default=600.0, help="seconds per case")
     parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--solids", action="store_true", help="the 3D scenes of ngfracture.studies.random_solids")
     parser.add_argument("--one", type=int, default=None, help=argparse.SUPPRESS)
     benchmark_json.add_options(parser)
     args = parser.parse_args()
     if args.one is not None:
-        print(json.dumps(one_case(args.one, args.max_steps), default=float))
+        case = one_solid_case if args.solids else one_case
+        print(json.dumps(case(args.one, args.max_steps), default=float))
         return 0
     benchmark_json.refuse_existing(parser, args)
     t0 = time.perf_counter()
     seeds = range(args.seed, args.seed + args.cases)
     with ThreadPoolExecutor(args.workers) as pool:
-        records = list(pool.map(lambda s: run_case(s, args.max_steps, args.timeout), seeds))
-    result = {"seed": args.seed, "max_steps": args.max_steps, "wall_seconds": time.perf_counter() - t0,
+        records = list(pool.map(lambda s: run_case(s, args.max_steps, args.timeout, args.solids), seeds))
+    result = {"seed": args.seed, "max_steps": args.max_steps, "solids": args.solids, "wall_seconds": time.perf_counter() - t0,
               **tally(records), "records": records}
     benchmark_json.write(args, result)
     return 1 if result["silent_violations"] else 0

@@ -194,18 +194,8 @@ slave, face, corner : numpy.ndarray of int64
           Check(fn, "point", pid, 1, 0, nv);
           Check(fn, "face_key", face_key, 1, 0);
           CheckRange(fn, "edges", edges, nv);
-          for (py::ssize_t i = 0, n_at = at.size(); i < n_at; i++)
-            if (at.data()[i] < -1 || at.data()[i] >= nf)
-              throw std::invalid_argument("ngfracture.DiagonalEdgePairs: faces_at_edge has an entry outside [-1, "
-                                          + std::to_string(nf) + ")");
-          int64_t n_points = 0;
-          for (py::ssize_t i = 0, n_edges = edges.size(); i < n_edges; i++)
-            {
-              int64_t q = pid.data()[edges.data()[i]];
-              if (q < 0)
-                throw std::invalid_argument("ngfracture.DiagonalEdgePairs: edges has a vertex of no point (point -1)");
-              n_points = std::max(n_points, q + 1);
-            }
+          CheckRange(fn, "faces_at_edge", at, nf, -1);
+          const int64_t n_points = PointCount(fn, "edges", edges, pid);
           std::vector<int64_t> a, b, ends_b;
           {
             py::gil_scoped_release release;
@@ -239,18 +229,8 @@ ends_b : numpy.ndarray of int64, shape (m, 2)
           Check(fn, "point", pid, 1, 0);
           Check(fn, "face_key", face_key, 1, 0);
           CheckRange(fn, "edges", edges, pid.shape(0));
-          for (py::ssize_t i = 0, n_at = at.size(); i < n_at; i++)
-            if (at.data()[i] < -1 || at.data()[i] >= nf)
-              throw std::invalid_argument("ngfracture.EdgeCopyPairs: faces_at_edge has an entry outside [-1, "
-                                          + std::to_string(nf) + ")");
-          int64_t n_points = 0;
-          for (py::ssize_t i = 0, n_edges = edges.size(); i < n_edges; i++)
-            {
-              int64_t q = pid.data()[edges.data()[i]];
-              if (q < 0)
-                throw std::invalid_argument("ngfracture.EdgeCopyPairs: edges has a vertex of no point (point -1)");
-              n_points = std::max(n_points, q + 1);
-            }
+          CheckRange(fn, "faces_at_edge", at, nf, -1);
+          const int64_t n_points = PointCount(fn, "edges", edges, pid);
           std::vector<int64_t> a, b, ends_b;
           std::vector<uint8_t> partner;
           {

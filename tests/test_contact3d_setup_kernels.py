@@ -15,7 +15,8 @@ from ngfracture.contact.intsets import unique_ints
 from ngfracture.contact.junctions3d import fragment_pair_rows
 from ngfracture.contact.kinks3d import KINK, CopyIndex, expand_ranges, face_point_keys, point_groups
 from ngfracture.contact.rows3d import NodeToFaceRows, face_gap_rows, fragment_twin_rows, no_face_rows
-from ngfracture.contact.setup3d import FaceKeys
+from ngfracture import _ngfracture as ext
+from ngfracture.contact.setup3d import FaceKeys, MeshSetup3d
 from ngfracture.geometry.pieces import fragmented_box
 
 
@@ -195,3 +196,25 @@ def test_fragment_pair_kernel_is_the_numpy_rows(body):
         assert bends > 0                          # the bent lips have faces off the chosen plane
     for field in rows.FIELDS:
         assert_same(getattr(rows, field), getattr(reference, field), field)
+
+
+def test_edge_pair_kernels_name_a_face_out_of_range():
+    """faces_at_edge holds face numbers or -1 (an edge with one face): -1 and nf - 1 pass,
+    -2, nf and the extremes of int64 are named with the range [-1, nf)."""
+    a, piece = fragmented_box(4, 2)
+    setup = MeshSetup3d(a.points, a.tets, a.faces, np.asarray(piece, dtype=np.int64))
+    E, at, index = setup.edge_detector.edges, setup.faces_at_edge, setup.copy_index
+    nf = len(index.face_key)
+    calls = {"DiagonalEdgePairs": lambda at: ext.DiagonalEdgePairs(E, at, setup.vertex_fragment, index.point,
+                                                                   index.face_key),
+             "EdgeCopyPairs": lambda at: ext.EdgeCopyPairs(E, at, index.point, index.face_key)}
+    for name, call in calls.items():
+        for good in (-1, nf - 1):
+            edited = at.copy()
+            edited[0, 1] = good
+            call(edited)
+        for bad in (-2, nf, np.iinfo(np.int64).max, np.iinfo(np.int64).min):
+            edited = at.copy()
+            edited[0, 1] = bad
+            with pytest.raises(ValueError, match=rf"ngfracture\.{name}: faces_at_edge has an entry outside \[-1, {nf}\)"):
+                call(edited)

@@ -14,7 +14,7 @@ import ngsolve as ng
 from ..fracture.strain import vertex_displacement
 from .pressure import pressure_forces
 
-__all__ = ["load_vector", "work_of_forces", "boundary_resultants", "unsupported_pieces"]
+__all__ = ["load_vector", "work_of_forces", "reaction_work", "boundary_resultants", "unsupported_pieces"]
 
 
 def load_vector(problem, boundary=None):
@@ -67,6 +67,33 @@ def work_of_forces(f_start, f_end, u_start, u_end):
     float
     """
     return float(0.5 * np.dot(f_start + f_end, u_end - u_start))
+
+
+def reaction_work(problem, fixed_dofs, fixed_values, reactions):
+    """Work of the reactions over an increment just solved (trapezoid rule).
+
+    The increment is solved on the mesh of the state it starts from, so its fixed dofs
+    have the numbers they had there (cracks come later, at fixed load: they do no work);
+    dofs fixed at only one of the two ends do no work of their own.
+
+    Parameters
+    ----------
+    problem : ElasticProblem
+        The solved increment.
+    fixed_dofs, fixed_values, reactions : numpy.ndarray
+        The fixed dofs (sorted), their values and their reactions at the start.
+
+    Returns
+    -------
+    float
+    """
+    rows = problem.assemble_constraints()
+    pos = np.searchsorted(rows.fixed_dofs, fixed_dofs)
+    pos = np.minimum(pos, max(len(rows.fixed_dofs) - 1, 0))
+    same = (rows.fixed_dofs[pos] == fixed_dofs) if len(rows.fixed_dofs) else np.zeros(0, bool)
+    r_new = -problem.out_of_balance()[rows.fixed_dofs[pos[same]]]
+    dg = rows.fixed_values[pos[same]] - fixed_values[same]
+    return float(0.5 * np.dot(reactions[same] + r_new, dg))
 
 
 def _boundary_dofs(problem, name):

@@ -43,7 +43,7 @@ from ..output.overlap3d import fragment_overlap_volume
 from ..fracture.strain import vertex_displacement
 from ..fracture.fragments import FragmentStatistics
 
-__all__ = ["OVERLAP_TOL", "Violation", "check_state", "penetration_depth_3d", "overlap_volume_3d"]
+__all__ = ["OVERLAP_TOL", "Violation", "check_state", "depth_limit_3d", "penetration_depth_3d", "overlap_volume_3d"]
 
 #: overlap accepted between pieces, relative to the body's area
 OVERLAP_TOL = 1e-10
@@ -97,12 +97,11 @@ def check_state(problem, area_initial, with_overlap):
                          f"{det_f[worst]:.3g})"), 0.0
     if problem.dim == 3:
         depth = penetration_depth_3d(problem) if with_overlap else 0.0
-        P = problem.arrays.points
-        diameter = float(np.linalg.norm(P.max(axis=0) - P.min(axis=0)))
-        if not depth <= OVERLAP_TOL * diameter:
+        limit = depth_limit_3d(problem)
+        if not depth <= limit:
             return Violation("overlap", depth,
-                             f"a vertex lies {depth:.3g} deep in another piece ({depth / diameter:.2g} of the "
-                             f"body's diameter; at most {OVERLAP_TOL:g} of it is accepted)"), depth
+                             f"a vertex lies {depth:.3g} deep in another piece ({depth * OVERLAP_TOL / limit:.2g} "
+                             f"of the body's diameter; at most {OVERLAP_TOL:g} of it is accepted)"), depth
         volume = overlap_volume_3d(problem) if with_overlap else 0.0
         if not volume <= OVERLAP_TOL * area_initial:
             return Violation("overlap", volume,
@@ -136,6 +135,22 @@ def overlap_volume_3d(problem):
     _, piece = problem.fragments()
     points = problem.arrays.points + vertex_displacement(problem.u)
     return fragment_overlap_volume(points, tets, piece[tets[:, 0]], body_volume=0.0).volume
+
+
+def depth_limit_3d(problem):
+    """The depth a vertex may lie inside another piece: ``OVERLAP_TOL`` of the body's diameter
+    (the diagonal of the reference points' bounding box).
+
+    Parameters
+    ----------
+    problem : ElasticProblem
+
+    Returns
+    -------
+    float
+    """
+    P = problem.arrays.points
+    return OVERLAP_TOL * float(np.linalg.norm(P.max(axis=0) - P.min(axis=0)))
 
 
 def penetration_depth_3d(problem):

@@ -42,9 +42,9 @@ from ..fracture.strain import principal
 from ..linalg import bordered
 from ..mechanics.tangent import SavedTangent
 from ..mechanics.problem import ElasticProblem
-from ..mechanics.resultants import boundary_resultants, load_vector, work_of_forces
+from ..mechanics.resultants import boundary_resultants, load_vector, reaction_work, work_of_forces
 from .loadpath import load_path_cut, prescribed_increment
-from .invariants import check_state
+from .invariants import check_state, depth_limit_3d, penetration_depth_3d
 from .records import (AcceptedStep, Attempt, CrackPass, Equilibrium, StepFailed, StepLog, StepOutcome, TooManyCracks,
                       merged_notes)
 from .solid_pass import solid_crack_pass
@@ -53,7 +53,11 @@ from . import tangents
 from .growth import critical_event, relax
 from .refinement import refine_equilibrium, refine_initial
 
-__all__ = ["LoadStep"]
+__all__ = ["LoadStep", "UNHELD_NOTE"]
+
+#: the note of a 3D step whose pieces overlap in a run without contact rows (LoadStep.check)
+UNHELD_NOTE = ("pieces overlap: the scene solves without contact rows (Scene.contact is False), and the "
+               "step's deepest vertex in another piece is its overlap")
 
 
 class LoadStep:
@@ -130,7 +134,8 @@ class LoadStep:
         if mesh.dim == 3:
             # 3D: contact (crack lips included) where the scene asks for it: a contact solve on
             # a tetrahedral mesh costs several times the crack work of a scene whose pieces
-            # only separate (docs/contact.md, "Crack lips in 3D")
+            # only separate (docs/contact.md, "Crack lips in 3D"); where they do not, the
+            # overlap is measured and noted (:meth:`check`)
             return bool(self.scene.contact)
         return self.scene.contact or "crack" in mesh.GetBoundaries()
 
@@ -281,7 +286,7 @@ class LoadStep:
             x = state.x + dx
             prob, eq, start = self.increment(state, x, method, timings, substeps, keep)
             crack, iterations, notes = None, eq.iterations, eq.notes
-        work = self.increment_work(state, prob)
+        work = reaction_work(prob, state.fixed_dofs, state.fixed_values, state.reactions)
         if prob.loads:        # the dead loads' work over the increment (same mesh, same dofs)
             forces = load_vector(prob)
             before = state.external if state.external is not None else np.zeros_like(forces)
@@ -395,7 +400,8 @@ class LoadStep:
         try:
             attempt = self.attempt(state, dx, log.method, timings, log.substeps, keep)
             if not isinstance(attempt, TooManyCracks):
-                attempt.overlap = self.check(attempt.problem, attempt.area, timings)
+                attempt.overlap, notes = self.check(attempt.problem, attempt.area, timings)
+                attempt.notes = merged_notes(attempt.notes, notes)
             return attempt
         except StepFailed:
             raise
@@ -416,8 +422,12 @@ class LoadStep:
 
         Returns
         -------
-        float
-            The overlap area between the pieces (0 where nothing can overlap).
+        overlap : float
+            The overlap area between the pieces (0 where nothing can overlap); in 3D the
+            deepest vertex's depth in another piece.
+        notes : list of str
+            :data:`UNHELD_NOTE` where the pieces of a 3D run without contact rows overlap
+            by more than the invariant accepts (measured, not enforced: no row holds them).
 
         Raises
         ------
@@ -426,38 +436,13 @@ class LoadStep:
         """
         with timings.timed("checks"):
             pieces = self.scene.contact or "crack" in prob.mesh.GetBoundaries() or prob.fragments()[0] > 1
-            if prob.dim == 3:       # 3D: checked where the solve had contact rows
-                pieces = self.needs_contact(prob.mesh)
-            violation, overlap = check_state(prob, area, pieces)
+            unheld = pieces and prob.dim == 3 and not self.needs_contact(prob.mesh)
+            violation, overlap = check_state(prob, area, pieces and not unheld)
+            if violation is None and unheld:
+                overlap = penetration_depth_3d(prob)
         if violation is not None:
             raise StepFailed(violation.invariant, "invariant", violation.message)
-        return overlap
-
-    @staticmethod
-    def increment_work(state, prob):
-        """Work of the reactions over the increment just solved (trapezoid rule).
-
-        The increment is solved on the mesh of the accepted state, so its fixed dofs have
-        the numbers they had there (cracks come later, at fixed load: they do no work).
-
-        Parameters
-        ----------
-        state : State
-            The accepted state the increment starts from.
-        prob : ElasticProblem
-            The solved increment.
-
-        Returns
-        -------
-        float
-        """
-        rows = prob.assemble_constraints()
-        pos = np.searchsorted(rows.fixed_dofs, state.fixed_dofs)
-        pos = np.minimum(pos, max(len(rows.fixed_dofs) - 1, 0))
-        same = (rows.fixed_dofs[pos] == state.fixed_dofs) if len(rows.fixed_dofs) else np.zeros(0, bool)
-        r_new = -prob.out_of_balance()[rows.fixed_dofs[pos[same]]]
-        dg = rows.fixed_values[pos[same]] - state.fixed_values[same]
-        return float(0.5 * np.dot(state.reactions[same] + r_new, dg))
+        return overlap, [UNHELD_NOTE] if unheld and overlap > depth_limit_3d(prob) else []
 
     def accept(self, state, outcome, timings):
         """The accepted state of a step and its history record.
