@@ -78,7 +78,8 @@ def one_solid_case(seed, max_steps):
     record = {"seed": seed, "params": params}
     t0 = time.perf_counter()
     scene = random_solids.scene(**params)
-    volume = math.fsum(tet_volumes(solid_to_arrays(scene.mesh).points, solid_to_arrays(scene.mesh).tets))
+    reference = solid_to_arrays(scene.mesh)
+    volume = math.fsum(tet_volumes(reference.points, reference.tets))
     violations = []
 
     def check(step):

@@ -11,7 +11,8 @@ from ..mechanics.materials import StVenantKirchhoff
 from ..run.scene import Scene
 from .common import BAR_LOAD, BAR_RADIUS, GLASS, PLATE_LOAD, PLATE_RADIUS, positive
 
-__all__ = ["notched_bar_mesh", "bar3d", "extruded_plate_mesh", "plate3d", "FRONT_SPLITS", "SPLIT_3D"]
+__all__ = ["notched_bar_mesh", "bar3d", "extruded_plate_mesh", "plate3d", "hold_gliding_ends", "corner_vertices",
+           "FRONT_SPLITS", "SPLIT_3D"]
 
 #: the first pass of a load step may split this many front vertices before the step is cut
 FRONT_SPLITS = 1000
@@ -124,14 +125,14 @@ def bar3d(maxh=0.15, fine=None, strain_max=2e-3, dx=None, material=None, critica
     material = material if material is not None else StVenantKirchhoff(E, nu)
     length = positive("length", length)
     dx = positive("dx", dx) if dx is not None else length * critical / 5
-    corners = _corners(mesh, [[0.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+    corners = corner_vertices(mesh, [[0.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
     strength, strength_parameters = scene_strength(mesh, ["glass"], critical, weibull_m, weibull_scale,
                                                    weibull_area, seed)
 
     def apply_load(prob, x):
         prob.add_dirichlet("left", 0.0, component="x")
         prob.add_dirichlet("right", x, component="x")
-        _hold_gliding_ends(prob, corners)
+        hold_gliding_ends(prob, corners)
 
     return Scene(name="bar3d", mesh=mesh, material=material, critical=critical, apply_load=apply_load,
                  load_max=length * strain_max, dx=dx, contact_tol=1e-3 * fine, stop_when_unloaded=True,
@@ -144,16 +145,33 @@ def bar3d(maxh=0.15, fine=None, strain_max=2e-3, dx=None, material=None, critica
                  strength=strength)
 
 
-def _hold_gliding_ends(prob, corners):
+def hold_gliding_ends(prob, corners):
     """Hold the rigid modes that ends gliding along x leave free (translations in y and z,
-    rotation about x) at two corners of the left end, without stressing the body."""
+    rotation about x) at two corners of the left end, without stressing the body.
+
+    Parameters
+    ----------
+    prob : ElasticProblem
+    corners : sequence of int
+        Two vertices of the left end, apart in y (:func:`corner_vertices`).
+    """
     prob.add_point_constraint(corners[0], 0.0, component="y")
     prob.add_point_constraint(corners[0], 0.0, component="z")
     prob.add_point_constraint(corners[1], 0.0, component="z")
 
 
-def _corners(mesh, points):
-    """The vertices nearest the given points (corners of the mesh)."""
+def corner_vertices(mesh, points):
+    """The vertices nearest the given points (corners of the mesh).
+
+    Parameters
+    ----------
+    mesh : ngsolve.Mesh
+    points : sequence of (float, float, float)
+
+    Returns
+    -------
+    list of int
+    """
     P = mesh.ngmesh.Coordinates()
     return [int(np.argmin(np.linalg.norm(P - q, axis=1))) for q in points]
 
@@ -252,12 +270,12 @@ def plate3d(maxh=0.1, fine=None, thickness=0.2, strain_max=1e-3, dx=None, materi
     mesh = extruded_plate_mesh(maxh, fine, thickness)
     material = material if material is not None else StVenantKirchhoff(E, nu)
     dx = positive("dx", dx) if dx is not None else critical / 10
-    corners = _corners(mesh, [[0.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+    corners = corner_vertices(mesh, [[0.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
 
     def apply_load(prob, x):
         prob.add_dirichlet("left", -x / 2, component="x")
         prob.add_dirichlet("right", x / 2, component="x")
-        _hold_gliding_ends(prob, corners)
+        hold_gliding_ends(prob, corners)
 
     return Scene(name="plate3d", mesh=mesh, material=material, critical=critical, apply_load=apply_load,
                  load_max=strain_max, dx=dx, contact_tol=1e-3 * fine, stop_when_unloaded=True, radius=radius,

@@ -22,7 +22,7 @@ from netgen.geom2d import SplineGeometry
 from ..mechanics.materials import LinearElastic, NeoHookean, StVenantKirchhoff
 from ..run.scene import Scene
 
-__all__ = ["LOADS", "MODELS", "EXTREMES", "draw", "scene", "parse_holes"]
+__all__ = ["LOADS", "MODELS", "EXTREMES", "draw", "draw_extreme", "scene", "parse_holes"]
 
 #: the loads, all by prescribed displacement; x is a nominal strain
 LOADS = ("tension", "shear", "biaxial", "mixed")
@@ -74,19 +74,45 @@ def draw(seed, coarse=False):
              critical=float(10 ** rng.uniform(-4, -2)), radius=round(radius, 5),
              maxh=round(radius * rng.uniform(0.5, 1.5), 5), overload=round(float(rng.uniform(1.5, 4.0)), 3),
              angle=round(float(rng.uniform(0, 180)), 2))
+    extreme = draw_extreme(rng, p, short, huge_cells=6)
+    p["maxh"] = max(p["maxh"], short / (12 if coarse else 40))   # a few hundred or thousand triangles
+    return {**p, "seed": int(seed), "extreme": extreme}
+
+
+def draw_extreme(rng, p, short, huge_cells):
+    """Draw the extreme of about a third of the cases and apply it to the parameters ``p``
+    (changed in place): a mesh four times coarser than the critical distance, a critical
+    distance of the body's ``short`` size (on ``huge_cells`` elements across it), nu = 0.499
+    (in plane strain where ``p`` has a plane), a critical strain of 0.3, 40 times the load.
+
+    Parameters
+    ----------
+    rng : numpy.random.Generator
+    p : dict
+        A draw's parameters (``maxh``, ``radius``, ``nu``, ``critical``, ``overload``).
+    short : float
+        The body's shortest side.
+    huge_cells : int
+
+    Returns
+    -------
+    str
+        The extreme drawn (one of :data:`EXTREMES`), or "".
+    """
     extreme = str(rng.choice(EXTREMES)) if rng.random() < 1 / 3 else ""
     if extreme == "coarse_mesh":
         p["maxh"] = round(4 * p["radius"], 5)
     elif extreme == "huge_radius":
-        p["radius"], p["maxh"] = round(short, 5), round(short / 6, 5)
+        p["radius"], p["maxh"] = round(short, 5), round(short / huge_cells, 5)
     elif extreme == "incompressible":
-        p["nu"], p["plane"] = 0.499, "strain"
+        p["nu"] = 0.499
+        if "plane" in p:
+            p["plane"] = "strain"
     elif extreme == "large_critical":
         p["critical"] = 0.3
     elif extreme == "overload":
         p["overload"] = 40.0
-    p["maxh"] = max(p["maxh"], short / (12 if coarse else 40))   # a few hundred or thousand triangles
-    return {**p, "seed": int(seed), "extreme": extreme}
+    return extreme
 
 
 def parse_holes(holes):

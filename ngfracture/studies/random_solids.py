@@ -22,8 +22,9 @@ import ngsolve as ng
 from netgen.occ import X, Y, Z, Box, OCCGeometry, Pnt, Sphere
 
 from ..run.scene import Scene
-from ..scenes.solids import FRONT_CONTROL
-from .random_scenes import EXTREMES, MODELS
+from ..scenes.common import positive
+from ..scenes.solids import FRONT_CONTROL, corner_vertices, hold_gliding_ends
+from .random_scenes import MODELS, draw_extreme
 
 __all__ = ["LOADS", "draw", "scene", "parse_spheres"]
 
@@ -73,17 +74,7 @@ def draw(seed, coarse=False):
              critical=float(10 ** rng.uniform(-4, -2)), radius=round(radius, 5),
              maxh=round(radius * rng.uniform(0.7, 1.5), 5), overload=round(float(rng.uniform(1.5, 4.0)), 3),
              angle=round(float(rng.uniform(0, 180)), 2))
-    extreme = str(rng.choice(EXTREMES)) if rng.random() < 1 / 3 else ""
-    if extreme == "coarse_mesh":
-        p["maxh"] = round(4 * p["radius"], 5)
-    elif extreme == "huge_radius":
-        p["radius"], p["maxh"] = round(short, 5), round(short / 4, 5)
-    elif extreme == "incompressible":
-        p["nu"] = 0.499
-    elif extreme == "large_critical":
-        p["critical"] = 0.3
-    elif extreme == "overload":
-        p["overload"] = 40.0
+    extreme = draw_extreme(rng, p, short, huge_cells=4)
     p["maxh"] = max(p["maxh"], short / (4 if coarse else 8))     # hundreds or thousands of tetrahedra
     return {**p, "seed": int(seed), "extreme": extreme}
 
@@ -142,8 +133,7 @@ def _check(length, width, height, holes, notch, notch_x, maxh, radius, critical,
     """ValueError naming the first parameter that makes no body or no load."""
     for name, value in (("length", length), ("width", width), ("height", height), ("maxh", maxh),
                         ("radius", radius), ("critical", critical), ("overload", overload)):
-        if not (math.isfinite(value) and value > 0):
-            raise ValueError(f"{name} must be a finite number > 0, got {value!r}")
+        positive(name, value)
     if not 0 <= notch < height:
         raise ValueError(f"notch must be in [0, height = {height}), got {notch!r}")
     if notch > 0 and not notch / 8 < notch_x < length - notch / 8:
@@ -151,12 +141,6 @@ def _check(length, width, height, holes, notch, notch_x, maxh, radius, critical,
     for x, y, z, r in holes:
         if not (r < x < length - r and r < y < width - r and r < z < height - r):
             raise ValueError(f"the hole {x}:{y}:{z}:{r} does not lie inside the box")
-
-
-def _corner_vertices(mesh, points):
-    """The vertices nearest the given points (corners of the box)."""
-    P = np.asarray(mesh.ngmesh.Coordinates())
-    return [int(np.argmin(np.linalg.norm(P - q, axis=1))) for q in points]
 
 
 def _displacement_load(load, size, corners, angle):
@@ -170,10 +154,7 @@ def _displacement_load(load, size, corners, angle):
             prob.add_dirichlet("left", 0.0, component="x")
             prob.add_dirichlet("right", x * length, component="x")
         if load == "tension":
-            # translations in y and z and the rotation about x, held without stressing the body
-            prob.add_point_constraint(corners[0], 0.0, component="y")
-            prob.add_point_constraint(corners[0], 0.0, component="z")
-            prob.add_point_constraint(corners[1], 0.0, component="z")
+            hold_gliding_ends(prob, corners)
         if load == "triaxial":
             prob.add_dirichlet("front", 0.0, component="y")
             prob.add_dirichlet("back", x * width, component="y")
@@ -246,7 +227,7 @@ def scene(length=1.5, width=1.0, height=0.8, holes="", notch=0.0, notch_x=0.75, 
     _check(length, width, height, spheres, notch, notch_x, maxh, radius, critical, overload)
     material = MODELS[model](E, nu)
     mesh = _mesh((length, width, height), spheres, notch, notch_x, maxh)
-    corners = _corner_vertices(mesh, [[0.0, 0.0, 0.0], [0.0, width, 0.0]])
+    corners = corner_vertices(mesh, [[0.0, 0.0, 0.0], [0.0, width, 0.0]])
     apply_load = _displacement_load(load, (length, width, height), corners, angle)
     parameters = dict(length=length, width=width, height=height, holes=holes, notch=notch, notch_x=notch_x,
                       load=load, model=model, E=E, nu=nu, critical=critical, radius=radius, maxh=maxh,
