@@ -1,4 +1,4 @@
-"""A brute-force reference of the 3D detection (``cpp_ext/collision3d.cpp``).
+"""A brute-force reference of the 3D detection (``cpp_ext/collision3d*.cpp``).
 
 Pairs: every (boundary vertex, tetrahedron) tested with the exact ``orient3d``, a vertex
 against the tetrahedra of the other fragments, and a lip vertex (a copy of its point on

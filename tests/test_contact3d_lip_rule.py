@@ -1,5 +1,5 @@
 """The detection's lip rule at points of two or more copies on one fragment (docs/contact.md,
-"Points of several copies"; ``SeparatingFace(..., lips_only)`` in cpp_ext/collision3d.cpp).
+"Points of several copies"; ``SeparatingFace(..., lips_only)`` in cpp_ext/collision3d_faces.cpp).
 
 The body is the junction cube of ``test_contact3d_crack_junction.py``: two cracks inside
 one fragment meet along the line x = y = 1/2, z > 1/2, where every point has three copies

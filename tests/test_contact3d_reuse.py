@@ -1,7 +1,7 @@
 """Work of the 3D contact rounds done once and reused gives the results of doing it again.
 
 - The detection's sweep skips the cells whose vertices are all decided for the
-  fragments there (closed lips, ``cpp_ext/collision3d.cpp`` ClosedCells): a third block
+  fragments there (closed lips, ``cpp_ext/collision3d_sweep.cpp`` ClosedCells): a third block
   pushed through closed lips must still find every pair there (brute force over all pairs).
 - ``NodeToFaceRows.subset`` and ``stack`` carry the rows of a built ``C``: equal, array by
   array, to the ``C`` built from the selected rows.
