@@ -126,8 +126,9 @@ def _add_run(subparsers):
                    help="PNG of the final state and the fragment-size plot (default), also of every "
                         "step, or no pictures")
     p.add_argument("--contact", choices=["auto", "never"], default="auto",
-                   help="auto: contact from the first crack on (from the start for separate "
-                        "bodies); never: no contact rows (overlap is still measured)")
+                   help="auto: in 2D contact from the first crack on (from the start for separate "
+                        "bodies), in 3D where the scene asks for it (Scene.contact); never: no contact "
+                        "rows (overlap is still measured)")
     p.add_argument("--progress", choices=["auto", "bar", "json", "none"], default="auto",
                    help="bar: a progress line on stderr (auto: when stderr is a terminal); json: one "
                         "JSON object per accepted step on stdout (step, load, splits, fragments, "

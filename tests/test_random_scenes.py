@@ -80,3 +80,14 @@ def test_a_step_whose_pieces_overlap_is_not_accepted_and_the_run_says_which_inva
     assert failure["reason"] == "overlap" and failure["phase"] == "invariant"
     assert "pieces overlap by" in failure["message"] and "of the area" in failure["message"]
     assert result.state.x <= 1.0 and result.summary["max_overlap_area"] <= OVERLAP_TOL * 2.0
+
+
+def test_holes_are_parsed_in_two_and_three_dimensions():
+    assert random_scenes.parse_holes("0.1:0.2:0.05,0.5:0.5:0.1") == [(0.1, 0.2, 0.05), (0.5, 0.5, 0.1)]
+    assert random_scenes.parse_holes("0.1:0.2:0.3:0.05", dim=3) == [(0.1, 0.2, 0.3, 0.05)]
+    assert random_scenes.parse_holes("") == []
+    for text, dim, message in (("0.1:0.2", 2, "a hole must be x:y:r"), ("0.1:0.2:0.3:0.4", 2, "a hole must be x:y:r"),
+                               ("0.1:0.2:0.3", 3, "a spherical hole must be x:y:z:r"),
+                               ("0.1:0.2:0", 2, "radius must be > 0"), ("0.1:0.2:0.1", 4, "dim must be 2 or 3")):
+        with pytest.raises(ValueError, match=message):
+            random_scenes.parse_holes(text, dim=dim)

@@ -83,9 +83,11 @@ class Simulation:
         Called after every accepted step with a dict: step, x, load_max, split_vertices,
         fragments, seconds.
     contact : {"auto", "never"}
-        "auto": contact from the first crack on (or from the start for separate bodies);
-        "never": no contact rows at all (faster where pieces only separate; the summary's
-        ``max_overlap_area`` still measures any overlap).
+        "auto": in 2D contact from the first crack on (or from the start for separate
+        bodies); in 3D where the scene asks for it (``Scene.contact``: from the start, crack
+        lips included), else the overlap is measured and noted at every step
+        (:meth:`LoadStep.check`); "never": no contact rows at all (faster where pieces only
+        separate; the summary's ``max_overlap_area`` still measures any overlap).
 
     Attributes
     ----------

@@ -115,32 +115,42 @@ def draw_extreme(rng, p, short, huge_cells):
     return extreme
 
 
-def parse_holes(holes):
-    """Holes from their text form ``"x:y:r,x:y:r"``.
+def parse_holes(holes, dim=2):
+    """Holes from their text form ``"x:y:r,x:y:r"`` (circles) or, with ``dim=3``,
+    ``"x:y:z:r,x:y:z:r"`` (spheres).
 
     Parameters
     ----------
     holes : str
         Empty for none.
+    dim : {2, 3}
+        The coordinates of a centre.
 
     Returns
     -------
-    list of (float, float, float)
+    list of tuple of float
+        The centre's coordinates and the radius of every hole.
 
     Raises
     ------
     ValueError
-        A hole that is not three numbers with r > 0.
+        A hole that is not ``dim + 1`` numbers with r > 0, or ``dim`` not 2 or 3.
     """
+    if dim not in (2, 3):
+        raise ValueError(f"dim must be 2 or 3, got {dim!r}")
+    form = ":".join("xyz"[:dim]) + ":r"
+    kind = "a hole" if dim == 2 else "a spherical hole"
     out = []
     for item in filter(None, holes.split(",")):
         try:
-            x, y, r = (float(v) for v in item.split(":"))
+            values = tuple(float(v) for v in item.split(":"))
         except ValueError:
-            raise ValueError(f"a hole must be x:y:r, got {item!r}") from None
-        if not r > 0:
+            values = ()
+        if len(values) != dim + 1:
+            raise ValueError(f"{kind} must be {form}, got {item!r}")
+        if not values[-1] > 0:
             raise ValueError(f"a hole's radius must be > 0, got {item!r}")
-        out.append((x, y, r))
+        out.append(values)
     return out
 
 

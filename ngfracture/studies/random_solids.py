@@ -24,9 +24,9 @@ from netgen.occ import X, Y, Z, Box, OCCGeometry, Pnt, Sphere
 from ..run.scene import Scene
 from ..scenes.common import positive
 from ..scenes.solids import FRONT_CONTROL, corner_vertices, hold_gliding_ends
-from .random_scenes import MODELS, draw_extreme
+from .random_scenes import MODELS, draw_extreme, parse_holes
 
-__all__ = ["LOADS", "draw", "scene", "parse_spheres"]
+__all__ = ["LOADS", "draw", "scene"]
 
 #: the loads, all by prescribed displacement; x is a nominal strain
 LOADS = ("tension", "shear", "triaxial", "mixed")
@@ -77,35 +77,6 @@ def draw(seed, coarse=False):
     extreme = draw_extreme(rng, p, short, huge_cells=4)
     p["maxh"] = max(p["maxh"], short / (4 if coarse else 8))     # hundreds or thousands of tetrahedra
     return {**p, "seed": int(seed), "extreme": extreme}
-
-
-def parse_spheres(holes):
-    """Spherical holes from their text form ``"x:y:z:r,x:y:z:r"``.
-
-    Parameters
-    ----------
-    holes : str
-        Empty for none.
-
-    Returns
-    -------
-    list of (float, float, float, float)
-
-    Raises
-    ------
-    ValueError
-        A hole that is not four numbers with r > 0.
-    """
-    out = []
-    for item in filter(None, holes.split(",")):
-        try:
-            x, y, z, r = (float(v) for v in item.split(":"))
-        except ValueError:
-            raise ValueError(f"a spherical hole must be x:y:z:r, got {item!r}") from None
-        if not r > 0:
-            raise ValueError(f"a hole's radius must be > 0, got {item!r}")
-        out.append((x, y, z, r))
-    return out
 
 
 def _mesh(size, holes, notch, notch_x, maxh):
@@ -223,7 +194,7 @@ def scene(length=1.5, width=1.0, height=0.8, holes="", notch=0.0, notch_x=0.75, 
         raise ValueError(f"load must be one of {LOADS}, got {load!r}")
     if model not in MODELS:
         raise ValueError(f"model must be one of {sorted(MODELS)}, got {model!r}")
-    spheres = parse_spheres(holes)
+    spheres = parse_holes(holes, dim=3)
     _check(length, width, height, spheres, notch, notch_x, maxh, radius, critical, overload)
     material = MODELS[model](E, nu)
     mesh = _mesh((length, width, height), spheres, notch, notch_x, maxh)
