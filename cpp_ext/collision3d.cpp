@@ -230,6 +230,54 @@ namespace ngfracture
       VertexFaces vfaces;
     };
 
+    // The row of hit (v, F, t): the face at a copy that v crossed, if there is one, else
+    // v's master face of F (false if F has none). `partners`, `scratch`: space for PartnerFaces.
+    bool HitPenetration (const TetMesh3 & m, const Topology & T, const Copies & copies, const Derived & D,
+                         const HashGrid & fg, const VertexFaces & vfaces, int32_t v, int32_t F, int32_t t,
+                         std::vector<int32_t> & partners, std::vector<std::pair<int32_t,int32_t>> & scratch,
+                         Penetration3 & pen)
+    {
+      pen.vertex = v; pen.fragment = F; pen.tet = t;
+      pen.twin = copies.Twin(D.vfrag, v, F);             // closed seams were left out by the sweep
+      // v in the star of a copy t (the holding tetrahedron is at t): the face at t
+      // it crossed, if there is one
+      int32_t t_copy = -1;
+      for (int k = 0; k < 4 && pen.twin >= 0; k++)
+        {
+          int32_t w = m.tets[4*t + k];
+          if (w != v && copies.group[w] == copies.group[v]) t_copy = w;
+        }
+      double depth = 0;
+      int32_t sep = t_copy >= 0 ? SeparatingFace(m, vfaces, T, v, t_copy, m.tets + 4*t, depth) : -1;
+      // none, and two or more copies of the point on F (a crack inside F, or cracks
+      // meeting inside F): v's wedge can lie across the plane of the lip it crossed
+      // into t's wedge; that lip still separates v if v is behind it (the nearest face
+      // of F may be the coincident lip of another copy, v in front of it)
+      if (sep < 0 && t_copy >= 0 && copies.CountOn(D.vfrag, v, F) >= 2)
+        sep = SeparatingFace(m, vfaces, T, v, t_copy, m.tets + 4*t, depth, &copies);
+      // none, three or more copies on F, and the holding tetrahedron has no face on the
+      // boundary at t: v slid past the faces of the tetrahedra at t deeper into t's star
+      // where several cracks meet; the lip at t that v is least deep behind (the
+      // nearest face of F may be one v is in front of, whose row does not hold it)
+      if (sep < 0 && t_copy >= 0 && copies.CountOn(D.vfrag, v, F) >= 3
+          && !HasBoundaryFaceAt(m, vfaces, t_copy, m.tets + 4*t))
+        sep = SeparatingFace(m, vfaces, T, v, t_copy, nullptr, depth, &copies);
+      if (sep >= 0)
+        {
+          const int32_t * S = m.faces + 3*sep;
+          ClosestPointOnTriangle3(m.x + 3*v, m.x + 3*S[0], m.x + 3*S[1], m.x + 3*S[2], pen.bary);
+          for (int d = 0; d < 3; d++)
+            pen.proj[d] = pen.bary[0]*m.x[3*S[0]+d] + pen.bary[1]*m.x[3*S[1]+d] + pen.bary[2]*m.x[3*S[2]+d];
+          pen.face = sep;
+          std::copy(&D.fnormal[3*sep], &D.fnormal[3*sep] + 3, pen.normal);
+          pen.gap = -depth;
+          return true;
+        }
+      partners.clear();
+      if (pen.twin >= 0) PartnerFaces(m, copies, D, vfaces, v, F, partners, scratch);
+      return MasterFace(m, D, fg, v, F, partners, pen);
+    }
+
     // `incidence` the mesh's (made here, if there is a hit, when null)
     std::vector<Penetration3> Detect (const TetMesh3 & m, const Topology & T, const Copies & copies,
                                       Collision3Stats * stats, const Incidence * incidence = nullptr)
@@ -288,47 +336,7 @@ namespace ngfracture
           auto [v, F, t] = hits[s];
           if (s > 0 && std::get<0>(hits[s-1]) == v && std::get<1>(hits[s-1]) == F) continue;
           Penetration3 pen;
-          pen.vertex = v; pen.fragment = F; pen.tet = t;
-          pen.twin = copies.Twin(D.vfrag, v, F);             // closed seams were left out by the sweep
-          // v in the star of a copy t (the holding tetrahedron is at t): the face at t
-          // it crossed, if there is one
-          int32_t t_copy = -1;
-          for (int k = 0; k < 4 && pen.twin >= 0; k++)
-            {
-              int32_t w = m.tets[4*t + k];
-              if (w != v && copies.group[w] == copies.group[v]) t_copy = w;
-            }
-          double depth = 0;
-          int32_t sep = t_copy >= 0 ? SeparatingFace(m, vfaces, T, v, t_copy, m.tets + 4*t, depth) : -1;
-          // none, and two or more copies of the point on F (a crack inside F, or cracks
-          // meeting inside F): v's wedge can lie across the plane of the lip it crossed
-          // into t's wedge; that lip still separates v if v is behind it (the nearest face
-          // of F may be the coincident lip of another copy, v in front of it)
-          if (sep < 0 && t_copy >= 0 && copies.CountOn(D.vfrag, v, F) >= 2)
-            sep = SeparatingFace(m, vfaces, T, v, t_copy, m.tets + 4*t, depth, &copies);
-          // none, three or more copies on F, and the holding tetrahedron has no face on the
-          // boundary at t: v slid past the faces of the tetrahedra at t deeper into t's star
-          // where several cracks meet; the lip at t that v is least deep behind (the
-          // nearest face of F may be one v is in front of, whose row does not hold it)
-          if (sep < 0 && t_copy >= 0 && copies.CountOn(D.vfrag, v, F) >= 3
-              && !HasBoundaryFaceAt(m, vfaces, t_copy, m.tets + 4*t))
-            sep = SeparatingFace(m, vfaces, T, v, t_copy, nullptr, depth, &copies);
-          if (sep >= 0)
-            {
-              const int32_t * T = m.faces + 3*sep;
-              ClosestPointOnTriangle3(m.x + 3*v, m.x + 3*T[0], m.x + 3*T[1], m.x + 3*T[2], pen.bary);
-              for (int d = 0; d < 3; d++)
-                pen.proj[d] = pen.bary[0]*m.x[3*T[0]+d] + pen.bary[1]*m.x[3*T[1]+d] + pen.bary[2]*m.x[3*T[2]+d];
-              pen.face = sep;
-              std::copy(&D.fnormal[3*sep], &D.fnormal[3*sep] + 3, pen.normal);
-              pen.gap = -depth;
-              out.push_back(pen);
-              continue;
-            }
-          partners.clear();
-          if (pen.twin >= 0) PartnerFaces(m, copies, D, vfaces, v, F, partners, scratch);
-          if (!MasterFace(m, D, fg, v, F, partners, pen)) continue;
-          out.push_back(pen);
+          if (HitPenetration(m, T, copies, D, fg, vfaces, v, F, t, partners, scratch, pen)) out.push_back(pen);
         }
       if (stats) *stats = st;
       return out;
