@@ -396,27 +396,26 @@ class ActiveSet3d(ActiveSet):
         in the other fragment, 1.3e-5 behind the wedge's other face)."""
         a, setup = self.geometry.arrays, self.setup
         nv = len(a.points)
-        reflex = reflex_wedge_rows(setup.edge_copies, U, self.copy_tol, setup.copy_index)
-        parts = [behind_partner_rows(setup.partners, U, self.copy_tol, setup.copy_index),
-                 wedge_rows(setup.diagonal_edges, U, self.copy_tol, setup.copy_index, setup.vertex_fragment),
-                 reflex]
+        # each kind of row at copies with its name: the warm and the reflex-wedge rows
+        # take their own rules below
+        parts = [(behind_partner_rows(setup.partners, U, self.copy_tol, setup.copy_index), "partner"),
+                 (wedge_rows(setup.diagonal_edges, U, self.copy_tol, setup.copy_index, setup.vertex_fragment),
+                  "wedge"),
+                 (reflex_wedge_rows(setup.edge_copies, U, self.copy_tol, setup.copy_index), "reflex")]
         if self.warm:
             # the rows at copies the solve before imposed, which the warm start names
             warm = self._key_codes(sorted(self.warm))
-            parts.append(rows_at_copies_of(*self.codec.faces_of(warm[warm >= 0]), U, setup.copy_index))
-        more = NodeToFaceRows.stack(parts)
+            parts.append((rows_at_copies_of(*self.codec.faces_of(warm[warm >= 0]), U, setup.copy_index), "warm"))
+        more = NodeToFaceRows.stack([rows for rows, _ in parts])
         if not len(more):
             return found, codes
+        kind = np.repeat([name for _, name in parts], [len(rows) for rows, _ in parts])
         copy = more.master[np.arange(len(more)), np.argmax(more.bary, axis=1)]
         deep = unique_ints(np.asarray(pen.vertex, dtype=np.int64)[pen.gap < -self.penetration_tol])
-        start = len(parts[0]) + len(parts[1])
         # the warm rows were imposed beside the tie in the solve before: a pair's one row
         # there (the detection finds it only once the copy is deep again)
-        warm_rows = np.zeros(len(more), dtype=bool)
-        warm_rows[start + len(reflex):] = True
-        keep = warm_rows | ~isin_ints(np.minimum(more.slave, copy) * nv + np.maximum(more.slave, copy), self.tied)
-        exempt = np.zeros(len(more), dtype=bool)
-        exempt[start:start + len(reflex)] = True
+        keep = (kind == "warm") | ~isin_ints(np.minimum(more.slave, copy) * nv + np.maximum(more.slave, copy), self.tied)
+        exempt = kind == "reflex"
         return self._with_new(found, codes,
                               more.subset(np.flatnonzero(keep & (exempt | ~isin_ints(more.slave, deep)))))
 
