@@ -9,8 +9,8 @@ import pytest
 from conftest import child_env
 
 ROOT = Path(__file__).resolve().parent.parent
-BENCHMARKS = ["contact", "contact3d", "crack", "edges3d", "ensemble", "linear3d", "lshape", "meshcheck", "objectivity", "scenes", "schur", "sphere3d",
-              "solid"]
+BENCHMARKS = ["contact", "contact3d", "crack", "edges3d", "ensemble", "linear3d", "lshape", "meshcheck", "objectivity",
+              "random_scenes", "scenes", "schur", "sphere3d", "solid"]
 
 
 def run_benchmark(name, *args):
@@ -138,3 +138,18 @@ def test_contact3d_scene_run_stops_at_its_first_crack(tmp_path):
     assert case["split_vertices"][:k - 1] == [0] * (k - 1) and case["split_vertices"][k - 1] > 0
     assert case["seconds_to_first_crack"] == case["step_seconds"][-1] <= case["wall"]
     assert case["solve_equivalents_to_first_crack"] == case["seconds_to_first_crack"] / case["t_unit"]
+
+
+def test_random_solids_benchmark_checks_every_step_of_a_broken_box(tmp_path):
+    # seed 3 is a coarse box that breaks into pieces within 8 steps: the benchmark's own
+    # checks (volume to the last bit, no inverted tetrahedron, overlap between pieces at
+    # most 1e-10 of the volume, from the arrays, not from the contact code) see pieces
+    target = tmp_path / "random3d.json"
+    r = run_benchmark("random_scenes", "--solids", "--cases", "1", "--seed", "3", "--workers", "1",
+                      "--max-steps", "8", "--timeout", "500", "--json", str(target))
+    assert r.returncode == 0, r.stderr
+    result = json.loads(target.read_text())
+    (record,) = result["records"]
+    assert record["reason"] in ("broken", "load_max", "max_steps"), record
+    assert record["fragments"] >= 2 and record["violations"] == []
+    assert result["silent_violations"] == 0 and result["to_replay"] == []
