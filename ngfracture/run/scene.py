@@ -52,8 +52,10 @@ class Scene:
     contact_tol : float
         Precision threshold of collision detection and contact selection (a length).
     contact : bool
-        Solve with contact from the start (separate bodies); otherwise contact starts
-        with the first crack.
+        Solve with contact from the start (separate bodies). Otherwise a 2D scene solves
+        with contact from the first crack on, and a 3D scene never does: its pieces'
+        overlap is measured and noted at every step (``LoadStep.needs_contact``,
+        ``LoadStep.check``).
     stop_when_unloaded : bool
         End the run once the body is broken through: no fragment is deformed by the
         prescribed displacements any more although they deform the body (each piece

@@ -53,7 +53,8 @@ def draw(seed, coarse=False):
     ----------
     seed : int
     coarse : bool
-        Meshes of at most about a thousand tetrahedra (fast samples).
+        Coarse meshes, about a thousand tetrahedra (840 to 1900 in the draws of
+        docs/verification.md; fast samples).
 
     Returns
     -------
