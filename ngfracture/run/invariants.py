@@ -21,16 +21,18 @@ the step and the size of the violation in its reason.
   same bound: pieces that only separate never overlap. A 3D run without contact rows
   (``contact="never"`` or ``Scene.contact`` False) records the deepest vertex in another
   piece and notes it (``step.UNHELD_NOTE``), not enforced: no row holds the pieces apart
-  (:meth:`ngfracture.run.step.LoadStep.check`). In 3D with contact two things are checked: that no
-  boundary vertex of a piece lies deeper than :data:`OVERLAP_TOL` of the body's diameter
-  (the diagonal of its bounding box) inside another piece, or a lip vertex deeper in the
-  other lip of its own crack, by :func:`ngfracture.contact.collision3d.detect_penetrations_3d`
+  (:meth:`ngfracture.run.step.LoadStep.check`). In 3D with contact two things are
+  checked: that no boundary vertex of a piece lies deeper than :data:`OVERLAP_TOL` of the
+  body's diameter (the diagonal of its bounding box) inside another piece, or a lip vertex
+  deeper in the other lip of its own crack, by
+  :func:`ngfracture.contact.collision3d.detect_penetrations_3d`
   (exact predicates; the largest depth is what the step records as its overlap), and that
   the volume shared by tetrahedra of different fragments is at most :data:`OVERLAP_TOL` of
   the body's volume (:func:`overlap_volume_3d`, exact clipping): faces can cross with no
   vertex inside another piece, which node-to-face rows do not hold (docs/solid.md,
   "Overlap in the free run"). This is checked where a 3D run solves with contact
-  (``Scene.contact`` True, :meth:`ngfracture.run.step.LoadStep.needs_contact`); the written files are measured the same way by
+  (``Scene.contact`` True, :meth:`ngfracture.run.step.LoadStep.needs_contact`); the
+  written files are measured the same way by
   :func:`ngfracture.output.overlap3d.vtu_overlap_volume`.
 
 The checks cost a few percent of a run (docs/performance.md): the overlap is measured only
