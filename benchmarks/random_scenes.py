@@ -7,7 +7,9 @@
 spherical holes and a slot, about a thousand tetrahedra) and checks every accepted step's reference volume to the last bit
 (math.fsum of the tetrahedra), no inverted tetrahedron and the overlap between fragments
 (exact intersections of the deformed tetrahedra, ngfracture.output.overlap3d) at most
-1e-10 of the volume.
+1e-10 of the volume. A 3D record has the case's CPU seconds (``cpu_seconds``), and a case
+stopped by ``--timeout`` how far it got (``reached``: accepted steps, load, fragments, CPU
+seconds at its last accepted step).
 
 Every case runs in its own process (``--timeout`` seconds at most) with every accepted step
 checked independently of the engine (tests/invariant_util.py: reference area with
@@ -76,7 +78,7 @@ def one_solid_case(seed, max_steps):
 
     params = random_solids.draw(seed, coarse=True)      # contact rows from the start: hundreds of tetrahedra
     record = {"seed": seed, "params": params}
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     scene = random_solids.scene(**params)
     reference = solid_to_arrays(scene.mesh)
     volume = math.fsum(tet_volumes(reference.points, reference.tets))
@@ -91,12 +93,15 @@ def one_solid_case(seed, max_steps):
                           ("inverted", tet_volumes(x, a.tets).min() <= 0), ("overlap", overlap > 1e-10 * volume)):
             if bad:
                 violations.append({"step": step.state.step, "check": name, "overlap": overlap})
+        # how far the case got, for a case stopped by the time limit (run_case)
+        print(json.dumps({"progress": {"steps": step.state.step, "x": step.state.x, "fragments": len(set(piece)),
+                                       "cpu_seconds": time.process_time() - c0}}), flush=True)
 
     result = nf.Simulation(scene, nf.StepControl(max_steps=max_steps), pictures="none").run(on_step=check)
     s = result.summary
     record.update(reason=result.reason, message=result.message, failure=s.get("failure"), steps=s["n_steps"],
                   tetrahedra=scene.mesh.ne, fragments=s["n_fragments"], seconds=time.perf_counter() - t0,
-                  violations=violations)
+                  cpu_seconds=time.process_time() - c0, violations=violations)
     return record
 
 
@@ -105,8 +110,10 @@ def run_case(seed, max_steps, timeout, solids=False):
     cmd = [sys.executable, __file__, "--one", str(seed), "--max-steps", str(max_steps)] + (["--solids"] if solids else [])
     try:
         proc = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
-    except subprocess.TimeoutExpired:
-        return {"seed": seed, "reason": "timeout", "seconds": timeout}
+    except subprocess.TimeoutExpired as stopped:
+        out = stopped.stdout.decode() if isinstance(stopped.stdout, bytes) else stopped.stdout or ""
+        progress = [json.loads(line)["progress"] for line in out.splitlines() if line.startswith('{"progress"')]
+        return {"seed": seed, "reason": "timeout", "seconds": timeout, "reached": progress[-1] if progress else None}
     if proc.returncode != 0:
         return {"seed": seed, "reason": "crashed", "message": proc.stderr.strip().splitlines()[-1:]}
     return json.loads(proc.stdout.strip().splitlines()[-1])

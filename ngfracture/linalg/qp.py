@@ -89,23 +89,16 @@ def convex_qp(H, c, A_eq, b_eq, A_in, b_in, tol=1e-12, max_steps=None, start=Non
     norm = np.maximum(np.linalg.norm(N, axis=0), 1e-300)
     sign = np.ones(len(b))              # equalities are entered from the side they miss
     x, active, u, Q, R = _warm_start(start, x, A, b, N, L, p)  # Q R: the active columns sign_j N[:, j]
+    u = np.asarray(u, dtype=float)
     # the data's size in the metric of H (the unconstrained minimiser's, the constraints' offsets)
     data = max(np.abs(b / norm).max(initial=0.0), np.linalg.norm(sla.solve_triangular(L, c, lower=True)))
     size = np.linalg.norm(L.T @ x)      # the iterate's
+    bounds = _bound_rows(A, b, p)
     max_steps = 10 * (n + len(b)) + 100 if max_steps is None else max_steps
     for _ in range(max_steps):
-        s = (A @ x - b) / norm          # signed misses, scaled to the metric of H
-        level = tol * max(data, size, 1e-300)
-        todo = [j for j in range(p) if j not in active]
-        if todo:
-            j_new = todo[0]
-            sign[j_new] = -1.0 if s[j_new] > 0 else 1.0
-        else:
-            miss = np.where(np.isin(np.arange(len(b)), active), np.inf, s)
-            miss[:p] = np.inf
-            j_new = int(np.argmin(miss)) if len(miss) else -1
-            if j_new < 0 or miss[j_new] >= -level:
-                break
+        j_new = _next_constraint(A, b, p, x, norm, active, sign, bounds, tol * max(data, size, 1e-300))
+        if j_new < 0:
+            break
         x, u, Q, R = _enter(j_new, sign[j_new] * N[:, j_new], sign[j_new] * (A[j_new] @ x - b[j_new]),
                             x, u, active, Q, R, L, p)
         size = np.linalg.norm(L.T @ x) if np.all(np.isfinite(x)) else np.inf
@@ -131,41 +124,88 @@ def _stacked(A_eq, b_eq, A_in, b_in, n):
 def _enter(j_new, n_new, miss_new, x, u, active, Q, R, L, p):
     """Dual steps until constraint ``j_new`` (its vector n_new in the metric of H, its miss)
     enters the working set, dropping the inequalities whose multipliers reach zero on the
-    way. ``active`` is changed in place; returns the new (x, u, Q, R).
+    way. ``active`` is changed in place; ``u`` holds the multipliers of ``active`` (an
+    array); returns the new (x, u, Q, R).
 
     Raises Infeasible if the constraint cannot hold together with the working set."""
     u_new = 0.0
     while True:
         if active:
             projection = Q.T @ n_new
-            r = sla.solve_triangular(R, projection)
+            r = sla.solve_triangular(R, projection, check_finite=False)
             w = n_new - Q @ projection
         else:
             r, w = np.zeros(0), n_new
-        # the largest dual step before an active inequality's multiplier reaches zero
+        # the largest dual step before an active inequality's multiplier reaches zero (the
+        # first of equal ratios, as a loop with a strict comparison takes it)
         t_dual, k_drop = np.inf, -1
-        for k, (j, uk, rk) in enumerate(zip(active, u, r)):
-            if j >= p and rk > 0 and uk / rk < t_dual:
-                t_dual, k_drop = uk / rk, k
+        droppable = (np.asarray(active, dtype=np.int64) >= p) & (r > 0)
+        if droppable.any():
+            ratio = np.full(len(r), np.inf)
+            ratio[droppable] = u[droppable] / r[droppable]
+            ratio[np.isnan(ratio)] = np.inf
+            k = int(np.argmin(ratio))
+            if ratio[k] < np.inf:
+                t_dual, k_drop = float(ratio[k]), k
         ww = float(w @ w)
         t_full = -miss_new / ww if ww > (1e-14 * np.linalg.norm(n_new)) ** 2 else np.inf
         t = min(t_dual, t_full)
         if not np.isfinite(t):
             raise Infeasible(f"constraint {j_new} cannot hold together with the working set")
         if np.isfinite(t_full):
-            x = x + t * sla.solve_triangular(L.T, w, lower=False)
+            x = x + t * sla.solve_triangular(L.T, w, lower=False, check_finite=False)
             miss_new += t * ww
-        u = [uk - t * rk for uk, rk in zip(u, r)]
+        u = u - t * r
         u_new += t
         if t == t_full:
             Q, R = _append_column(Q, R, n_new)
             active.append(j_new)
-            u.append(u_new)
-            return x, u, Q, R
+            return x, np.append(u, u_new), Q, R
         Q, R = sla.qr_delete(Q, R, k_drop, 1, which="col", check_finite=False)
-        del active[k_drop], u[k_drop]
+        del active[k_drop]
+        u = np.delete(u, k_drop)
 
 
+def _next_constraint(A, b, p, x, norm, active, sign, bounds, level):
+    """The constraint to enter next: the first equality not in the working set ``active``
+    (its ``sign`` set to the side it misses), else the inequality missed most in the
+    metric of H, if by more than ``level``; -1 for none (``bounds`` as
+    :func:`_bound_rows`)."""
+    in_set = np.zeros(len(b), dtype=bool)
+    in_set[active] = True
+    todo = np.flatnonzero(~in_set[:p])
+    if len(todo):
+        s = (A @ x - b) / norm          # signed misses, scaled to the metric of H
+        j_new = int(todo[0])
+        sign[j_new] = -1.0 if s[j_new] > 0 else 1.0
+        return j_new
+    miss = np.full(len(b), np.inf)
+    miss[p:] = _inequality_misses(A, b, p, x, bounds) / norm[p:]
+    miss[in_set] = np.inf
+    j_new = int(np.argmin(miss)) if len(miss) else -1
+    return -1 if j_new < 0 or miss[j_new] >= -level else j_new
+
+
+def _bound_rows(A, b, p):
+    """Where every inequality row of A (after the p equalities) is -e_i with b = 0 (the
+    bounds x_i <= 0 of :func:`bound_qp`): the i per row, else None."""
+    rows, offsets = A[p:], b[p:]
+    if not len(rows) or np.any(offsets != 0.0):
+        return None
+    at = np.argmin(rows, axis=1)
+    picked = rows[np.arange(len(rows)), at]
+    if np.any(picked != -1.0) or np.count_nonzero(rows) != len(rows):
+        return None
+    return at
+
+
+def _inequality_misses(A, b, p, x, bounds):
+    """A_in x - b_in, unscaled. For bound rows (``bounds``, from :func:`_bound_rows`) the
+    product is -x_i itself, which the dense product gives exactly (its other terms are
+    zeros) for a finite x: O(q) instead of O(q n) a step."""
+    if bounds is None or not np.all(np.isfinite(x)):
+        return A[p:] @ x - b[p:]
+    return -x[bounds] - b[p:]
 def _warm_start(start, x, A, b, N, L, p):
     """The minimiser x with the p equalities and the inequalities ``start`` holding, their
     multipliers u >= 0 for the inequalities, and the thin QR of their vectors in the
@@ -229,7 +269,9 @@ def bound_qp(H, c, A_eq, b_eq, bounded, tol=1e-12, max_sweeps=8):
     working set; a sweep that changes nothing is the solution. These sweeps need not end
     when H is no M-matrix (nearly dependent contact rows cycle), so after ``max_sweeps``
     the dual method starts from the guess with the fewest violations: finite, and a few
-    steps from a good guess.
+    steps from a good guess. Its answer is kept unless the minimiser on its working set
+    clearly contradicts that set (rounding in a nearly singular H can lead the dual steps
+    astray); then the sweeps go on from it.
 
     Parameters
     ----------
@@ -255,7 +297,8 @@ def bound_qp(H, c, A_eq, b_eq, bounded, tol=1e-12, max_sweeps=8):
     Raises
     ------
     numpy.linalg.LinAlgError, Infeasible, QPError
-        As :func:`convex_qp`.
+        As :func:`convex_qp`; QPError also when the dual method's working set is
+        contradicted and ``max_sweeps`` sweeps from it do not settle.
     """
     H = np.asarray(H, dtype=float)
     n = H.shape[0]
@@ -267,12 +310,40 @@ def bound_qp(H, c, A_eq, b_eq, bounded, tol=1e-12, max_sweeps=8):
         return BoundQP(*solved, sweeps, False)
     x, u_eq, u_in, held = convex_qp(H, c, E, e, -np.eye(n)[bounded], np.zeros(len(bounded)), tol=tol,
                                     start=start)
-    return BoundQP(x, u_eq, u_in, held, sweeps, True)
+    working = np.zeros(n, dtype=bool)
+    working[bounded[held]] = True
+    if not _contradicted(H, c, E, e, bounded, working):
+        return BoundQP(x, u_eq, u_in, held, sweeps, True)
+    # rounding in a nearly singular H (dependent contact rows) led the dual steps to a working
+    # set whose own minimiser breaks its conditions: the sweeps go on from that set
+    solved, _, more = _primal_dual_sweeps(H, c, E, e, bounded, tol, max_sweeps, held=working)
+    if solved is None:
+        raise QPError(f"bound_qp: the dual active-set method ended on a working set of {int(held.sum())} bounds "
+                      f"that its minimiser contradicts, and {more} sweeps from it did not settle")
+    return BoundQP(*solved, sweeps + more, True)
 
 
-def _primal_dual_sweeps(H, c, E, e, bounded, tol, max_sweeps):
-    """Primal-dual active-set sweeps for :func:`bound_qp`, from the bounds with c_i > 0
-    held (the sign of the unconstrained minimiser for a diagonal H).
+def _contradicted(H, c, E, e, bounded, held):
+    """Whether the minimiser on the working set ``held`` (bool per variable) breaks its
+    conditions clearly: a free bounded variable above 0 by more than 1e-6 of the largest,
+    a held one pulled by more than 1e-6 of the force scale, or dependent equalities. A
+    dual active-set answer passes this test up to the rounding of a nearly singular H; a
+    working set that rounding led astray does not (docs/solvers.md, "The contact QP")."""
+    x, u_eq = _minimiser_on(H, c, E, e, ~held)
+    if x is None:
+        return True
+    is_bound = np.zeros(len(c), dtype=bool)
+    is_bound[bounded] = True
+    u = c[held] + E[:, held].T @ u_eq - H[held] @ x
+    force = max(np.abs(c).max(initial=0.0), np.abs(H @ x).max(initial=0.0), 1e-300)
+    rises = ~held & is_bound & (x > 1e-6 * max(np.abs(x).max(initial=0.0), 1e-300))
+    return bool(rises.any() or (u < -1e-6 * force).any())
+
+
+def _primal_dual_sweeps(H, c, E, e, bounded, tol, max_sweeps, held=None):
+    """Primal-dual active-set sweeps for :func:`bound_qp`, from the bounds ``held`` (bool per
+    variable; default: those with c_i > 0, the sign of the unconstrained minimiser for a
+    diagonal H).
 
     Returns (solution, guess, sweeps): solution (x, u_eq, u_bound, held) if a sweep
     changed nothing, else None and guess, the positions in ``bounded`` held in the sweep
@@ -280,7 +351,7 @@ def _primal_dual_sweeps(H, c, E, e, bounded, tol, max_sweeps):
     n = len(c)
     is_bound = np.zeros(n, dtype=bool)
     is_bound[bounded] = True
-    held = is_bound & (c > 0)
+    held = is_bound & (c > 0) if held is None else held
     best, fewest, sweep = held, np.inf, 0
     for sweep in range(1, max_sweeps + 1):
         x, u_eq = _minimiser_on(H, c, E, e, ~held)
