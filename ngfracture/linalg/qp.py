@@ -269,9 +269,7 @@ def bound_qp(H, c, A_eq, b_eq, bounded, tol=1e-12, max_sweeps=8):
     working set; a sweep that changes nothing is the solution. These sweeps need not end
     when H is no M-matrix (nearly dependent contact rows cycle), so after ``max_sweeps``
     the dual method starts from the guess with the fewest violations: finite, and a few
-    steps from a good guess. Its answer is kept unless the minimiser on its working set
-    clearly contradicts that set (rounding in a nearly singular H can lead the dual steps
-    astray); then the sweeps go on from it.
+    steps from a good guess.
 
     Parameters
     ----------
@@ -297,8 +295,7 @@ def bound_qp(H, c, A_eq, b_eq, bounded, tol=1e-12, max_sweeps=8):
     Raises
     ------
     numpy.linalg.LinAlgError, Infeasible, QPError
-        As :func:`convex_qp`; QPError also when the dual method's working set is
-        contradicted and ``max_sweeps`` sweeps from it do not settle.
+        As :func:`convex_qp`.
     """
     H = np.asarray(H, dtype=float)
     n = H.shape[0]
@@ -310,40 +307,12 @@ def bound_qp(H, c, A_eq, b_eq, bounded, tol=1e-12, max_sweeps=8):
         return BoundQP(*solved, sweeps, False)
     x, u_eq, u_in, held = convex_qp(H, c, E, e, -np.eye(n)[bounded], np.zeros(len(bounded)), tol=tol,
                                     start=start)
-    working = np.zeros(n, dtype=bool)
-    working[bounded[held]] = True
-    if not _contradicted(H, c, E, e, bounded, working):
-        return BoundQP(x, u_eq, u_in, held, sweeps, True)
-    # rounding in a nearly singular H (dependent contact rows) led the dual steps to a working
-    # set whose own minimiser breaks its conditions: the sweeps go on from that set
-    solved, _, more = _primal_dual_sweeps(H, c, E, e, bounded, tol, max_sweeps, held=working)
-    if solved is None:
-        raise QPError(f"bound_qp: the dual active-set method ended on a working set of {int(held.sum())} bounds "
-                      f"that its minimiser contradicts, and {more} sweeps from it did not settle")
-    return BoundQP(*solved, sweeps + more, True)
+    return BoundQP(x, u_eq, u_in, held, sweeps, True)
 
 
-def _contradicted(H, c, E, e, bounded, held):
-    """Whether the minimiser on the working set ``held`` (bool per variable) breaks its
-    conditions clearly: a free bounded variable above 0 by more than 1e-6 of the largest,
-    a held one pulled by more than 1e-6 of the force scale, or dependent equalities. A
-    dual active-set answer passes this test up to the rounding of a nearly singular H; a
-    working set that rounding led astray does not (docs/solvers.md, "The contact QP")."""
-    x, u_eq = _minimiser_on(H, c, E, e, ~held)
-    if x is None:
-        return True
-    is_bound = np.zeros(len(c), dtype=bool)
-    is_bound[bounded] = True
-    u = c[held] + E[:, held].T @ u_eq - H[held] @ x
-    force = max(np.abs(c).max(initial=0.0), np.abs(H @ x).max(initial=0.0), 1e-300)
-    rises = ~held & is_bound & (x > 1e-6 * max(np.abs(x).max(initial=0.0), 1e-300))
-    return bool(rises.any() or (u < -1e-6 * force).any())
-
-
-def _primal_dual_sweeps(H, c, E, e, bounded, tol, max_sweeps, held=None):
-    """Primal-dual active-set sweeps for :func:`bound_qp`, from the bounds ``held`` (bool per
-    variable; default: those with c_i > 0, the sign of the unconstrained minimiser for a
-    diagonal H).
+def _primal_dual_sweeps(H, c, E, e, bounded, tol, max_sweeps):
+    """Primal-dual active-set sweeps for :func:`bound_qp`, from the bounds with c_i > 0
+    held (the sign of the unconstrained minimiser for a diagonal H).
 
     Returns (solution, guess, sweeps): solution (x, u_eq, u_bound, held) if a sweep
     changed nothing, else None and guess, the positions in ``bounded`` held in the sweep
@@ -351,7 +320,7 @@ def _primal_dual_sweeps(H, c, E, e, bounded, tol, max_sweeps, held=None):
     n = len(c)
     is_bound = np.zeros(n, dtype=bool)
     is_bound[bounded] = True
-    held = is_bound & (c > 0) if held is None else held
+    held = is_bound & (c > 0)
     best, fewest, sweep = held, np.inf, 0
     for sweep in range(1, max_sweeps + 1):
         x, u_eq = _minimiser_on(H, c, E, e, ~held)
