@@ -146,4 +146,3 @@ def test_sweeps_that_do_not_settle_are_finished_by_the_dual_method(seed):
     A_in, b_in = bounds_of(n, bounded)
     assert kuhn_tucker_error(H, c, A_eq, b_eq, A_in, b_in, answer.x, answer.u_eq, answer.u_bound) < 1e-10
     assert np.array_equal(answer.held, convex_qp(H, c, A_eq, b_eq, A_in, b_in)[3])
-

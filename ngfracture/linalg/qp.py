@@ -206,6 +206,8 @@ def _inequality_misses(A, b, p, x, bounds):
     if bounds is None or not np.all(np.isfinite(x)):
         return A[p:] @ x - b[p:]
     return -x[bounds] - b[p:]
+
+
 def _warm_start(start, x, A, b, N, L, p):
     """The minimiser x with the p equalities and the inequalities ``start`` holding, their
     multipliers u >= 0 for the inequalities, and the thin QR of their vectors in the
