@@ -2,7 +2,9 @@
 by numpy and math.fsum, inverted triangles by their deformed signed areas, and overlap
 between pieces by rasterising the deformed triangles on a grid (a point covered by two
 triangles is overlap; triangles sharing an edge cover its points once, as the grid is
-offset from every mesh coordinate by an irrational fraction of its step)."""
+offset from every mesh coordinate by an irrational fraction of its step). In 3D the same
+with volumes, and the overlap by exact intersections of the deformed tetrahedra of
+different pieces (``ngfracture.output.overlap3d``, which uses no contact code)."""
 import math
 
 import numpy as np
@@ -43,10 +45,11 @@ def raster_overlap(points, triangles, U, pixels=600):
     return float(np.count_nonzero(count > 1)) * step * step, step * step
 
 
-def pieces(triangles, nv):
-    """Connected components of triangles through shared vertices."""
-    t = np.asarray(triangles)
-    graph = coo_matrix((np.ones(2 * len(t)), (np.r_[t[:, 0], t[:, 1]], np.r_[t[:, 1], t[:, 2]])), shape=(nv, nv))
+def pieces(cells, nv):
+    """Connected components of the cells (triangles or tetrahedra) through shared vertices."""
+    t = np.asarray(cells)
+    rows, cols = t[:, :-1].ravel(), t[:, 1:].ravel()          # each cell's vertices chained
+    graph = coo_matrix((np.ones(len(rows)), (rows, cols)), shape=(nv, nv))
     return connected_components(graph, directed=False)[1]
 
 
@@ -60,4 +63,29 @@ def check_accepted(step, area_initial, pixels=600):
     overlap, pixel = raster_overlap(arrays.points, arrays.triangles, U, pixels)
     # a few pixels along an edge are rounding of the raster, not overlap
     assert overlap <= 4 * pixel, (step.state.step, overlap, pixel)
+    return overlap
+
+
+def signed_volumes(points, tets):
+    d = points[tets[:, 1:]] - points[tets[:, [0]]]
+    return np.einsum("ij,ij->i", d[:, 0], np.cross(d[:, 1], d[:, 2])) / 6.0
+
+
+def reference_volume(points, tets):
+    return math.fsum(signed_volumes(points, tets))
+
+
+def check_accepted_3d(step, volume_initial, tol=1e-10):
+    """Assert the invariants of a 3D ``AcceptedStep`` independently: the reference volume to
+    the last bit, no inverted tetrahedron, the overlap between pieces at most ``tol`` of the
+    volume; returns the overlap volume."""
+    from ngfracture.output.overlap3d import fragment_overlap_volume
+    arrays = step.state.arrays
+    nv = len(arrays.points)
+    x = arrays.points + np.asarray(step.state.u).reshape(3, -1)[:, :nv].T
+    assert reference_volume(arrays.points, arrays.tets) == volume_initial, step.state.step
+    assert signed_volumes(x, arrays.tets).min() > 0, step.state.step
+    piece = pieces(arrays.tets, nv)[arrays.tets[:, 0]]
+    overlap = fragment_overlap_volume(x, arrays.tets, piece, body_volume=volume_initial).volume
+    assert overlap <= tol * volume_initial, (step.state.step, overlap)
     return overlap

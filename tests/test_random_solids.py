@@ -11,10 +11,10 @@ contact code). ``benchmarks/random_scenes.py --solids`` runs many.
 import math
 import warnings
 
-import numpy as np
 import pytest
 
 import ngfracture as nf
+from invariant_util import reference_volume, signed_volumes
 from overlap3d_util import check_run_overlap
 from ngfracture.fracture.strain import vertex_displacement
 from ngfracture.geometry.solid import solid_to_arrays
@@ -25,23 +25,18 @@ from ngfracture.studies import random_solids
 ENDINGS = {"load_max", "broken", "max_steps"}
 
 
-def signed_volumes(points, tets):
-    d = points[tets[:, 1:]] - points[tets[:, [0]]]
-    return np.einsum("ij,ij->i", d[:, 0], np.cross(d[:, 1], d[:, 2])) / 6.0
-
-
 def run_checked(params, out, **changes):
     """Run a drawn scene (with ``changes`` to its parameters) into ``out``; per accepted step
     (volume difference, smallest deformed volume); the result."""
     scene = random_solids.scene(**{**params, **changes})
     a = solid_to_arrays(scene.mesh)
-    volume = math.fsum(signed_volumes(a.points, a.tets))
+    volume = reference_volume(a.points, a.tets)
     steps = []
 
     def on_step(accepted):
         b = accepted.problem.arrays
         U = vertex_displacement(accepted.problem.u)
-        steps.append((math.fsum(signed_volumes(b.points, b.tets)) - volume,
+        steps.append((reference_volume(b.points, b.tets) - volume,
                       signed_volumes(b.points + U, b.tets).min()))
 
     with warnings.catch_warnings():
