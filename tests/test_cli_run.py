@@ -21,7 +21,7 @@ OPTIONS = ["--maxh", "--steps", "--load-max", "--out", "--force", "--resume", "-
            "--quiet", "--set", "--max-new-cracks", "--method", "--tol", "--maxit", "--cut", "--grow",
            "--grow-after", "--dx-min", "--dx-max", "--max-retries", "--split", "--checkpoint-every",
            "--threads", "--progress"]
-#: what summary.json holds at least (the README's Outputs table)
+#: what summary.json holds at least (docs/design.md, "Outputs")
 SUMMARY_KEYS = ["scene", "parameters", "n_steps", "n_split_vertices", "crack_length", "n_fragments",
                 "fragment_areas", "area_initial", "area_final", "max_overlap_area", "energy",
                 "newton_iterations", "timings"]
