@@ -146,3 +146,31 @@ def test_sweeps_that_do_not_settle_are_finished_by_the_dual_method(seed):
     A_in, b_in = bounds_of(n, bounded)
     assert kuhn_tucker_error(H, c, A_eq, b_eq, A_in, b_in, answer.x, answer.u_eq, answer.u_bound) < 1e-10
     assert np.array_equal(answer.held, convex_qp(H, c, A_eq, b_eq, A_in, b_in)[3])
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_a_guess_that_releases_every_row_of_free_pieces_is_mended(seed):
+    """Many free pieces (three equalities each, as a 2D piece's rigid modes) with their own
+    rows, H = S + G G^T as the contact dual's; every row of a third of the pieces has
+    c_i > 0, so the sweeps' first guess holds all of them and those pieces' equalities are
+    dependent on the free variables. The guess is mended and the answer is the Kuhn-Tucker
+    point to rounding (sqrt(n) eps cond(H)) with the cold dual method's working set."""
+    rng = np.random.default_rng(400 + seed)
+    pieces, rows = 30, 6
+    n = pieces * rows
+    A_eq = np.zeros((3 * pieces, n))
+    for j in range(pieces):
+        A_eq[3 * j:3 * j + 3, rows * j:rows * (j + 1)] = rng.standard_normal((3, rows))
+    B = rng.standard_normal((n, n)) / np.sqrt(n)
+    H = B @ B.T + A_eq.T @ A_eq + 1e-2 * np.eye(n)
+    c = rng.standard_normal(n)
+    c[:rows * pieces // 3] = np.abs(c[:rows * pieces // 3])     # the released pieces
+    b_eq = A_eq @ -np.abs(rng.standard_normal(n))               # feasible with x <= 0
+    bounded = np.arange(n)
+    answer = bound_qp(H, c, A_eq, b_eq, bounded)
+    A_in, b_in = bounds_of(n, bounded)
+    rounding = np.sqrt(n) * np.finfo(float).eps * np.linalg.cond(H)
+    assert kuhn_tucker_error(H, c, A_eq, b_eq, A_in, b_in, answer.x, answer.u_eq, answer.u_bound) < rounding
+    cold = convex_qp(H, c, A_eq, b_eq, A_in, b_in)
+    assert np.array_equal(answer.held, cold[3])
+    assert np.abs(answer.x - cold[0]).max() < rounding * np.abs(cold[0]).max()

@@ -162,6 +162,7 @@ def _enter(j_new, n_new, miss_new, x, u, active, Q, R, L, p):
             active.append(j_new)
             return x, np.append(u, u_new), Q, R
         Q, R = sla.qr_delete(Q, R, k_drop, 1, which="col", check_finite=False)
+        Q, R = Q[:, :R.shape[1]], R[:R.shape[1]]    # thin again after a full (n columns) set
         del active[k_drop]
         u = np.delete(u, k_drop)
 
@@ -271,7 +272,9 @@ def bound_qp(H, c, A_eq, b_eq, bounded, tol=1e-12, max_sweeps=8):
     working set; a sweep that changes nothing is the solution. These sweeps need not end
     when H is no M-matrix (nearly dependent contact rows cycle), so after ``max_sweeps``
     the dual method starts from the guess with the fewest violations: finite, and a few
-    steps from a good guess.
+    steps from a good guess. A guess that holds every row of a free piece is mended
+    (:func:`_spanning`); if the dual method stops with QPError from the best guess, it
+    starts again from the best guess before the first mending.
 
     Parameters
     ----------
@@ -304,28 +307,42 @@ def bound_qp(H, c, A_eq, b_eq, bounded, tol=1e-12, max_sweeps=8):
     c = np.asarray(c, dtype=float)
     E, e = np.asarray(A_eq, dtype=float).reshape(-1, n), np.asarray(b_eq, dtype=float).ravel()
     bounded = np.asarray(bounded, dtype=int).ravel()
-    solved, start, sweeps = _primal_dual_sweeps(H, c, E, e, bounded, tol, max_sweeps)
+    solved, starts, sweeps = _primal_dual_sweeps(H, c, E, e, bounded, tol, max_sweeps)
     if solved is not None:
         return BoundQP(*solved, sweeps, False)
-    x, u_eq, u_in, held = convex_qp(H, c, E, e, -np.eye(n)[bounded], np.zeros(len(bounded)), tol=tol,
-                                    start=start)
-    return BoundQP(x, u_eq, u_in, held, sweeps, True)
+    for k, start in enumerate(starts):
+        try:
+            x, u_eq, u_in, held = convex_qp(H, c, E, e, -np.eye(n)[bounded], np.zeros(len(bounded)), tol=tol,
+                                            start=start)
+        except QPError:                  # rounding led the steps astray: the other start, if any
+            if k == len(starts) - 1:
+                raise
+            continue
+        return BoundQP(x, u_eq, u_in, held, sweeps, True)
 
 
 def _primal_dual_sweeps(H, c, E, e, bounded, tol, max_sweeps):
     """Primal-dual active-set sweeps for :func:`bound_qp`, from the bounds with c_i > 0
     held (the sign of the unconstrained minimiser for a diagonal H).
 
-    Returns (solution, guess, sweeps): solution (x, u_eq, u_bound, held) if a sweep
-    changed nothing, else None and guess, the positions in ``bounded`` held in the sweep
-    with the fewest violations."""
+    A guess whose equalities are dependent on its free variables (its held bounds take
+    every row of a free piece) is mended by :func:`_spanning` and the sweeps go on.
+
+    Returns (solution, guesses, sweeps): solution (x, u_eq, u_bound, held) if a sweep
+    changed nothing, else None and guesses, each the positions in ``bounded`` held in a
+    sweep with the fewest violations: the one of all sweeps first, then, if a guess was
+    mended, the one before the first mending (the dual method's start without mending)."""
     n = len(c)
     is_bound = np.zeros(n, dtype=bool)
     is_bound[bounded] = True
     held = is_bound & (c > 0)
-    best, fewest, sweep = held, np.inf, 0
+    best, fewest, sweep, unmended = held, np.inf, 0, None
     for sweep in range(1, max_sweeps + 1):
         x, u_eq = _minimiser_on(H, c, E, e, ~held)
+        if x is None:                    # a piece's equalities dependent on the free rows
+            unmended = best if unmended is None else unmended
+            held = _spanning(E, held)
+            x, u_eq = _minimiser_on(H, c, E, e, ~held)
         if x is None:
             break
         u = np.zeros(n)                  # H x - c = E^T u_eq - u on the held bounds
@@ -341,7 +358,8 @@ def _primal_dual_sweeps(H, c, E, e, bounded, tol, max_sweeps):
         if violations < fewest:
             best, fewest = held, violations
         held = (held & ~pulls) | rises
-    return None, np.flatnonzero(best[bounded]), sweep
+    guesses = [best] + ([unmended] if unmended is not None and not np.array_equal(unmended, best) else [])
+    return None, [np.flatnonzero(g[bounded]) for g in guesses], sweep
 
 
 def _minimiser_on(H, c, E, e, free):
@@ -361,3 +379,22 @@ def _minimiser_on(H, c, E, e, free):
     u_eq = np.linalg.solve(coupling, e - Ef @ Z[:, 0])
     x[free] = Z[:, 0] + Z[:, 1:] @ u_eq
     return x, u_eq
+
+
+def _spanning(E, held):
+    """``held`` with the fewest bounds freed that make the equalities E independent on the
+    free variables (E full row rank): the held columns that add most to the span of the
+    free ones, by a pivoted QR of their parts outside it. A guess whose held bounds
+    take every row of a free piece leaves that piece's equalities without a column."""
+    free = ~held
+    U, s, _ = np.linalg.svd(E[:, free], full_matrices=False)
+    rank = int(np.count_nonzero(s > 1e-8 * max(s.max(initial=0.0), 1e-300)))
+    candidates = np.flatnonzero(held)
+    missing = E.shape[0] - rank
+    if missing <= 0 or not len(candidates):
+        return held
+    outside = E[:, candidates] - U[:, :rank] @ (U[:, :rank].T @ E[:, candidates])
+    _, _, order = sla.qr(outside, mode="economic", pivoting=True, check_finite=False)
+    held = held.copy()
+    held[candidates[order[:missing]]] = False
+    return held
