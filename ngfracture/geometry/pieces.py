@@ -20,15 +20,13 @@ follow in the order of their tetrahedra.
 """
 import numpy as np
 
-from .solid import SolidArrays
+from .solid import OUTWARD_FACES, SolidArrays
 from .structured import box_mesh
 
 __all__ = ["separate_pieces", "fragmented_box"]
 
 #: vertex numbers up to this bound keep a face's key (three numbers) within int64
 MAX_VERTICES = 2**21
-#: the faces of a positively oriented tetrahedron (0, 1, 2, 3), each oriented out of it
-OUTWARD_FACES = np.array([[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]])
 
 
 def _face_keys(tri, nv):

@@ -24,11 +24,15 @@ import netgen.meshing as nm
 import ngsolve as ng
 import numpy as np
 
-__all__ = ["SolidArrays", "solid_to_arrays", "solid_mesh", "tet_volumes", "total_volume", "is_solid", "crack_area",
-           "merge_bodies", "nodal_areas"]
+__all__ = ["SolidArrays", "solid_to_arrays", "outward_faces", "solid_mesh", "tet_volumes", "total_volume", "is_solid",
+           "crack_area", "merge_bodies", "nodal_areas"]
 
 #: from this many tetrahedra NGSolve builds a mesh's topology in its task manager
 PARALLEL_MIN_TETS = 20000
+
+#: the faces of a positively oriented tetrahedron (local vertex numbers), each with
+#: (x1-x0) x (x2-x0) pointing out of it
+OUTWARD_FACES = np.array([[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]])
 
 
 @dataclass
@@ -168,14 +172,69 @@ def solid_to_arrays(mesh):
     nfd = int(faces["index"].max()) if len(faces) else 0
     fd_bc = np.array([0] + [ngmesh.FaceDescriptor(i).bc for i in range(1, nfd + 1)], dtype=np.int64)
     bc_names = [ngmesh.GetBCName(i) for i in range(int(fd_bc.max(initial=0)))]
+    tets = nodes[:, [0, 1, 3, 2]].astype(np.int64) - 1
     return SolidArrays(
         points=ngmesh.Coordinates()[:, :3].copy(),
-        tets=nodes[:, [0, 1, 3, 2]].astype(np.int64) - 1,
+        tets=tets,
         regions=els["index"].astype(np.int64),
         region_names=[ngmesh.GetMaterial(i) for i in range(1, nregions + 1)],
-        faces=fnodes[:, :3].astype(np.int64) - 1,
+        faces=outward_faces(tets, fnodes[:, :3].astype(np.int64) - 1),
         face_bc=fd_bc[faces["index"]],
         bc_names=bc_names)
+
+
+def outward_faces(tets, faces):
+    """``faces`` with every face of exactly one tetrahedron turned out of it.
+
+    netgen orients a surface element from its face descriptor's inner to its outer domain:
+    out of the body on the faces of the solid it was cut from, into the body on the faces
+    of a solid subtracted from it (the notch of ``scenes.notched_bar_mesh``). The outward
+    order follows from the tetrahedron's (positive) orientation alone: no coordinates, no
+    rounding. A face between two tetrahedra (an interface of two regions) keeps its order.
+
+    Parameters
+    ----------
+    tets : numpy.ndarray of int, shape (ne, 4)
+        Positively oriented tetrahedra.
+    faces : numpy.ndarray of int, shape (nf, 3)
+        Triangles on faces of the tetrahedra.
+
+    Returns
+    -------
+    numpy.ndarray of int64, shape (nf, 3)
+        The faces, those in the order of the other orientation with their last two
+        vertices swapped.
+
+    Raises
+    ------
+    ValueError
+        If a face is no face of any tetrahedron.
+    """
+    tets = np.asarray(tets, dtype=np.int64).reshape(-1, 4)
+    faces = np.asarray(faces, dtype=np.int64).reshape(-1, 3)
+    own = tets[:, OUTWARD_FACES].reshape(-1, 3)
+    tri = np.sort(np.vstack([own, faces]), axis=1)
+    nv = int(tri.max(initial=-1)) + 1
+    if nv < 2**21:
+        # one integer per vertex set (three numbers below 2**21 fit in an int64): a 1-D unique
+        _, inverse = np.unique((tri[:, 0] * nv + tri[:, 1]) * nv + tri[:, 2], return_inverse=True)
+    else:
+        _, inverse = np.unique(tri, axis=0, return_inverse=True)
+    inverse = inverse.ravel()
+    # per face, its tetrahedron's own order where exactly one tetrahedron has it
+    tets_at = np.bincount(inverse[:len(own)], minlength=int(inverse.max(initial=-1)) + 1)
+    at = np.full(len(tets_at), -1, dtype=np.int64)
+    at[inverse[:len(own)]] = np.arange(len(own))
+    count = tets_at[inverse[len(own):]]
+    if np.any(count == 0):
+        raise ValueError(f"faces: face {int(np.argmin(count))} is no face of any tetrahedron")
+    one = np.flatnonzero(count == 1)
+    mine = own[at[inverse[len(own) + one]]]
+    f = faces[one]
+    same = ((mine == f).all(axis=1) | (mine == f[:, [1, 2, 0]]).all(axis=1) | (mine == f[:, [2, 0, 1]]).all(axis=1))
+    out = faces.copy()
+    out[one[~same]] = f[~same][:, [0, 2, 1]]
+    return out
 
 
 def _check_arrays(a):
