@@ -25,16 +25,14 @@ import pytest
 import ngfracture as nf
 from invariant_util import check_accepted_3d, pieces, reference_volume
 from ngfracture.contact.collision3d import detect_penetrations_3d, orient3d
-from ngfracture.geometry.solid import solid_to_arrays
-
-#: the faces of a positively oriented tetrahedron, each pointing out of it, face k opposite vertex k
-FACES = np.array([[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]])
+from ngfracture.geometry.solid import OUTWARD_FACES, solid_to_arrays
 
 
 def behind(arrays):
-    """orient3d of every boundary face with the fourth vertex of its tetrahedron (+1: behind the face)."""
+    """orient3d of every boundary face with the fourth vertex of its tetrahedron (+1: behind
+    the face); OUTWARD_FACES only finds that vertex (face k is opposite vertex k)."""
     T, F = arrays.tets, arrays.faces
-    own = T[:, FACES].reshape(-1, 3)
+    own = T[:, OUTWARD_FACES].reshape(-1, 3)
     opposite = T.reshape(-1)
     where = {tuple(sorted(f)): i for i, f in enumerate(own.tolist())}
     at = np.array([where[tuple(sorted(f))] for f in F.tolist()])

@@ -20,19 +20,13 @@ follow in the order of their tetrahedra.
 """
 import numpy as np
 
-from .solid import OUTWARD_FACES, SolidArrays
+from .solid import OUTWARD_FACES, SolidArrays, face_keys
 from .structured import box_mesh
 
 __all__ = ["separate_pieces", "fragmented_box"]
 
 #: vertex numbers up to this bound keep a face's key (three numbers) within int64
 MAX_VERTICES = 2**21
-
-
-def _face_keys(tri, nv):
-    """One integer per face, equal for faces of the same three vertices."""
-    s = np.sort(tri, axis=1).astype(np.int64)
-    return (s[:, 0] * nv + s[:, 1]) * nv + s[:, 2]
 
 
 def separate_pieces(arrays, piece, crack="crack"):
@@ -78,7 +72,7 @@ def separate_pieces(arrays, piece, crack="crack"):
     # every face of every tetrahedron, outward; a face of one tetrahedron only is a boundary face
     tri = tets[:, OUTWARD_FACES].reshape(-1, 3)
     old = T[:, OUTWARD_FACES].reshape(-1, 3)
-    new_keys, old_keys = _face_keys(tri, len(parent)), _face_keys(old, nv)
+    new_keys, old_keys = face_keys(tri, len(parent)), face_keys(old, nv)
     _, new_inv, new_count = np.unique(new_keys, return_inverse=True, return_counts=True)
     _, old_inv, old_count = np.unique(old_keys, return_inverse=True, return_counts=True)
     if old_count.size and old_count.max() > 2:
@@ -92,7 +86,7 @@ def separate_pieces(arrays, piece, crack="crack"):
     outer = np.flatnonzero(single & ~inner)
     F = np.asarray(arrays.faces, dtype=np.int64).reshape(-1, 3)
     order = np.argsort(old_keys[outer], kind="stable")
-    wanted = _face_keys(F, nv)
+    wanted = face_keys(F, nv)
     at = np.searchsorted(old_keys[outer][order], wanted)
     if len(F) != len(outer) or (len(F) and np.any(old_keys[outer][order][np.minimum(at, len(outer) - 1)] != wanted)):
         raise ValueError(f"separate_pieces: the input's {len(F)} faces are not its {len(outer)} boundary faces")

@@ -24,7 +24,7 @@ import netgen.meshing as nm
 import ngsolve as ng
 import numpy as np
 
-__all__ = ["SolidArrays", "solid_to_arrays", "outward_faces", "solid_mesh", "tet_volumes", "total_volume", "is_solid",
+__all__ = ["SolidArrays", "solid_to_arrays", "outward_faces", "face_keys", "solid_mesh", "tet_volumes", "total_volume", "is_solid",
            "crack_area", "merge_bodies", "nodal_areas"]
 
 #: from this many tetrahedra NGSolve builds a mesh's topology in its task manager
@@ -213,13 +213,8 @@ def outward_faces(tets, faces):
     tets = np.asarray(tets, dtype=np.int64).reshape(-1, 4)
     faces = np.asarray(faces, dtype=np.int64).reshape(-1, 3)
     own = tets[:, OUTWARD_FACES].reshape(-1, 3)
-    tri = np.sort(np.vstack([own, faces]), axis=1)
-    nv = int(tri.max(initial=-1)) + 1
-    if nv < 2**21:
-        # one integer per vertex set (three numbers below 2**21 fit in an int64): a 1-D unique
-        _, inverse = np.unique((tri[:, 0] * nv + tri[:, 1]) * nv + tri[:, 2], return_inverse=True)
-    else:
-        _, inverse = np.unique(tri, axis=0, return_inverse=True)
+    tri = np.vstack([own, faces])
+    _, inverse = np.unique(face_keys(tri, int(tri.max(initial=-1)) + 1), return_inverse=True)
     inverse = inverse.ravel()
     # per face, its tetrahedron's own order where exactly one tetrahedron has it
     tets_at = np.bincount(inverse[:len(own)], minlength=int(inverse.max(initial=-1)) + 1)
@@ -235,6 +230,27 @@ def outward_faces(tets, faces):
     out = faces.copy()
     out[one[~same]] = f[~same][:, [0, 2, 1]]
     return out
+
+
+def face_keys(faces, nv):
+    """One key per face, equal for faces on the same three vertices (of ``nv``).
+
+    Parameters
+    ----------
+    faces : array_like of int, shape (nf, 3)
+    nv : int
+        A bound of the vertex numbers.
+
+    Returns
+    -------
+    numpy.ndarray, shape (nf,)
+        int64 while nv^3 fits in it (nv < 2**21), else a structured record of the sorted
+        three numbers; either sorts and compares as the vertex sets.
+    """
+    f = np.sort(np.asarray(faces, dtype=np.int64).reshape(-1, 3), axis=1)
+    if nv < 2**21:
+        return (f[:, 0] * nv + f[:, 1]) * nv + f[:, 2]
+    return np.ascontiguousarray(f).view([("a", np.int64), ("b", np.int64), ("c", np.int64)]).ravel()
 
 
 def _check_arrays(a):

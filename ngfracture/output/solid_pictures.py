@@ -27,6 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..geometry.solid import face_keys
 from .atomic import write_bytes
 from .pictures import FRAGMENT_COLOURS, SUPERSAMPLING, RenderError, picture_pixels
 from .solid_vtk import solid_arrays, solid_displacement
@@ -44,14 +45,6 @@ _LIGHT = np.array([-0.2, 0.45, 0.87])
 
 #: colour factor of crack faces (a darker tone of the fragment's colour)
 _CRACK_TONE = 0.6
-
-
-def _face_keys(faces, nv):
-    """One integer (or row) per face, equal for faces on the same three vertices."""
-    f = np.sort(np.asarray(faces, dtype=np.int64), axis=1)
-    if nv < 2 ** 21:     # nv^3 < 2^63
-        return (f[:, 0] * nv + f[:, 1]) * nv + f[:, 2]
-    return np.ascontiguousarray(f).view([("a", np.int64), ("b", np.int64), ("c", np.int64)]).ravel()
 
 
 def surface_faces(tets, nv, on_boundary=None):
@@ -85,7 +78,7 @@ def surface_faces(tets, nv, on_boundary=None):
     if on_boundary is not None:
         keep = on_boundary[faces].all(axis=1)
         faces, owner = faces[keep], owner[keep]
-    _, inverse, counts = np.unique(_face_keys(faces, nv), return_inverse=True, return_counts=True)
+    _, inverse, counts = np.unique(face_keys(faces, nv), return_inverse=True, return_counts=True)
     once = counts[inverse.ravel()] == 1
     return faces[once], owner[once]
 
@@ -130,7 +123,7 @@ def _base_colours(a, faces, owner, fragment, crack_boundary):
     crack = a.boundary_faces(crack_boundary)
     if len(crack):
         nv = len(a.points)
-        base[np.isin(_face_keys(faces, nv), _face_keys(crack, nv))] *= _CRACK_TONE
+        base[np.isin(face_keys(faces, nv), face_keys(crack, nv))] *= _CRACK_TONE
     return base
 
 
