@@ -41,7 +41,11 @@ Candidates, each identified by its key ("f", slave, master vertices sorted; "e",
   vertex found in its own fragment, through the lip row of its pair of copies. A found
   row stays a candidate while it is active or found again, as in 2D, and once the
   complementarity problem chooses the set, while it has been wanted or imposed in the
-  solve (a row the problem released must stay visible to the next problem). Found the
+  solve (a row the problem released must stay visible to the next problem); but a found
+  row whose slave the detection no longer finds in the master's fragment and which lies
+  beyond the edges of its face by more than ``penetration_tol`` leaves the candidates,
+  active or not (:meth:`ActiveSet3d._beyond_face`: it holds the slave on the face's plane
+  where the master's surface has turned away). Found the
   same way, from the planes at copies of a point: a copy behind the plane of a partner
   face at its copy, the ends of a junction edge inside the wedge of a diagonal
   neighbour's copy of it, and the ends of an edge copy behind a face of another copy's
@@ -86,7 +90,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from .active_set import ActiveSet, Candidates, RowKeys, refreshed
-from .clipped3d import node_edge_rows, unseen_pairs
+from .clipped3d import beyond_face, node_edge_rows, unseen_pairs
 from .copies3d import (behind_partner_rows, folded_rows_at_copies, found_rows_at_copies, rows_at_copies_of,
                        two_sided_rows)
 from .edge_rows3d import EdgeRows, edge_rows, no_edge_rows, relinearise_edge_rows
@@ -246,6 +250,7 @@ class ActiveSet3d(ActiveSet):
         found, found_codes = self._with_rows_at_copies(found, found_codes, U, pen)
         n2s_codes = self.n2s_keys.codes
         retained = self._retained(n2s_codes, found_codes)
+        retained = retained[~self._beyond_face(retained, found_codes, U, pen)]
         new = np.flatnonzero(~isin_ints(found_codes, np.concatenate([n2s_codes, self.seam_keys.codes])))
         self.n2s = NodeToFaceRows.stack([self.n2s.subset(retained), found.subset(new)])
         self.n2s_keys = RowKeys(np.concatenate([n2s_codes[retained], found_codes[new]]), self.codec)
@@ -276,6 +281,29 @@ class ActiveSet3d(ActiveSet):
             # penetration that releasing it lets happen
             retain |= isin_ints(codes, union_ints(self.tried, self.wanted))
         return np.flatnonzero(retain)
+
+    def _beyond_face(self, retained, found_codes, U, pen):
+        """Which found rows ``retained`` (indices into the found rows of the last update) no
+        longer hold their slave against the master: not found again (``found_codes``), the
+        slave not detected in the master's fragment at X + U (``pen``), and beyond the edges
+        of its face by more than ``penetration_tol``
+        (:func:`~ngfracture.contact.clipped3d.beyond_face`). Such a row holds the slave on
+        the face's plane where the master's surface has turned away; active, it pins the
+        slave against nothing (docs/contact.md, "Rows beyond their face")."""
+        a, setup = self.geometry.arrays, self.setup
+        nv = len(a.points)
+        stale = ~isin_ints(self.n2s_keys.codes[retained], found_codes)
+        if not stale.any():
+            return stale
+        inside = np.asarray(pen.fragment, dtype=np.int64) * nv + np.asarray(pen.vertex, dtype=np.int64)
+        slave, master = self.n2s.slave[retained], self.n2s.master[retained, 0]
+        stale &= ~isin_ints(setup.vertex_fragment[master].astype(np.int64) * nv + slave, inside)
+        if not stale.any():
+            return stale
+        at = np.flatnonzero(stale)
+        rows = self.n2s.subset(retained[at])
+        stale[at] = beyond_face(a.points, rows, U, setup.copy_index.point) > self.penetration_tol
+        return stale
 
     def _key_codes(self, keys):
         """The codes of keys given as tuples (:meth:`FaceKeys.codes_of`)."""

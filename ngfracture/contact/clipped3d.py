@@ -192,3 +192,53 @@ def node_edge_rows(points, faces, pen, pick, displacement):
     g = (n * (X[v] - Xp)).sum(1)
     return EdgeRows(a, b, st, n, dist, g, nv=nv)
 
+
+
+def beyond_face(points, rows, displacement, point):
+    """How far each node-to-face row's slave lies beyond the edges of its master face at X + U.
+
+    A row reads the slave's distance to its face's plane. Where the slave's foot on that
+    plane lies outside the triangle the plane is not the master's surface: beyond a convex
+    edge the master's surface turns away from it, and a slave held on the plane there is
+    held against nothing of the master. The length returned is |t|, t the part in the
+    face's plane of x_s - q, q the foot with its negative barycentrics set to 0 and the
+    rest rescaled (the re-linearisation's clipping, :func:`~ngfracture.contact.rows3d.relinearise_node_to_face`):
+    0 up to rounding where the foot is inside. Rows at a copy of their slave (a corner of
+    the face with the slave's reference point) get 0: they are held at the copy by design.
+
+    Parameters
+    ----------
+    points, displacement : numpy.ndarray, shape (nv, 3)
+        Reference coordinates X and displacements U.
+    rows : ngfracture.contact.rows3d.NodeToFaceRows
+        The rows.
+    point : numpy.ndarray of int, shape (nv,)
+        The point id of each vertex (:class:`~ngfracture.contact.kinks3d.CopyIndex`,
+        ``point``; equal ids for copies, -1 for a vertex without copies).
+
+    Returns
+    -------
+    numpy.ndarray, shape (len(rows),)
+    """
+    if len(rows) == 0:
+        return np.zeros(0)
+    x = np.asarray(points) + np.asarray(displacement)
+    tri = x[rows.master]
+    e1, e2 = tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]
+    n = np.cross(e1, e2)
+    area2 = np.einsum("ij,ij->i", n, n)
+    ok = area2 > 0.0
+    d = x[rows.slave] - tri[:, 0]
+    # barycentrics of the foot (Cramer's rule in the face's plane)
+    c1 = np.einsum("ij,ij->i", np.cross(d, e2), n) / np.where(ok, area2, 1.0)
+    c2 = np.einsum("ij,ij->i", np.cross(e1, d), n) / np.where(ok, area2, 1.0)
+    b = np.maximum(np.stack([1.0 - c1 - c2, c1, c2], axis=1), 0.0)
+    b /= b.sum(axis=1, keepdims=True)
+    t = x[rows.slave] - np.einsum("ij,ijk->ik", b, tri)
+    unit = n / np.sqrt(np.where(ok, area2, 1.0))[:, None]
+    t -= np.einsum("ij,ij->i", t, unit)[:, None] * unit
+    out = np.where(ok, np.linalg.norm(t, axis=1), 0.0)
+    pid = np.asarray(point)
+    at_copy = ((pid[rows.master] == pid[rows.slave][:, None]) & (pid[rows.slave][:, None] >= 0)).any(axis=1)
+    out[at_copy] = 0.0
+    return out
