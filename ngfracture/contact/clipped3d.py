@@ -193,7 +193,6 @@ def node_edge_rows(points, faces, pen, pick, displacement):
     return EdgeRows(a, b, st, n, dist, g, nv=nv)
 
 
-
 def beyond_face(points, rows, displacement, point):
     """How far each node-to-face row's slave lies beyond the edges of its master face at X + U.
 
