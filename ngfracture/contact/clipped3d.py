@@ -63,8 +63,9 @@ import numpy as np
 from .edge_rows3d import EdgeRows, no_edge_rows
 from .intsets import isin_ints
 from .rows import take_rows
+from .rows3d import relinearise_node_to_face
 
-__all__ = ["unseen_pairs", "node_edge_rows"]
+__all__ = ["unseen_pairs", "node_edge_rows", "beyond_face"]
 
 
 def _row_values(rows, x):
@@ -200,10 +201,11 @@ def beyond_face(points, rows, displacement, point):
     plane lies outside the triangle the plane is not the master's surface: beyond a convex
     edge the master's surface turns away from it, and a slave held on the plane there is
     held against nothing of the master. The length returned is |t|, t the part in the
-    face's plane of x_s - q, q the foot with its negative barycentrics set to 0 and the
-    rest rescaled (the re-linearisation's clipping, :func:`~ngfracture.contact.rows3d.relinearise_node_to_face`):
-    0 up to rounding where the foot is inside. Rows at a copy of their slave (a corner of
-    the face with the slave's reference point) get 0: they are held at the copy by design.
+    face's plane of x_s - q, q the foot clipped to the triangle as the rows are
+    re-linearised (:func:`~ngfracture.contact.rows3d.relinearise_node_to_face`: negative
+    barycentrics set to 0 and the rest rescaled): 0 up to rounding where the foot is inside.
+    Rows at a copy of their slave (a corner of the face with the slave's reference point)
+    get 0: they are held at the copy by design.
 
     Parameters
     ----------
@@ -221,22 +223,12 @@ def beyond_face(points, rows, displacement, point):
     """
     if len(rows) == 0:
         return np.zeros(0)
+    # the clipped foot and the face's normal at X + U, as the rows are re-linearised
+    fresh = relinearise_node_to_face(rows, points, displacement)
     x = np.asarray(points) + np.asarray(displacement)
-    tri = x[rows.master]
-    e1, e2 = tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]
-    n = np.cross(e1, e2)
-    area2 = np.einsum("ij,ij->i", n, n)
-    ok = area2 > 0.0
-    d = x[rows.slave] - tri[:, 0]
-    # barycentrics of the foot (Cramer's rule in the face's plane)
-    c1 = np.einsum("ij,ij->i", np.cross(d, e2), n) / np.where(ok, area2, 1.0)
-    c2 = np.einsum("ij,ij->i", np.cross(e1, d), n) / np.where(ok, area2, 1.0)
-    b = np.maximum(np.stack([1.0 - c1 - c2, c1, c2], axis=1), 0.0)
-    b /= b.sum(axis=1, keepdims=True)
-    t = x[rows.slave] - np.einsum("ij,ijk->ik", b, tri)
-    unit = n / np.sqrt(np.where(ok, area2, 1.0))[:, None]
-    t -= np.einsum("ij,ij->i", t, unit)[:, None] * unit
-    out = np.where(ok, np.linalg.norm(t, axis=1), 0.0)
+    t = x[rows.slave] - np.einsum("ij,ijk->ik", fresh.bary, x[rows.master])
+    t -= np.einsum("ij,ij->i", t, fresh.normal)[:, None] * fresh.normal
+    out = np.linalg.norm(t, axis=1)
     pid = np.asarray(point)
     at_copy = ((pid[rows.master] == pid[rows.slave][:, None]) & (pid[rows.slave][:, None] >= 0)).any(axis=1)
     out[at_copy] = 0.0
