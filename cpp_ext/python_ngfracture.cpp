@@ -17,6 +17,7 @@ void ExportOverlap3d (py::module & m);  // python_overlap3d.cpp
 void ExportSetup3d (py::module & m);  // python_setup3d.cpp
 void ExportEdges3d (py::module & m);  // python_edges3d.cpp
 void ExportCopies3d (py::module & m);  // python_copies3d.cpp
+void ExportQp (py::module & m);  // python_qp.cpp
 
 using Doubles = py::array_t<double, py::array::c_style | py::array::forcecast>;
 using Ints = py::array_t<int, py::array::c_style | py::array::forcecast>;
@@ -333,4 +334,5 @@ PYBIND11_MODULE(_ngfracture, m)
   ExportSetup3d(m);
   ExportEdges3d(m);
   ExportCopies3d(m);
+  ExportQp(m);
 }

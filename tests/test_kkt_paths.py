@@ -175,7 +175,7 @@ def test_sparse_schur_complement_and_complementarity_equal_the_columns(contact_s
             whole = factor.schur(rows.C)
             assert solves == [rows.C.shape[0] - half]
             assert np.abs(again - whole[:half, :half]).max() <= 1e-14 * np.abs(whole).max()
-    (S0, (du0, lam0, act0)), (S1, (du1, lam1, act1)) = solved[False], solved[True]
+    (S0, (du0, lam0, act0, _)), (S1, (du1, lam1, act1, _)) = solved[False], solved[True]
     assert np.abs(S1 - S0).max() <= 1e-13 * np.abs(S0).max()
     assert np.array_equal(act0, act1)
     assert np.linalg.norm(lam1 - lam0) <= 1e-10 * np.linalg.norm(lam0)

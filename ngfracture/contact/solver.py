@@ -345,7 +345,7 @@ class ContactSolver:
         offset = self._contact_offset()
         options = {k: v for k, v in self.options.items() if k != "load_steps"}
         try:
-            _, closed = NewtonSolver(prob, tangent=tangent, **options).unilateral_multipliers(
+            _, closed, fallback = NewtonSolver(prob, tangent=tangent, **options).unilateral_multipliers(
                 np.arange(offset, offset + len(candidates)))
         except (SingularSystem, QPError, np.linalg.LinAlgError, ValueError) as exc:
             # recorded: the set then comes from the primal-dual update, not the exact solution
@@ -356,6 +356,8 @@ class ContactSolver:
             prob.constraints.clear_rows(LABEL)
             result.timings["solve"] += time.perf_counter() - t0
         result.lcp += 1
+        if fallback:
+            result.notes.append(f"complementarity problem of {len(candidates)} candidate rows: {fallback}")
         return candidates[closed[offset:offset + len(candidates)]]
 
     def _newton(self, result, tangent, increment_scale=None):

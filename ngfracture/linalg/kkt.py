@@ -361,6 +361,9 @@ class ConstrainedSolver:
             The rows that hold with equality, C_i du = h_i: the equalities and the unilateral
             rows that are not released. A closed row may carry no force (lam_i = 0): it
             touches, and still fixes the position of a piece that no force holds.
+        fallback : str
+            Empty, or why the QP's updated factorisation gave way to the QR of its working
+            set (:attr:`ngfracture.linalg.qp.BoundQP.fallback`): for the caller's record.
 
         Raises
         ------
@@ -372,7 +375,7 @@ class ConstrainedSolver:
 
         q, du = self._unconstrained(r, du_fixed)
         if not self.m:
-            return du, np.zeros(0), np.zeros(0, dtype=bool)
+            return du, np.zeros(0), np.zeros(0, dtype=bool), ""
         bounded = np.zeros(self.m, dtype=bool)
         bounded[unilateral] = True
         b = self.C @ du - h
@@ -393,7 +396,7 @@ class ConstrainedSolver:
         lam = d * y
         du -= self._correction(lam)
         du += self._R @ (gscale * alpha)
-        return du, lam, ~released
+        return du, lam, ~released, answer.fallback
 
 
 def _chosen_path(path, factor, m, dependent_rows):

@@ -345,6 +345,8 @@ class NewtonSolver:
             Multipliers of the assembled general rows (0 for released unilateral rows).
         closed : numpy.ndarray of bool
             The rows that hold with equality (see ConstrainedSolver.solve_unilateral).
+        fallback : str
+            Empty, or why the QP solver fell back (see ConstrainedSolver.solve_unilateral).
 
         Raises
         ------
@@ -369,9 +371,9 @@ class NewtonSolver:
         du_fixed = np.zeros(u.size)
         du_fixed[rows.fixed_dofs] = rows.fixed_values - u[rows.fixed_dofs]
         with prob.threads():
-            _, lam, closed = kkt.solve_unilateral(self._out_of_balance(), du_fixed, rows.g - rows.C @ u,
+            _, lam, closed, fallback = kkt.solve_unilateral(self._out_of_balance(), du_fixed, rows.g - rows.C @ u,
                                                   unilateral)
-        return lam[:m], closed[:m]
+        return lam[:m], closed[:m], fallback
 
     def _out_of_balance(self):
         """The out-of-balance force, taken from the saved tangent if u is where it was left."""

@@ -1,0 +1,124 @@
+"""The dual active-set method on sign bounds with the free block's Cholesky factor updated
+(C++ BoundDualActiveSet behind bound_qp): the same working sets as the QR form of
+convex_qp, the same Kuhn-Tucker point, and a recorded fallback when rounding stops it."""
+import numpy as np
+import pytest
+
+from ngfracture import _ngfracture as ext
+from ngfracture.linalg import qp as qp_module
+from ngfracture.linalg.qp import GROWTH_LIMIT, Infeasible, bound_qp, convex_qp
+from test_qp import bounds_of, kuhn_tucker_error
+
+
+def contact_like(seed, n, p):
+    """An SPD H with dense mixed-sign coupling (no M-matrix), p equalities as free modes."""
+    rng = np.random.default_rng(seed)
+    B = rng.standard_normal((n, n)) / np.sqrt(n)
+    H, c = B @ B.T + 1e-2 * np.eye(n), rng.standard_normal(n)
+    return H, c, rng.standard_normal((p, n)), rng.standard_normal(p), rng
+
+
+def bound_dual(H, c, E, e, bounded, held):
+    """BoundDualActiveSet from the start ``held`` (bool per variable), its data as bound_qp
+    prepares them."""
+    n = len(c)
+    inverse = np.linalg.inv(np.linalg.cholesky(H))
+    norm = np.linalg.norm(inverse, axis=0)
+    data = np.max(np.abs(e) / np.linalg.norm(inverse @ E.T, axis=0), initial=np.linalg.norm(inverse @ c))
+    is_bound = np.zeros(n, dtype=np.int8)
+    is_bound[bounded] = 1
+    free = np.flatnonzero(~held)
+    L0 = np.linalg.cholesky(H[np.ix_(free, free)])
+    return ext.BoundDualActiveSet(H, c, E, e, is_bound, norm, held.astype(np.int8), L0, 1e-12, data,
+                                  GROWTH_LIMIT, 10 * n + 100)
+
+
+@pytest.mark.parametrize("seed,p", [(0, 0), (1, 6), (2, 6), (3, 9)])
+def test_updated_factor_walks_the_working_sets_of_the_qr_method(seed, p, monkeypatch):
+    """From a start that holds every bound (most of them wrongly) and from a random half:
+    the start's negative multipliers are freed, then bounds enter and leave (the rank-one
+    update of a removed row and column, the appended row of a freed variable). The answer
+    is convex_qp's from the same start: as many bounds entered, the same working set, x to
+    rounding (sqrt(n) eps cond(H)), Kuhn-Tucker to 1e-10."""
+    n = 300
+    H, c, E, e, rng = contact_like(500 + seed, n, p)
+    bounded = np.sort(rng.choice(n, n - 10, replace=False))
+    A_in, b_in = bounds_of(n, bounded)
+    entered = []
+    enter = qp_module._enter
+    monkeypatch.setattr(qp_module, "_enter", lambda *a: entered.append(1) or enter(*a))
+    rounding = np.sqrt(n) * np.finfo(float).eps * np.linalg.cond(H)
+    for start in (np.arange(len(bounded)), np.sort(rng.choice(len(bounded), len(bounded) // 2, replace=False))):
+        held = np.zeros(n, dtype=bool)
+        held[bounded[start]] = True
+        x, mu, u, held_out, steps, dropped, status, reason = bound_dual(H, c, E, e, bounded, held)
+        assert status == 0 and reason == ""
+        assert steps > 10 and dropped > 0
+        entered.clear()
+        ref = convex_qp(H, c, E, e, A_in, b_in, start=start)
+        assert steps == len(entered)
+        assert np.array_equal(held_out[bounded].astype(bool), ref[3])
+        assert np.abs(x - ref[0]).max() <= rounding * np.abs(ref[0]).max()
+        assert kuhn_tucker_error(H, c, E, e, A_in, b_in, x, mu, u[bounded]) < 1e-10
+
+
+def test_a_start_that_leaves_the_equalities_dependent_is_mended():
+    """20 equalities and 10 unbounded variables, c > 0: the guess (the bounds with c_i > 0
+    held, no sweep) holds every bound and leaves the equalities dependent on the free
+    variables. bound_qp frees bounds to span them and ends at the cold QR method's point
+    with its working set, without a fallback."""
+    n = 300
+    H, c, E, e, rng = contact_like(800, n, 20)
+    c = np.abs(c)
+    bounded = np.sort(rng.choice(n, n - 10, replace=False))
+    answer = bound_qp(H, c, E, e, bounded, max_sweeps=0)
+    assert answer.dual_steps and answer.fallback == ""
+    cold = convex_qp(H, c, E, e, *bounds_of(n, bounded))
+    assert np.array_equal(answer.held, cold[3])
+    assert kuhn_tucker_error(H, c, E, e, *bounds_of(n, bounded), answer.x, answer.u_eq, answer.u_bound) < 1e-10
+
+
+def test_bound_qp_takes_the_updated_factor_and_records_no_fallback():
+    """Two sweeps (fewer than the problem needs): the dual method finishes from the sweeps'
+    guess through the updated factor, with no fallback, at the cold QR method's point."""
+    n = 400
+    H, c, E, e, _ = contact_like(600, n, 6)
+    bounded = np.arange(n)
+    answer = bound_qp(H, c, E, e, bounded, max_sweeps=2)
+    assert answer.dual_steps and answer.fallback == ""
+    cold = convex_qp(H, c, E, e, *bounds_of(n, bounded))
+    assert np.array_equal(answer.held, cold[3])
+    assert kuhn_tucker_error(H, c, E, e, *bounds_of(n, bounded), answer.x, answer.u_eq, answer.u_bound) < 1e-10
+
+
+def test_a_failure_of_the_updated_factor_is_recorded_and_the_qr_method_answers(monkeypatch):
+    """When rounding stops the updated factor (here forced), bound_qp answers by the QR
+    method from the same start and says why in ``fallback``."""
+    n = 200
+    H, c, E, e, _ = contact_like(700, n, 3)
+    monkeypatch.setattr(qp_module._ext, "BoundDualActiveSet",
+                        lambda *a: (None, None, None, None, 0, 0, 2, "H lost definiteness to rounding"))
+    answer = bound_qp(H, c, E, e, np.arange(n), max_sweeps=1)
+    assert answer.dual_steps and "H lost definiteness to rounding" in answer.fallback
+    cold = convex_qp(H, c, E, e, *bounds_of(n, np.arange(n)))
+    assert np.array_equal(answer.held, cold[3])
+
+
+def test_bounds_that_contradict_the_equalities_are_infeasible():
+    """x_i <= 0 for all i and x_0 + x_1 + x_2 = 1 have no common point."""
+    H = np.diag([1.0, 2.0, 3.0]) + 0.1
+    with pytest.raises(Infeasible):
+        bound_qp(H, np.array([1.0, -1.0, 0.5]), np.ones((1, 3)), np.ones(1), np.arange(3), max_sweeps=1)
+
+
+def test_the_binding_names_a_wrong_shape():
+    n = 4
+    H = np.eye(n)
+    args = dict(H=H, c=np.zeros(n), E=np.zeros((1, n)), e=np.zeros(1), bounded=np.ones(n, np.int8),
+                norm=np.ones(n), held=np.zeros(n, np.int8), L0=np.eye(n), tol=1e-12, data=1.0,
+                growth_limit=1e8, max_steps=100)
+    with pytest.raises(ValueError, match="L0 must be f x f"):
+        ext.BoundDualActiveSet(**{**args, "L0": np.eye(n - 1)})
+    with pytest.raises(ValueError, match="held variable is not bounded"):
+        ext.BoundDualActiveSet(**{**args, "bounded": np.zeros(n, np.int8), "held": np.ones(n, np.int8),
+                                  "L0": np.zeros((0, 0))})
