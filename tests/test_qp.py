@@ -121,7 +121,7 @@ def test_primal_dual_sweeps_alone_solve_an_m_matrix_problem():
     H = 2.1 * np.eye(n) - np.eye(n, k=1) - np.eye(n, k=-1)
     c = np.sin(np.linspace(0.0, 25.0, n)) + 0.2
     bounded = np.arange(n)
-    answer = bound_qp(H, c, np.zeros((0, n)), np.zeros(0), bounded, max_sweeps=n + 1)
+    answer = bound_qp(H, c, np.zeros((0, n)), np.zeros(0), bounded, max_sweeps=n + 1, stop_early=False)
     assert not answer.dual_steps and answer.sweeps > 1
     A_in, b_in = bounds_of(n, bounded)
     assert kuhn_tucker_error(H, c, np.zeros((0, n)), np.zeros(0), A_in, b_in, answer.x, answer.u_eq,

@@ -122,3 +122,20 @@ def test_the_binding_names_a_wrong_shape():
     with pytest.raises(ValueError, match="held variable is not bounded"):
         ext.BoundDualActiveSet(**{**args, "bounded": np.zeros(n, np.int8), "held": np.ones(n, np.int8),
                                   "L0": np.zeros((0, 0))})
+
+
+def test_sweeps_stop_once_the_dual_steps_are_cheaper():
+    """An M-matrix problem whose sweeps converge by themselves (tests/test_qp.py): with
+    ``stop_early`` they stop once fewer bounds are violated than a third of the free
+    variables, and the dual method ends at the same Kuhn-Tucker point with the same held
+    bounds as the sweeps alone."""
+    n = 800
+    H = 2.1 * np.eye(n) - np.eye(n, k=1) - np.eye(n, k=-1)
+    c = np.sin(np.linspace(0.0, 25.0, n)) + 0.2
+    bounded, none = np.arange(n), np.zeros((0, n))
+    alone = bound_qp(H, c, none, np.zeros(0), bounded, max_sweeps=n + 1, stop_early=False)
+    early = bound_qp(H, c, none, np.zeros(0), bounded, max_sweeps=n + 1)
+    assert not alone.dual_steps and early.dual_steps and early.sweeps < alone.sweeps
+    assert early.fallback == ""
+    assert np.array_equal(early.held, alone.held)
+    assert np.abs(early.x - alone.x).max() <= 1e-12 * np.abs(alone.x).max()

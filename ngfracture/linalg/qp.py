@@ -265,7 +265,7 @@ class BoundQP(NamedTuple):
     fallback: str = ""      #: why the updated free-block factor gave way to convex_qp's QR, if it did
 
 
-def bound_qp(H, c, A_eq, b_eq, bounded, tol=1e-12, max_sweeps=8):
+def bound_qp(H, c, A_eq, b_eq, bounded, tol=1e-12, max_sweeps=8, stop_early=True):
     """minimise 1/2 x^T H x - c^T x  subject to  A_eq x = b_eq,  x_i <= 0 for i in ``bounded``.
 
     The contact dual has this form (sign bounds on the multipliers, a few equalities for
@@ -276,9 +276,10 @@ def bound_qp(H, c, A_eq, b_eq, bounded, tol=1e-12, max_sweeps=8):
     Optim. 13, 2003: the minimiser on the free variables, then hold the bounded ones that
     came out positive and free the held ones whose multiplier came out negative) guess the
     working set; a sweep that changes nothing is the solution. These sweeps need not end
-    when H is no M-matrix (nearly dependent contact rows cycle), so after ``max_sweeps``
-    the dual method starts from the guess with the fewest violations: finite, and a few
-    steps from a good guess. A guess that holds every row of a free piece is mended
+    when H is no M-matrix (nearly dependent contact rows cycle), so after ``max_sweeps``,
+    or as soon as fewer bounds are violated than a third of the free variables (a sweep's
+    factorisation costs about that many dual steps), the dual method starts from the guess
+    with the fewest violations: finite, and a few steps from a good guess. A guess that holds every row of a free piece is mended
     (:func:`_spanning`); if the dual method stops with QPError from the best guess, it
     starts again from the best guess before the first mending.
 
@@ -297,6 +298,9 @@ def bound_qp(H, c, A_eq, b_eq, bounded, tol=1e-12, max_sweeps=8):
         rounding, as the dual method keeps them); for the dual method as in
         :func:`convex_qp`.
     max_sweeps : int
+    stop_early : bool
+        Stop the sweeps as soon as fewer bounds are violated than a third of the free
+        variables; False: sweep until a solution or ``max_sweeps``.
 
     Returns
     -------
@@ -313,7 +317,7 @@ def bound_qp(H, c, A_eq, b_eq, bounded, tol=1e-12, max_sweeps=8):
     c = np.asarray(c, dtype=float)
     E, e = np.asarray(A_eq, dtype=float).reshape(-1, n), np.asarray(b_eq, dtype=float).ravel()
     bounded = np.asarray(bounded, dtype=int).ravel()
-    solved, starts, sweeps = _primal_dual_sweeps(H, c, E, e, bounded, tol, max_sweeps)
+    solved, starts, sweeps = _primal_dual_sweeps(H, c, E, e, bounded, tol, max_sweeps, stop_early)
     if solved is not None:
         return BoundQP(*solved, sweeps, False)
     fallback = ""
@@ -380,12 +384,14 @@ def _dual_steps_on_bounds(H, c, E, e, bounded, start, tol):
     return x, u_eq, u[bounded], held[bounded].astype(bool)
 
 
-def _primal_dual_sweeps(H, c, E, e, bounded, tol, max_sweeps):
+def _primal_dual_sweeps(H, c, E, e, bounded, tol, max_sweeps, stop_early):
     """Primal-dual active-set sweeps for :func:`bound_qp`, from the bounds with c_i > 0
     held (the sign of the unconstrained minimiser for a diagonal H).
 
     A guess whose equalities are dependent on its free variables (its held bounds take
-    every row of a free piece) is mended by :func:`_spanning` and the sweeps go on.
+    every row of a free piece) is mended by :func:`_spanning` and the sweeps go on. They
+    stop after ``max_sweeps`` or, with ``stop_early``, when fewer bounds are violated than
+    a third of the free variables.
 
     Returns (solution, guesses, sweeps): solution (x, u_eq, u_bound, held) if a sweep
     changed nothing, else None and guesses, each the positions in ``bounded`` held in a
@@ -416,6 +422,8 @@ def _primal_dual_sweeps(H, c, E, e, bounded, tol, max_sweeps):
             return (x, u_eq, u[bounded], held[bounded]), None, sweep
         if violations < fewest:
             best, fewest = held, violations
+        if stop_early and violations < np.count_nonzero(~held) / 3:
+            break       # a sweep's factorisation costs about f/3 dual steps: they finish cheaper
         held = (held & ~pulls) | rises
     guesses = [best] + ([unmended] if unmended is not None and not np.array_equal(unmended, best) else [])
     return None, [np.flatnonzero(g[bounded]) for g in guesses], sweep
