@@ -9,8 +9,9 @@ import pytest
 from conftest import child_env
 
 ROOT = Path(__file__).resolve().parent.parent
-BENCHMARKS = ["contact", "contact_qp", "contact3d", "contact3d_cracking", "crack", "edges3d", "ensemble", "linear3d", "lshape",
-              "meshcheck", "objectivity", "random_scenes", "scenes", "schur", "sphere3d", "solid"]
+BENCHMARKS = ["contact", "contact_qp", "contact3d", "contact3d_cracking", "crack", "edges3d", "ensemble",
+              "linear3d", "lshape", "meshcheck", "objectivity", "random_scenes", "scenes", "schur",
+              "sphere3d", "solid"]
 
 
 def run_benchmark(name, *args):

@@ -279,9 +279,12 @@ def bound_qp(H, c, A_eq, b_eq, bounded, tol=1e-12, max_sweeps=8, stop_early=True
     when H is no M-matrix (nearly dependent contact rows cycle), so after ``max_sweeps``,
     or as soon as fewer bounds are violated than a third of the free variables (a sweep's
     factorisation costs about that many dual steps), the dual method starts from the guess
-    with the fewest violations: finite, and a few steps from a good guess. A guess that holds every row of a free piece is mended
-    (:func:`_spanning`); if the dual method stops with QPError from the best guess, it
-    starts again from the best guess before the first mending.
+    with the fewest violations: finite, and a few steps from a good guess. Its steps update
+    the Cholesky factor of the free block (:func:`_dual_steps_on_bounds`); if rounding
+    stops them, :func:`convex_qp` takes the same start and ``fallback`` says why. A guess
+    that holds every row of a free piece is mended (:func:`_spanning`); if the dual method
+    stops with QPError from the best guess, it starts again from the best guess before the
+    first mending.
 
     Parameters
     ----------
@@ -366,6 +369,7 @@ def _dual_steps_on_bounds(H, c, E, e, bounded, start, tol):
     data = np.linalg.norm(inverse @ c)
     if len(e):
         data = max(data, np.max(np.abs(e) / np.maximum(np.linalg.norm(inverse @ E.T, axis=0), 1e-300)))
+    del L, inverse                       # n x n each: not kept beside the C++ copies of H
     is_bound = np.zeros(n, dtype=np.int8)
     is_bound[bounded] = 1
     held = np.zeros(n, dtype=bool)

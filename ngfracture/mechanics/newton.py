@@ -371,8 +371,8 @@ class NewtonSolver:
         du_fixed = np.zeros(u.size)
         du_fixed[rows.fixed_dofs] = rows.fixed_values - u[rows.fixed_dofs]
         with prob.threads():
-            _, lam, closed, fallback = kkt.solve_unilateral(self._out_of_balance(), du_fixed, rows.g - rows.C @ u,
-                                                  unilateral)
+            _, lam, closed, fallback = kkt.solve_unilateral(self._out_of_balance(), du_fixed,
+                                                            rows.g - rows.C @ u, unilateral)
         return lam[:m], closed[:m], fallback
 
     def _out_of_balance(self):
