@@ -36,21 +36,23 @@ namespace ngfracture
       SlotMatrix (const BoundQpData & qp, const std::vector<int8_t> & held)
         : n_(qp.n), H_(size_t(qp.n) * qp.n), slot_(qp.n), var_(qp.n)
       {
+        int next = 0;
         for (int pass = 0; pass < 2; pass++)
+        {
           for (int i = 0; i < n_; i++)
             if (bool(held[i]) == bool(pass))
             {
-              slot_[i] = free_ + held_;
-              var_[free_ + held_] = i;
-              (pass ? held_ : free_)++;
+              slot_[i] = next;
+              var_[next++] = i;
             }
+          free_ = pass == 0 ? next : free_;
+        }
         for (int a = 0; a < n_; a++)
           for (int b = 0; b < n_; b++)
             H_[size_t(a) * n_ + b] = qp.H[size_t(var_[a]) * n_ + var_[b]];
       }
 
       int Slot (int i) const { return slot_[i]; }
-      int Free () const { return free_; }
       const double * Row (int i) const { return &H_[size_t(slot_[i]) * n_]; }
 
       void Hold (int i) { Swap(slot_[i], free_ - 1); free_--; }
@@ -69,7 +71,7 @@ namespace ngfracture
         slot_[var_[b]] = b;
       }
 
-      int n_, free_ = 0, held_ = 0;
+      int n_, free_ = 0;
       std::vector<double> H_;
       std::vector<int> slot_, var_;
     };
@@ -196,20 +198,15 @@ namespace ngfracture
       {
         int f = Size();
         std::fill(R_.begin(), R_.end(), 0.0);
+        std::vector<double> coefficients(p_);
         double largest = 0.0;
         for (int q = 0; q < p_; q++)
         {
           double * v = &Q_[size_t(q) * n_];
           std::copy(&Wiq(0, q), &Wiq(f, q), v);
-          for (int pass = 0; pass < 2; pass++)
-            for (int s = 0; s < q; s++)
-            {
-              const double * u = &Q_[size_t(s) * n_];
-              double d = Dot(u, v, f);
-              R_[size_t(s) * p_ + q] += d;
-              for (int r = 0; r < f; r++)
-                v[r] -= d * u[r];
-            }
+          ProjectOff(v, q, coefficients.data());
+          for (int s = 0; s < q; s++)
+            R_[size_t(s) * p_ + q] = coefficients[s];
           double size = std::sqrt(Dot(v, v, f));
           largest = std::max(largest, size);
           if (!(size > 1e-10 * largest))
@@ -221,27 +218,11 @@ namespace ngfracture
         return true;
       }
 
-      // y minus its projection on the range of W, in place; the coefficients z (R mu = z)
+      // y minus its projection on the range of W, in place, and mu with W mu that projection
       void Project (double * y, double * mu) const
       {
-        int f = Size();
-        std::vector<double> z(p_, 0.0);
-        for (int pass = 0; pass < 2; pass++)
-          for (int q = 0; q < p_; q++)
-          {
-            const double * u = &Q_[size_t(q) * n_];
-            double d = Dot(u, y, f);
-            z[q] += d;
-            for (int r = 0; r < f; r++)
-              y[r] -= d * u[r];
-          }
-        for (int q = p_ - 1; q >= 0; q--)   // R mu = z
-        {
-          double s = z[q];
-          for (int t = q + 1; t < p_; t++)
-            s -= R_[size_t(q) * p_ + t] * mu[t];
-          mu[q] = s / R_[size_t(q) * p_ + q];
-        }
+        ProjectOff(y, p_, mu);          // the coefficients z = Q^T y, then R mu = z
+        SolveR(mu);
       }
 
       // W^T b
@@ -261,13 +242,7 @@ namespace ngfracture
             s -= R_[size_t(t) * p_ + q] * b[t];
           b[q] = s / R_[size_t(q) * p_ + q];
         }
-        for (int q = p_ - 1; q >= 0; q--)
-        {
-          double s = b[q];
-          for (int t = q + 1; t < p_; t++)
-            s -= R_[size_t(q) * p_ + t] * b[t];
-          b[q] = s / R_[size_t(q) * p_ + q];
-        }
+        SolveR(b);
       }
 
       // W mu added to b
@@ -279,6 +254,35 @@ namespace ngfracture
       }
 
     private:
+      // v minus its projection on Q's first ``columns`` columns (Gram-Schmidt twice), in
+      // place; the coefficients Q^T v of the original v
+      void ProjectOff (double * v, int columns, double * coefficients) const
+      {
+        int f = Size();
+        std::fill(coefficients, coefficients + columns, 0.0);
+        for (int pass = 0; pass < 2; pass++)
+          for (int q = 0; q < columns; q++)
+          {
+            const double * u = &Q_[size_t(q) * n_];
+            double d = Dot(u, v, f);
+            coefficients[q] += d;
+            for (int r = 0; r < f; r++)
+              v[r] -= d * u[r];
+          }
+      }
+
+      // R x = b in place (R upper triangular)
+      void SolveR (double * b) const
+      {
+        for (int q = p_ - 1; q >= 0; q--)
+        {
+          double s = b[q];
+          for (int t = q + 1; t < p_; t++)
+            s -= R_[size_t(q) * p_ + t] * b[t];
+          b[q] = s / R_[size_t(q) * p_ + q];
+        }
+      }
+
       double & Lij (int i, int j) { return L_[size_t(j) * n_ + i]; }
       double & Wiq (int i, int q) { return W_[size_t(q) * n_ + i]; }
 
@@ -388,10 +392,11 @@ namespace ngfracture
       return std::sqrt(std::max(v, 0.0));
     }
 
-    // the free bound missed most in the metric of H, if by more than the level; -1 for none
-    int NextBound (const BoundQpData & qp, const DualState & s)
+    // the free bound missed most in the metric of H, if by more than the level (relative
+    // to the data and the iterate's size |x|_H); -1 for none
+    int NextBound (const BoundQpData & qp, const DualState & s, double size)
     {
-      double level = qp.level * std::max({ qp.data, SizeInH(qp, s), 1e-300 });
+      double level = qp.level * std::max({ qp.data, size, 1e-300 });
       int best = -1;
       double most = level;
       for (int i = 0; i < qp.n; i++)
@@ -503,9 +508,10 @@ namespace ngfracture
     {
       SlotMatrix slots(qp, s.held);
       answer.reason = "no solution in " + std::to_string(qp.max_steps) + " steps";
+      double size = SizeInH(qp, s);
       for (int step = 0; step < qp.max_steps; step++)
       {
-        int j = NextBound(qp, s);
+        int j = NextBound(qp, s, size);
         if (j < 0)
         {
           answer.status = BoundDualStatus::solved;
@@ -519,7 +525,8 @@ namespace ngfracture
           answer.status = entered;
           break;
         }
-        if (!(SizeInH(qp, s) <= qp.growth_limit * std::max(qp.data, 1e-300)))
+        size = SizeInH(qp, s);
+        if (!(size <= qp.growth_limit * std::max(qp.data, 1e-300)))
         {
           answer.reason = "the iterate grew beyond the growth limit (H nearly singular)";
           break;
