@@ -104,6 +104,25 @@ def test_a_failure_of_the_updated_factor_is_recorded_and_the_qr_method_answers(m
     assert np.array_equal(answer.held, cold[3])
 
 
+def test_an_answer_that_is_not_finite_is_a_recorded_fallback(monkeypatch):
+    """A solved status with a NaN in x is no answer: bound_qp falls back to the QR method
+    and says so, instead of returning the NaN."""
+    n = 200
+    H, c, E, e, _ = contact_like(900, n, 3)
+    solve = qp_module._ext.BoundDualActiveSet
+
+    def with_nan(*args):
+        x, mu, u, held, entered, dropped, status, reason = solve(*args)
+        x[0] = np.nan
+        return x, mu, u, held, entered, dropped, status, reason
+
+    monkeypatch.setattr(qp_module._ext, "BoundDualActiveSet", with_nan)
+    answer = bound_qp(H, c, E, e, np.arange(n), max_sweeps=1)
+    assert "not finite" in answer.fallback and np.all(np.isfinite(answer.x))
+    cold = convex_qp(H, c, E, e, *bounds_of(n, np.arange(n)))
+    assert np.array_equal(answer.held, cold[3])
+
+
 def test_bounds_that_contradict_the_equalities_are_infeasible():
     """x_i <= 0 for all i and x_0 + x_1 + x_2 = 1 have no common point."""
     H = np.diag([1.0, 2.0, 3.0]) + 0.1

@@ -328,9 +328,9 @@ def bound_qp(H, c, A_eq, b_eq, bounded, tol=1e-12, max_sweeps=8, stop_early=True
         try:
             try:
                 x, u_eq, u_in, held = _dual_steps_on_bounds(H, c, E, e, bounded, start, tol)
+            except Infeasible:
+                raise
             except QPError as err:      # rounding in the updated factor: the QR of the working set
-                if isinstance(err, Infeasible):
-                    raise
                 fallback = f"{fallback}; {err}" if fallback else str(err)
                 x, u_eq, u_in, held = convex_qp(H, c, E, e, -np.eye(n)[bounded], np.zeros(len(bounded)),
                                                 tol=tol, start=start)
@@ -358,7 +358,8 @@ def _dual_steps_on_bounds(H, c, E, e, bounded, start, tol):
         If the bounds and the equalities have no common point.
     QPError
         If rounding stops the method (a free block that is no longer positive definite,
-        equalities dependent on the free variables of the start, the step limit, growth).
+        equalities dependent on the free variables of the start, the step limit, growth,
+        an answer that is not finite).
     """
     n = len(c)
     L = sla.cholesky(H, lower=True)
@@ -385,6 +386,8 @@ def _dual_steps_on_bounds(H, c, E, e, bounded, start, tol):
         raise Infeasible(f"bound_qp: {reason}")
     if status != 0:
         raise QPError(f"bound_qp: {reason}")
+    if not (np.all(np.isfinite(x)) and np.all(np.isfinite(u_eq)) and np.all(np.isfinite(u))):
+        raise QPError("bound_qp: the dual steps ended on a value that is not finite")
     return x, u_eq, u[bounded], held[bounded].astype(bool)
 
 
