@@ -90,6 +90,45 @@ def test_a_cycle_makes_every_wanted_row_a_candidate():
     assert settled and np.array_equal(np.sort(chosen), np.sort(B))
 
 
+def test_a_warm_solve_asks_the_complementarity_problem_from_its_second_round():
+    """A solve from the rows of the solve before (``warm``): with ``warm_exact`` the
+    second round's set is the complementarity problem's, and its candidates hold a row
+    wanted in the first round that was neither imposed (dropped, as a row dependent on the
+    others is) nor wanted now: released rows it depended on would let it sink unseen
+    (the default sphere: 1e-4 deep). Without ``warm_exact`` the primal-dual update
+    chooses the second round's set."""
+    geometry, U = overlapping_geometry()
+    cold = ActiveSet3d(geometry, 1e-12)
+    cand = cold.update(U, {"collision": 0.0})
+    _, kept, _ = cold.primal_dual(cand)
+    warm = [cand.keys[i] for i in kept.tolist()]
+    for warm_exact in (False, True):
+        active = ActiveSet3d(geometry, 1e-12, warm=warm, warm_exact=warm_exact)
+        assert active.pdas_rounds == (1 if warm_exact else 6)
+        cand = active.update(U, {"collision": 0.0})
+        want, kept, _ = active.primal_dual(cand)
+        codes = cand.keys.codes
+        dropped = kept[-1]                       # wanted in round 1, not imposed
+        imposed, settled = active.choose(cand, want, kept[:-1], 1, lambda rows, idx: None)
+        assert not settled and not active.exact
+        active.record(cand.keys, imposed, -np.ones(len(imposed)), 1.0)
+        cand = active.update(U, {"collision": 0.0})
+        calls = []
+
+        def complementarity(rows, idx):
+            calls.append(codes[idx])
+            return idx[np.isin(codes[idx], codes[imposed])]
+
+        released = imposed[1:]                   # the update releases a row
+        chosen, settled = active.choose(cand, released, released, 2, complementarity)
+        assert active.exact == warm_exact and len(calls) == int(warm_exact)
+        if not warm_exact:
+            assert not settled and np.array_equal(chosen, released)
+        else:
+            assert codes[dropped] in calls[0] and settled
+            assert np.array_equal(np.sort(codes[chosen]), np.sort(codes[imposed]))
+
+
 def test_a_row_the_complementarity_problem_released_stays_a_candidate():
     """Found rows stay candidates while active or found again; once the complementarity
     problem chooses, every row wanted or imposed in the solve stays one: a row it released

@@ -106,6 +106,7 @@ def test_validate_does_not_mutate():
     ("inverse", "superLU", "inverse must be one of ("),
     ("method", "newton", "method must be one of ('modified', 'full')"),
     ("fix_free_modes", "some", "fix_free_modes must be False, True or 'all'"),
+    ("warm_exact", "yes", "warm_exact must be None, False or True"),
 ])
 def test_contact_solver_options_are_checked_at_construction(option, value, message):
     _, prob = pressed_blocks()

@@ -235,6 +235,9 @@ class ActiveSet:
         Keys of rows that enter the first choice as active. Non-empty: the solve starts
         from them instead of a solve without contact rows, so the first round has no solve
         before it and cannot settle.
+    warm_exact : bool
+        With ``warm`` rows: the complementarity problem chooses from the second round on, every
+        row wanted in the solve among its candidates (docs/contact.md, warm increment solves).
 
     Attributes
     ----------
@@ -246,11 +249,12 @@ class ActiveSet:
     """
 
     def __init__(self, geometry, tol, penetration_tol, kink_angle=KINK_ANGLE, rank_tol=1e-5, pdas_rounds=6,
-                 max_updates=10, warm=()):
-        self.geometry = geometry
+                 max_updates=10, warm=(), warm_exact=False):
+        self.geometry, self.rank_tol, self.max_updates = geometry, rank_tol, max_updates
         self.tol, self.penetration_tol, self.kink_angle = tol, penetration_tol, kink_angle
-        self.rank_tol, self.pdas_rounds, self.max_updates = rank_tol, pdas_rounds, max_updates
         self.warm = set(warm)                   # judged as active in the first choice only
+        self.warm_exact = bool(warm_exact and self.warm)
+        self.pdas_rounds = min(pdas_rounds, 1) if self.warm_exact else pdas_rounds
         self.solved = not self.warm             # the multipliers belong to a solve
         self.seam_rows, self.seam_keys = None, []
         self.matched = None                     # vertices with a seam row
@@ -437,9 +441,9 @@ class ActiveSet:
         return kept, settled
 
     def _exact_choice(self, candidates, codes, want, complementarity):
-        """The closed rows of the complementarity problem of the wanted and tried rows, made
-        independent, and their sorted codes; None where the problem could not be solved."""
-        tried = np.flatnonzero(isin_ints(codes, self.tried))
+        """The closed rows of the complementarity problem of the wanted and tried rows (``warm_exact``:
+        all wanted so far), made independent, and their sorted codes; None where it is not solved."""
+        tried = np.flatnonzero(isin_ints(codes, union_ints(self.tried, self.wanted) if self.warm_exact else self.tried))
         closed = complementarity(candidates.rows, union_ints(want, tried))
         if closed is None:
             return None

@@ -191,6 +191,15 @@ class ContactSolver:
         Rounds of the primal-dual update before the set is chosen by the complementarity
         problem (also chosen so at once when the update revisits a set). Where the update
         converges, it settles within a few rounds (``docs/contact.md``).
+    warm_exact : bool or None
+        A warm-started solve lets the complementarity problem choose from its second round,
+        with every row wanted in the solve among its candidates (ActiveSet's
+        ``warm_exact``). For warm rows of a solve on the same mesh: rows carried over a crack
+        pass can hold a vertex on the plane of a face that no longer bounds it, and a run's
+        relaxation solves pass False (``run/step.py``). None (default): on tetrahedral
+        meshes, where it takes the default sphere's increment solves from 10 to 12 rounds to
+        6 or 7 (``docs/contact.md``, "Rounds of a warm increment solve"); triangular meshes
+        keep the primal-dual rounds (not measured there).
     setups : ngfracture.contact.setup3d.MeshSetups, optional
         In 3D, the set-up of the mesh (fixed rows, detector, copy index) from an earlier
         solve on the same arrays, and where this solve's is kept for the next; without it
@@ -207,13 +216,14 @@ class ContactSolver:
     ------
     ValueError
         Naming the first bad argument: ``tol`` NaN, infinite or negative; ``max_rounds``,
-        ``max_updates`` or ``pdas_rounds`` not an integer (>= 1, >= 0, >= 0);
+        ``max_updates`` or ``pdas_rounds`` not an integer (>= 1, >= 0, >= 0); ``warm_exact``
+        not None, False or True;
         ``rank_tol`` not in (0, 1); ``kink_angle`` not in [0, pi]; ``fix_free_modes`` not
         False, True or "all"; an unknown ``method``, ``linear_solver`` or ``inverse``.
     """
 
     def __init__(self, problem, tol, penetration_tol=None, max_rounds=20, rank_tol=1e-5, max_updates=10,
-                 kink_angle=KINK_ANGLE, pdas_rounds=6, setups=None, **solve_options):
+                 kink_angle=KINK_ANGLE, pdas_rounds=6, warm_exact=None, setups=None, **solve_options):
         if not np.isfinite(tol) or tol < 0:
             raise ValueError(f"contact detection tol must be finite and >= 0, got {tol!r}")
         for name, value, low in (("max_rounds", max_rounds, 1), ("max_updates", max_updates, 0),
@@ -225,6 +235,8 @@ class ContactSolver:
         if isinstance(kink_angle, bool) or not isinstance(kink_angle, numbers.Real) \
                 or not 0 <= kink_angle <= math.pi:
             raise ValueError(f"ContactSolver kink_angle must be an angle in [0, pi] (radians), got {kink_angle!r}")
+        if warm_exact not in (None, False, True):
+            raise ValueError(f"ContactSolver warm_exact must be None, False or True, got {warm_exact!r}")
         fix = solve_options.get("fix_free_modes", True)
         if fix not in (False, True, "all"):
             raise ValueError(f"fix_free_modes must be False, True or 'all', got {fix!r}")
@@ -240,6 +252,7 @@ class ContactSolver:
         self.max_updates = max_updates
         self.kink_angle = kink_angle
         self.pdas_rounds = pdas_rounds
+        self.warm_exact = problem.dim == 3 if warm_exact is None else warm_exact
         self.setups = setups
         self.options = dict(solve_options)
         self.options["fix_free_modes"] = "all" if self.options.get("fix_free_modes") == "all" else True
@@ -294,7 +307,8 @@ class ContactSolver:
 
     def _active_set(self, geometry, warm):
         """The active set of a solve: ActiveSet on triangles, ActiveSet3d on tetrahedra."""
-        options = dict(rank_tol=self.rank_tol, pdas_rounds=self.pdas_rounds, max_updates=self.max_updates, warm=warm)
+        options = dict(rank_tol=self.rank_tol, pdas_rounds=self.pdas_rounds, max_updates=self.max_updates, warm=warm,
+                       warm_exact=self.warm_exact)
         if self.problem.dim == 3:
             return ActiveSet3d(geometry, self.penetration_tol, setups=self.setups,
                                edge_tol=max(EDGE_TOL * self.tol, self.penetration_tol),

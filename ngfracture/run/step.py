@@ -183,8 +183,12 @@ class LoadStep:
 
     def _contact_equilibrium(self, prob, phase, options, timings, warm, lineage, start):
         """:meth:`equilibrium` with an active set of contact rows."""
+        # the complementarity choice from a warm set of the same mesh only: warm rows carried
+        # over a crack pass can hold a vertex on the plane of a face that no longer bounds it
+        # (docs/contact.md, "Rounds of a warm increment solve")
         solver = ContactSolver(prob, tol=self.scene.contact_tol,   # its tol: detection threshold
-                               fix_free_modes=self.scene.fix_free_modes, setups=self.contact_setups)
+                               fix_free_modes=self.scene.fix_free_modes, setups=self.contact_setups,
+                               warm_exact=None if phase == "increment" else False)
         solver.options.update(options)                              # Newton's tol, method, maxit
         result = solver.solve(warm=warm, lineage=lineage, start=start)
         collision = result.timings.get("collision", 0.0)
