@@ -8,8 +8,8 @@ no longer bounds it, and the primal-dual rounds decide as before (the slow bar t
 ``tests/test_contact3d_mouth.py``, breaks in its first cracking step only so).
 
 The coarse confined sphere, four steps: steps 3 and 4 crack, so both kinds of solve occur
-with warm rows; every solve must also keep the reference volume and leave no vertex in
-another piece (``invariant_util.check_accepted_3d``).
+with warm rows; every accepted step must also keep the reference volume and leave no
+vertex in another piece (``invariant_util.check_accepted_3d``).
 """
 import ngfracture as nf
 import ngfracture.run.step as step_module
