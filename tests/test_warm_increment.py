@@ -19,14 +19,20 @@ from ngfracture.geometry.solid import solid_to_arrays
 
 
 def test_increment_solves_choose_exactly_from_warm_rows_and_relaxations_do_not(tmp_path, monkeypatch):
-    solves = []
+    solves, phases = [], []
+    contact_equilibrium = step_module.LoadStep._contact_equilibrium
+
+    def with_phase(self, prob, phase, *args):
+        phases.append(phase)
+        return contact_equilibrium(self, prob, phase, *args)
 
     class Recording(ContactSolver):
         def solve(self, warm=(), lineage=None, start=None):
             result = super().solve(warm=warm, lineage=lineage, start=start)
-            solves.append((lineage is not None, len(tuple(warm)) > 0, self.warm_exact, result.converged))
+            solves.append((phases[-1] == "relaxation", len(tuple(warm)) > 0, self.warm_exact, result.converged))
             return result
 
+    monkeypatch.setattr(step_module.LoadStep, "_contact_equilibrium", with_phase)
     monkeypatch.setattr(step_module, "ContactSolver", Recording)
     scene = nf.scenes.sphere3d(maxh=0.4, fine=0.15)
     reference = solid_to_arrays(scene.mesh)
