@@ -237,6 +237,9 @@ class StepLog:
         Departures from the plain path (a kept tangent that failed, ...).
     kept_tangent : bool
         The accepted increment solve started from the tangent kept from the step before.
+    cut_modified : bool
+        A failed relaxation was retried with dx * cut and modified Newton
+        (``LoadStep.cuts_before_full``): done at most once per step.
     """
     retries: int = 0
     failures: list = field(default_factory=list)
@@ -244,6 +247,7 @@ class StepLog:
     method: str = "modified"
     notes: list = field(default_factory=list)
     kept_tangent: bool = False
+    cut_modified: bool = False
 
 
 @dataclass

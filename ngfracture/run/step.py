@@ -13,11 +13,8 @@
 Each stage returns a record (:mod:`ngfracture.run.records`); a failed solve raises
 ``StepFailed``. A failure sends the step back to the saved state: an increment solve that
 started from the tangent kept from the step before is made again with a tangent of its
-own; with modified Newton, the next retry solves the same attempt with full Newton (the
-tangent factorised at the start of a solve can be too far from the state that new
-contact rows impose); then a failure of the increment solve is retried with the same
-target in twice as many Newton load steps (the load path does not change), a failure at
-fixed load after a split with dx * cut; after ``max_retries`` failures the step gives up.
+own; the other retries follow :mod:`ngfracture.run.retries` (full Newton, more Newton load
+steps, dx * cut); after ``max_retries`` failures the step gives up.
 
 Where the paper is vague:
 
@@ -52,6 +49,7 @@ from .state import State, crack_extent, round_trip
 from . import tangents
 from .growth import critical_event, relax
 from .refinement import refine_equilibrium, refine_initial
+from .retries import next_retry
 
 __all__ = ["LoadStep", "UNHELD_NOTE"]
 
@@ -349,12 +347,11 @@ class LoadStep:
 
         Too many cracks: dx * cut. A failed increment solve that started from the tangent
         the state keeps: the same attempt with a tangent of its own (recorded in the notes,
-        not counted against ``max_retries``). A failed solve with modified Newton: the same
-        attempt with full Newton (from then on for this step). A failed solve of the
-        increment: the same target in twice as many substeps (load steps of the Newton
-        solver, no crack pass between them), so a passing trouble does not change the load
-        path. A failed solve at fixed load (relaxation on a split mesh): dx * cut, substeps
-        reset. Every attempt starts from the saved state: nothing of a failed attempt is kept.
+        not counted against ``max_retries``). Other failures: the next attempt of
+        :func:`ngfracture.run.retries.next_retry` (full Newton, twice as many substeps of
+        the increment, or dx * cut; on a tetrahedral mesh with contact a failed relaxation
+        first takes dx * cut with modified Newton, :meth:`cuts_before_full`). Every attempt
+        starts from the saved state: nothing of a failed attempt is kept.
 
         Parameters
         ----------
@@ -383,14 +380,10 @@ class LoadStep:
                     continue
                 if log.retries - (not keep) > c.max_retries:
                     return StepOutcome(None, dx, log, err)
-                if log.method == "modified":
-                    log.method = "full"           # the same attempt with fresh tangents
-                elif err.phase == "increment":
-                    log.substeps *= 2
-                elif dx * c.cut >= c.dx_min:
-                    dx, log.substeps = dx * c.cut, 1
-                else:
+                dx_next = next_retry(log, err.phase, dx, c, self.cuts_before_full(state.mesh))
+                if dx_next is None:
                     return StepOutcome(None, dx, log, err)
+                dx = dx_next
                 continue
             if isinstance(attempt, TooManyCracks):     # too many cracks at once: smaller increment
                 dx *= c.cut
@@ -398,6 +391,21 @@ class LoadStep:
             log.kept_tangent = attempt.kept_tangent
             log.notes = merged_notes(log.notes, attempt.notes)
             return StepOutcome(attempt, dx, log)
+
+    def cuts_before_full(self, mesh):
+        """True where a relaxation that failed with modified Newton is retried with dx * cut
+        before full Newton (:mod:`ngfracture.run.retries`): a tetrahedral mesh with contact.
+
+        Parameters
+        ----------
+        mesh : ngsolve.Mesh
+            The state's mesh.
+
+        Returns
+        -------
+        bool
+        """
+        return mesh.dim == 3 and self.needs_contact(mesh)
 
     def _checked_attempt(self, state, dx, log, timings, keep):
         """:meth:`attempt` and :meth:`check`; an unexpected error in them is a failed attempt
