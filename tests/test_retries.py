@@ -3,7 +3,7 @@
 The ladder itself: modified Newton fails, then full Newton at the same increment, then
 twice as many Newton load steps of the increment or dx * cut at fixed load; on a
 tetrahedral mesh with contact a failed relaxation first takes dx * cut with modified
-Newton. Then a run: the coarse confined sphere whose first relaxation of step 3 is made
+Newton. Then a run: the coarse confined sphere whose first relaxation of the run is made
 to fail (the contact solve's "active_set" reason) is retried from the saved state with dx
 * cut and modified Newton; the steps before are the undisturbed run's bit for bit, and
 every accepted step keeps the reference volume to the last bit and leaves no vertex in
