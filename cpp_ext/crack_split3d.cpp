@@ -553,6 +553,10 @@ namespace ngfracture
   int TetSplitter :: RefuseReason (const std::vector<int> & side, const std::vector<long long> & before,
                                    int & after) const
   {
+    // both sides hold tetrahedra: the cut and Connect can move every tetrahedron to one
+    // side, which would leave a copy of v in no tetrahedron
+    long long n1 = std::count(side.begin(), side.end(), 1);
+    if (n1 == 0 || n1 == (long long)side.size()) return SPLIT3_EMPTY;
     // on v's boundary (free surface or crack), both sides reach it: the new faces do not
     // close a cone around v
     bool boundary = false, reach[2] = { false, false };

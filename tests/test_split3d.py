@@ -6,6 +6,7 @@ rounding and a planar crack; the rules at fronts, free surfaces, junctions and m
 fronts one case each.
 """
 import math
+from pathlib import Path
 
 import numpy as np
 import ngsolve
@@ -15,7 +16,7 @@ from netgen.csg import CSGeometry, OrthoBrick, Pnt
 from ngfracture.fracture.split import transfer_vertex_field
 from ngfracture.fracture import split3d as s3
 from ngfracture.fracture.fragments import FragmentStatistics
-from ngfracture.geometry.solid import solid_mesh, solid_to_arrays, tet_volumes, total_volume
+from ngfracture.geometry.solid import SolidArrays, solid_mesh, solid_to_arrays, tet_volumes, total_volume
 from split3d_util import check_twins, crack_area, crack_pieces, cube_bar, min_face_surface
 
 Z = np.array([0.0, 0.0, 1.0])
@@ -318,3 +319,26 @@ def test_split_mode_is_checked():
     a = cube_bar(1, 1, 1)
     with pytest.raises(ValueError, match="mode"):
         s3.split_by_tensor_3d(a, np.zeros((len(a.points), 6)), mode="every")
+
+
+def test_a_cut_that_leaves_one_side_empty_is_refused_and_every_copy_keeps_tetrahedra():
+    """The first crack pass of the coarse random box ``random_solids.draw(4, coarse=True)``
+    (tests/data/split3d_empty_side.npz: its mesh, the 54 vertices the pass processed and
+    their directions). At the last one (vertex 427, on the crack made by the others) the
+    minimum cut and the connecting of the sides put every tetrahedron of its star on one
+    side: a copy in no tetrahedron would be a piece of one vertex whose rotations are zero
+    vectors (a singular coarse problem in every solve after it). The cut is refused as
+    "empty", the sides by centroid are taken instead, and every vertex of the split mesh
+    is in a tetrahedron."""
+    data = np.load(Path(__file__).parent / "data" / "split3d_empty_side.npz")
+    names = [f"b{i}" for i in range(1, int(data["face_bc"].max()) + 1)]
+    a = SolidArrays(data["points"], data["tets"].astype(np.int64), np.zeros(len(data["tets"]), dtype=np.int64),
+                    ["solid"], data["faces"].astype(np.int64), data["face_bc"].astype(np.int64), names[:-1] + ["crack"])
+    r = s3.split_vertices_3d(a, data["vertices"], data["directions"])
+    check_invariants(a, r.arrays)
+    in_a_tet = np.zeros(len(r.arrays.points), dtype=bool)
+    in_a_tet[r.arrays.tets.ravel()] = True
+    assert in_a_tet.all(), f"vertices in no tetrahedron: {np.flatnonzero(~in_a_tet)}"
+    last = len(r.record["vertex"]) - 1
+    assert r.record["vertex"][last] == 427
+    assert r.record["faces"][last] > 0 and "cut" in s3.flag_names_3d(r.record["flags"][last])

@@ -45,11 +45,11 @@ the far edges of the new faces (flag ``closed``). Then:
 
 * pinched: a star already in pieces (crack faces all around) gets one copy per piece,
   without new faces;
-* refused (``none``): a side is empty (``empty``); v lies on a boundary (free surface or
-  crack) and a side touches none of v's boundary faces, so that the new faces would close a
-  cone around v (``enclosed``); the new faces would end inside the body at an edge through
-  v that was not a front edge (``dangling``); a side would be a piece of the mesh smaller
-  than the star, a pocket closed by earlier cracks (``pocket``);
+* refused (``none``): a side is empty (``empty``), by the plane or after the cut; v lies on
+  a boundary (free surface or crack) and a side touches none of v's boundary faces, so that
+  the new faces would close a cone around v (``enclosed``); the new faces would end inside
+  the body at an edge through v that was not a front edge (``dangling``); a side would be a
+  piece of the mesh smaller than the star, a pocket closed by earlier cracks (``pocket``);
 * far vertices: every vertex of the new faces whose star fell apart is split per piece
   (``far``): no two pieces are ever joined by a single vertex or a single edge;
 * fronts meeting a free surface, two fronts meeting, a crack meeting another (junction,
