@@ -278,6 +278,33 @@ def test_the_schur_complement_by_dofs_solves_no_row_whose_dofs_were_met(monkeypa
     assert solves == [dofs_first, dofs_more]
 
 
+def test_the_schur_complement_by_dofs_of_rows_met_in_the_last_product_is_its_own_numbers(monkeypatch):
+    """A call whose rows (bitwise) are all rows of the last product, reordered and fewer
+    (a contact round's equations after the complementarity problem over all its candidates),
+    takes S from that product without multiplying: bit for bit what the whole product of
+    its rows gives (a DofSchur that meets them after the same growth of G, with no product
+    kept). A call with a row of new values multiplies again."""
+    monkeypatch.setattr(factor_module, "SPARSE_SCHUR_MIN_DOFS", 0)
+    rng = np.random.default_rng(10)
+    factor, fresh_factor = plate_factor(schur_by_dofs=True), plate_factor(schur_by_dofs=True)
+    first = random_rows(factor, 14, rng)
+    subset = first[[12, 0, 5, 9, 1, 7, 2]]
+    for f in (factor, fresh_factor):
+        f.schur(first)
+    kept = factor._sparse._made[1]
+    S = factor.schur(subset)
+    assert factor._sparse._made[1] is kept                      # no product made
+    fresh_factor._sparse._made = ({}, None)                    # the same G, no product kept
+    assert np.array_equal(S, fresh_factor.schur(subset))
+    assert np.array_equal(S, S.T)
+    reference = subset @ factor.solve(subset.T.toarray())
+    assert np.abs(S - reference).max() <= 1e-12 * np.abs(reference).max()
+    changed = subset.copy()
+    changed.data[:3] = rng.standard_normal(3)
+    factor.schur(changed)
+    assert factor._sparse._made[1] is not kept
+
+
 def test_a_3d_tangent_factorised_for_one_system_takes_the_schur_complement_by_rows(monkeypatch):
     """Full Newton factorises every iterate for the solves of one system: in 3D its Schur
     complement is built from the rows (one triangular solve per row), not from K^-1 on their

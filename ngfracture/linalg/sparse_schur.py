@@ -13,7 +13,10 @@ at every round of the active set: a call meets a quarter of its rows with new va
 not recognised by their keys. For them S is built from the dofs instead (:class:`DofSchur`):
 G = E^T K_ff^-1 E on the factorised dofs the rows touch (E their unit columns), made row by
 row as above from the unit rows of those dofs, kept and grown with the dofs a call adds;
-then S = C_d G C_d^T costs a sparse product per call and no triangular solve.
+then S = C_d G C_d^T costs a sparse product per call and no triangular solve. A call whose
+rows are all among those of the last call that made the product (bitwise: a contact round's
+equations after its complementarity problem over all candidates) takes its S from that
+product's, entry for entry the same numbers.
 """
 import numpy as np
 import scipy.sparse as sp
@@ -125,6 +128,7 @@ class DofSchur:
         self._units = SparseSchur(lu, arrays, supernodal, index)
         self._index, self._symmetric = index, arrays[2] is not None     # U = D L^T: G symmetric
         self._dofs, self._order, self._G = np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), None
+        self._made = ({}, None)   # the last product's rows (key -> position) and S
 
     def complement(self, C):
         """S for the rows C (entries at dofs that are not factorised are ignored).
@@ -157,8 +161,18 @@ class DofSchur:
         at = self._order[np.searchsorted(self._dofs, C.indices[factorised], sorter=self._order)]
         rows = np.repeat(np.arange(C.shape[0]), np.diff(C.indptr))[factorised]
         Cd = sp.csr_matrix((C.data[factorised], (rows, at)), shape=(C.shape[0], len(self._dofs)))
+        keys = row_keys(Cd)
+        place, made = self._made
+        if keys and all(key in place for key in keys):
+            # an entry of S depends on its two rows and G alone (G's block of these rows'
+            # dofs has not changed since: new dofs join at the end), so the gather is the
+            # product's own numbers
+            at = np.array([place[key] for key in keys], dtype=np.int64)
+            return made[np.ix_(at, at)]
         S = (Cd @ (Cd @ self._G).T).T
-        return 0.5 * (S + S.T) if self._symmetric else S
+        S = 0.5 * (S + S.T) if self._symmetric else S
+        self._made = ({key: i for i, key in enumerate(keys)}, S)
+        return S
 
 
 __all__ = ["DofSchur", "SparseSchur"]
