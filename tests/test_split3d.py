@@ -323,7 +323,7 @@ def test_split_mode_is_checked():
 
 def test_a_cut_that_leaves_one_side_empty_is_refused_and_every_copy_keeps_tetrahedra():
     """The first crack pass of the coarse random box ``random_solids.draw(4, coarse=True)``
-    (tests/data/split3d_empty_side.npz: its mesh, the 54 vertices the pass processed and
+    (tests/data/split3d_empty_side.npz: its mesh, the first 54 vertices the pass processed and
     their directions). At the last one (vertex 427, on the crack made by the others) the
     minimum cut and the connecting of the sides put every tetrahedron of its star on one
     side: a copy in no tetrahedron would be a piece of one vertex whose rotations are zero
