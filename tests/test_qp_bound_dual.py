@@ -158,3 +158,36 @@ def test_sweeps_stop_once_the_dual_steps_are_cheaper():
     assert early.fallback == ""
     assert np.array_equal(early.held, alone.held)
     assert np.abs(early.x - alone.x).max() <= 1e-12 * np.abs(alone.x).max()
+
+
+@pytest.mark.parametrize("seed,p", [(1, 0), (2, 6)])
+def test_the_dual_method_starts_from_the_last_sweeps_factor(seed, p, monkeypatch):
+    """Where the dual method starts from the bounds the last primal-dual sweep held, it
+    takes that sweep's factorisation of the free block instead of factorising it again:
+    the same answer to the last bit as with a fresh factorisation, one Cholesky
+    factorisation of a free block fewer."""
+    H, c, E, e, _ = contact_like(seed, 300, p)
+    bounded = np.arange(300)
+
+    def solve(reuse):
+        fresh = []
+        sweeps = qp_module._primal_dual_sweeps
+
+        def sweeps_keeping(*args):
+            solved, starts, count, factored = sweeps(*args)
+            return solved, starts, count, factored if reuse else None
+
+        monkeypatch.setattr(qp_module, "_primal_dual_sweeps", sweeps_keeping)
+        cholesky = qp_module.sla.cholesky
+        monkeypatch.setattr(qp_module.sla, "cholesky",
+                            lambda a, **k: fresh.append(a.shape[0]) or cholesky(a, **k))
+        answer = bound_qp(H, c, E, e, bounded)
+        monkeypatch.undo()
+        return answer, [size for size in fresh if size < len(c)]
+
+    reused, free_blocks_reused = solve(True)
+    fresh, free_blocks_fresh = solve(False)
+    assert reused.dual_steps and fresh.dual_steps
+    assert free_blocks_reused == [] and len(free_blocks_fresh) == 1
+    assert np.array_equal(reused.x, fresh.x) and np.array_equal(reused.held, fresh.held)
+    assert np.array_equal(reused.u_eq, fresh.u_eq)

@@ -320,14 +320,14 @@ def bound_qp(H, c, A_eq, b_eq, bounded, tol=1e-12, max_sweeps=8, stop_early=True
     c = np.asarray(c, dtype=float)
     E, e = np.asarray(A_eq, dtype=float).reshape(-1, n), np.asarray(b_eq, dtype=float).ravel()
     bounded = np.asarray(bounded, dtype=int).ravel()
-    solved, starts, sweeps = _primal_dual_sweeps(H, c, E, e, bounded, tol, max_sweeps, stop_early)
+    solved, starts, sweeps, factored = _primal_dual_sweeps(H, c, E, e, bounded, tol, max_sweeps, stop_early)
     if solved is not None:
         return BoundQP(*solved, sweeps, False)
     fallback = ""
     for k, start in enumerate(starts):
         try:
             try:
-                x, u_eq, u_in, held = _dual_steps_on_bounds(H, c, E, e, bounded, start, tol)
+                x, u_eq, u_in, held = _dual_steps_on_bounds(H, c, E, e, bounded, start, tol, factored)
             except Infeasible:
                 raise
             except QPError as err:      # rounding in the updated factor: the QR of the working set
@@ -341,7 +341,7 @@ def bound_qp(H, c, A_eq, b_eq, bounded, tol=1e-12, max_sweeps=8, stop_early=True
         return BoundQP(x, u_eq, u_in, held, sweeps, True, fallback)
 
 
-def _dual_steps_on_bounds(H, c, E, e, bounded, start, tol):
+def _dual_steps_on_bounds(H, c, E, e, bounded, start, tol, factored=None):
     """The dual active-set method of :func:`convex_qp` for the bounds of :func:`bound_qp`,
     from the S-pair of ``start`` (positions in ``bounded``), with the Cholesky factor of the
     free block updated as bounds enter and leave (C++, ``BoundDualActiveSet``): O(f^2 + f k)
@@ -350,6 +350,9 @@ def _dual_steps_on_bounds(H, c, E, e, bounded, start, tol):
     most in the metric of H, the first of equal ratios), so the same working sets to
     rounding. A start whose held bounds leave the equalities dependent on the free
     variables is mended first (:func:`_spanning`; convex_qp drops the dependent bounds).
+    ``factored`` (held, factor): a factorisation of the free block that the primal-dual
+    sweeps made (:func:`_minimiser_on`), taken where the start holds the same bounds (the
+    same LAPACK factor as a fresh one, to the last bit).
     Returns (x, u_eq, u_bound, held) in the form of BoundQP.
 
     Raises
@@ -377,9 +380,12 @@ def _dual_steps_on_bounds(H, c, E, e, bounded, start, tol):
     held[bounded[np.asarray(start, dtype=int)]] = True
     if len(e):
         held = _spanning(E, held)
+    free = np.flatnonzero(~held)
+    if factored is not None and np.array_equal(factored[0], held):
+        L0 = np.tril(factored[1][0])
+    else:
+        L0 = sla.cholesky(H[np.ix_(free, free)], lower=True) if len(free) else np.zeros((0, 0))
     held = held.astype(np.int8)
-    free = np.flatnonzero(held == 0)
-    L0 = sla.cholesky(H[np.ix_(free, free)], lower=True) if len(free) else np.zeros((0, 0))
     x, u_eq, u, held, _, _, status, reason = _ext.BoundDualActiveSet(
         H, c, E, e, is_bound, norm, held, L0, tol, data, GROWTH_LIMIT, 10 * (n + len(e) + len(bounded)) + 100)
     if status == 1:
@@ -400,21 +406,23 @@ def _primal_dual_sweeps(H, c, E, e, bounded, tol, max_sweeps, stop_early):
     stop after ``max_sweeps`` or, with ``stop_early``, when fewer bounds are violated than
     a third of the free variables.
 
-    Returns (solution, guesses, sweeps): solution (x, u_eq, u_bound, held) if a sweep
-    changed nothing, else None and guesses, each the positions in ``bounded`` held in a
-    sweep with the fewest violations: the one of all sweeps first, then, if a guess was
-    mended, the one before the first mending (the dual method's start without mending)."""
+    Returns (solution, guesses, sweeps, factored): solution (x, u_eq, u_bound, held) if a
+    sweep changed nothing, else None and guesses, each the positions in ``bounded`` held in
+    a sweep with the fewest violations: the one of all sweeps first, then, if a guess was
+    mended, the one before the first mending (the dual method's start without mending);
+    factored: the held bounds of the last sweep and its factorisation of the free block."""
     n = len(c)
     is_bound = np.zeros(n, dtype=bool)
     is_bound[bounded] = True
     held = is_bound & (c > 0)
-    best, fewest, sweep, unmended = held, np.inf, 0, None
+    best, fewest, sweep, unmended, factored = held, np.inf, 0, None, None
     for sweep in range(1, max_sweeps + 1):
-        x, u_eq = _minimiser_on(H, c, E, e, ~held)
+        x, u_eq, factor = _minimiser_on(H, c, E, e, ~held)
         if x is None:                    # a piece's equalities dependent on the free rows
             unmended = best if unmended is None else unmended
             held = _spanning(E, held)
-            x, u_eq = _minimiser_on(H, c, E, e, ~held)
+            x, u_eq, factor = _minimiser_on(H, c, E, e, ~held)
+        factored = (held, factor)
         if x is None:
             break
         u = np.zeros(n)                  # H x - c = E^T u_eq - u on the held bounds
@@ -426,33 +434,34 @@ def _primal_dual_sweeps(H, c, E, e, bounded, tol, max_sweeps, stop_early):
         pulls = held & (u < -np.sqrt(n) * np.finfo(float).eps * force)
         violations = int(rises.sum() + pulls.sum())
         if violations == 0:
-            return (x, u_eq, u[bounded], held[bounded]), None, sweep
+            return (x, u_eq, u[bounded], held[bounded]), None, sweep, factored
         if violations < fewest:
             best, fewest = held, violations
         if stop_early and violations < np.count_nonzero(~held) / 3:
             break       # a sweep's factorisation costs about f/3 dual steps: they finish cheaper
         held = (held & ~pulls) | rises
     guesses = [best] + ([unmended] if unmended is not None and not np.array_equal(unmended, best) else [])
-    return None, [np.flatnonzero(g[bounded]) for g in guesses], sweep
+    return None, [np.flatnonzero(g[bounded]) for g in guesses], sweep, factored
 
 
 def _minimiser_on(H, c, E, e, free):
-    """The minimiser of 1/2 x^T H x - c^T x on E x = e with x = 0 off ``free``, and the
-    equalities' multipliers; (None, None) if the equalities are dependent on ``free``."""
+    """The minimiser of 1/2 x^T H x - c^T x on E x = e with x = 0 off ``free``, the
+    equalities' multipliers and the factorisation of H on ``free`` (scipy's cho_factor);
+    x and the multipliers None if the equalities are dependent on ``free``."""
     x = np.zeros(len(c))
     factor = sla.cho_factor(H[np.ix_(free, free)], lower=True, check_finite=False)
     Ef = E[:, free]
     Z = sla.cho_solve(factor, np.column_stack([c[free], Ef.T]), check_finite=False)
     if not len(e):
         x[free] = Z[:, 0]
-        return x, np.zeros(0)
+        return x, np.zeros(0), factor
     coupling = Ef @ Z[:, 1:]             # E_f H_ff^-1 E_f^T, positive definite iff E_f has full rank
     eig = np.linalg.eigvalsh(coupling)
     if not eig[0] > 1e-12 * max(eig[-1], 1e-300):
-        return None, None
+        return None, None, factor
     u_eq = np.linalg.solve(coupling, e - Ef @ Z[:, 0])
     x[free] = Z[:, 0] + Z[:, 1:] @ u_eq
-    return x, u_eq
+    return x, u_eq, factor
 
 
 def _spanning(E, held):
