@@ -380,10 +380,10 @@ def _dual_steps_on_bounds(H, c, E, e, bounded, start, tol, factored=None):
     held[bounded[np.asarray(start, dtype=int)]] = True
     if len(e):
         held = _spanning(E, held)
-    free = np.flatnonzero(~held)
     if factored is not None and np.array_equal(factored[0], held):
         L0 = np.tril(factored[1][0])
     else:
+        free = np.flatnonzero(~held)
         L0 = sla.cholesky(H[np.ix_(free, free)], lower=True) if len(free) else np.zeros((0, 0))
     held = held.astype(np.int8)
     x, u_eq, u, held, _, _, status, reason = _ext.BoundDualActiveSet(

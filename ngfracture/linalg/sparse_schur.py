@@ -167,8 +167,8 @@ class DofSchur:
             # an entry of S depends on its two rows and G alone (G's block of these rows'
             # dofs has not changed since: new dofs join at the end), so the gather is the
             # product's own numbers
-            at = np.array([place[key] for key in keys], dtype=np.int64)
-            return made[np.ix_(at, at)]
+            positions = np.array([place[key] for key in keys], dtype=np.int64)
+            return made[np.ix_(positions, positions)]
         S = (Cd @ (Cd @ self._G).T).T
         S = 0.5 * (S + S.T) if self._symmetric else S
         self._made = ({key: i for i, key in enumerate(keys)}, S)
