@@ -255,6 +255,13 @@ namespace ngfracture
       // of F may be the coincident lip of another copy, v in front of it)
       if (sep < 0 && t_copy >= 0 && copies.CountOn(D.vfrag, v, F) >= 2)
         sep = SeparatingFace(m, vfaces, T, v, t_copy, m.tets + 4*t, depth, &copies);
+      // none, t the only copy on F, and a lip of the holding tetrahedron at t whose other
+      // side is on F too: a crack of F ends at t (its front passes through the point). v
+      // can have slid into the crack's slit and on across its other lip, whose plane has
+      // v's wedge on its inner side; the nearest face of F can then be the coincident lip,
+      // v in front of it, whose row does not hold v
+      if (sep < 0 && t_copy >= 0 && copies.CountOn(D.vfrag, v, F) == 1)
+        sep = SeparatingFace(m, vfaces, T, v, t_copy, m.tets + 4*t, depth, &copies, F);
       // none, three or more copies on F, and the holding tetrahedron has no face on the
       // boundary at t: v slid past the faces of the tetrahedra at t deeper into t's star
       // where several cracks meet; the lip at t that v is least deep behind (the

@@ -136,8 +136,10 @@ namespace ngfracture::detect3d
     }
 
     // Whether boundary face f is a lip: another boundary face lies on its three points (the
-    // other side of a crack or of an interface of bodies meshed apart).
-    bool IsLip (const TetMesh3 & m, const Copies & copies, const VertexFaces & vfaces, int32_t f)
+    // other side of a crack or of an interface of bodies meshed apart); with `on` >= 0, one
+    // on fragment `on` (ffrag: the fragment of every boundary face).
+    bool IsLip (const TetMesh3 & m, const Copies & copies, const VertexFaces & vfaces, int32_t f,
+                const std::vector<int32_t> & ffrag, int32_t on)
     {
       const int32_t * T = m.faces + 3*f;
       const std::array<int32_t,3> pts = copies.FacePoints(T);
@@ -146,7 +148,7 @@ namespace ngfracture::detect3d
         for (int64_t i = vfaces.start[copies.members[s]]; i < vfaces.start[copies.members[s]+1]; i++)
           {
             int32_t h = vfaces.at[i];
-            if (h != f && copies.FacePoints(m.faces + 3*h) == pts) return true;
+            if (h != f && (on < 0 || ffrag[h] == on) && copies.FacePoints(m.faces + 3*h) == pts) return true;
           }
       return false;
     }
@@ -161,12 +163,13 @@ namespace ngfracture::detect3d
     // `depth` gets max(0, -signed distance). Faces of t elsewhere are not candidates: t's
     // wedge can be reflex, and v outside one of its planes may still be inside it.
     // With `lips_of` (the copies), the candidates are instead the lips among those faces
-    // (IsLip), and only one that v is behind is returned (see the caller). With `tet`
+    // (IsLip; with `lips_on` >= 0, lips whose other side is on that fragment), and only one
+    // that v is behind is returned (see the caller). With `tet`
     // null, the candidates are the faces at t of every tetrahedron that v is behind
     // (lips only with `lips_of`; see the caller).
     int32_t SeparatingFace (const TetMesh3 & m, const VertexFaces & vfaces, const Topology & topo,
                             int32_t v, int32_t t, const int32_t * tet, double & depth,
-                            const Copies * lips_of)
+                            const Copies * lips_of, int32_t lips_on)
     {
       bool lips_only = lips_of != nullptr;
       bool behind_only = lips_only || tet == nullptr;
@@ -192,7 +195,7 @@ namespace ngfracture::detect3d
           if (!tet && !(s < 0)) continue;              // the whole star: faces v is behind
           if (!(s > best_s || (s == best_s && f < best))) continue;
           // the tests on the mesh last: they decide only for a face that would be the best
-          if (lips_only ? !IsLip(m, *lips_of, vfaces, f) : (tet && !StarOnSide(m, topo, v, nref, 1.0))) continue;
+          if (lips_only ? !IsLip(m, *lips_of, vfaces, f, topo.ffrag, lips_on) : (tet && !StarOnSide(m, topo, v, nref, 1.0))) continue;
           best_s = s; best = f;
         }
       if (behind_only && !(best_s < 0)) best = -1;

@@ -285,7 +285,7 @@ namespace ngfracture::detect3d
     // The face at copy t that v crossed into tetrahedron `tet` (or, `tet` null, into t's star).
     int32_t SeparatingFace (const TetMesh3 & m, const VertexFaces & vfaces, const Topology & topo,
                             int32_t v, int32_t t, const int32_t * tet, double & depth,
-                            const Copies * lips_of = nullptr);
+                            const Copies * lips_of = nullptr, int32_t lips_on = -1);
 
     // Whether tetrahedron `tet` has a boundary face at vertex t.
     bool HasBoundaryFaceAt (const TetMesh3 & m, const VertexFaces & vfaces, int32_t t, const int32_t * tet);

@@ -8,7 +8,8 @@ holding tetrahedron of a pair is the smallest. Master faces (collision3d's docst
 a tetrahedron at a copy t of the vertex, the face of that tetrahedron at t with the
 vertex's reference star outside its plane that the vertex is least deep behind; if none
 passes and two or more copies of the point lie on the fragment, the lip of that
-tetrahedron at t the vertex is least deep behind if it is behind one; else, where that tetrahedron has no
+tetrahedron at t the vertex is least deep behind if it is behind one (t the only copy
+there: a lip whose other side is on the fragment too, a crack of it ending at t); else, where that tetrahedron has no
 boundary face at t and three copies lie on the fragment, the lip at t (of any tetrahedron)
 that the vertex is least deep behind; else the nearest face of the fragment
 opposing the vertex's normal or coincident with one of its faces (partner faces). Import with ``PYTHONPATH=.:tests``.
@@ -146,8 +147,10 @@ class MasterReference:
         by_lip = False
         on_block = int(np.count_nonzero(np.all(X == X[a], axis=1) & (self.vf == f)))
         if not len(sep):
-            lips = at[[self.points_count[self.points[g]] > 1 for g in at]]
-            if len(lips) and on_block >= 2 and self.signed(a, t[0], lips).max() < 0:
+            # two or more copies on the fragment: its lips at t; t the only one: the lips at
+            # t whose other side is on the fragment too (a crack of it ending at t)
+            lips = at[[self.points_count[self.points[g]] > 1 and (on_block >= 2 or self.lip_on(g, f)) for g in at]]
+            if len(lips) and self.signed(a, t[0], lips).max() < 0:
                 sep, by_lip = lips, True
         if not len(sep) and not len(at) and on_block >= 3:
             # a tetrahedron with no boundary face at the copy, three copies on the fragment:
@@ -162,6 +165,11 @@ class MasterReference:
             return None
         signed = self.signed(a, t[0], sep)
         return int(sep[np.lexsort((sep, -signed))[0]]), -max(0.0, -signed.max()), by_lip
+
+    def lip_on(self, g, f):
+        """Whether another boundary face of fragment ``f`` lies on the three points of face ``g``."""
+        return any(h != g and self.points[h] == self.points[g] and self.vf[self.F[h, 0]] == f
+                   for h in range(len(self.F)))
 
     def signed(self, a, t, faces):
         """Signed distances of a from the planes through copy t with the faces' current normals."""

@@ -187,3 +187,56 @@ def test_deep_in_the_star_the_master_is_the_face_at_the_copy_least_deep_behind()
     cand, d = ref.nearest(v, 0)
     assert best not in cand                                   # the rule without it takes another face
     ref.check(pen, 1e-15)
+
+
+# the corner of the crack of cut_cube on the cut: the crack's front z = 1/2 meets the cut
+# there, and the piece x > 1/2 has one copy of the point, at which both lips end
+FRONT_CORNER = 0.5
+
+
+@pytest.mark.parametrize("weights", [(0.3, 0.2, 0.1), (0.1, 0.1, 0.4)])
+def test_a_copy_past_a_crack_front_at_its_copy_is_held_by_the_lip_it_is_behind(weights):
+    """The copy v of piece 1 at the corner of cut_cube's crack moved into a tetrahedron of
+    the piece x > 1/2 above the crack, at the piece's copy t there, whose boundary faces at
+    t are lips of the crack (no face on x = 1/2): v's reference star lies across their
+    plane, and t is the piece's only copy of the point (the crack's front passes through
+    it). The master is the lip v is least deep behind (the upper lip: the way back into
+    the slit), not the nearest face the vertex's normal opposes (here a face of the cut;
+    in the random box of docs/contact.md the coincident lower lip, which v was in front of)."""
+    z = FRONT_CORNER
+    a = cut_cube()
+    X, T, F = a.points, a.tets, a.faces
+    labels = wedge_labels(a)
+    piece = (labels == 0).astype(np.int64)
+    copies = copies_of(X, z)
+    side = [set(labels[np.any(T == c, axis=1)].tolist()) for c in copies]
+    assert sorted(map(tuple, side)) == [(0,), (1, 2)]      # one copy on each piece: t at the front
+    v, t = (int(copies[[0 in s for s in side].index(want)]) for want in (True, False))
+    k, at = holding_tet(a, labels, v, t, 2)
+    ref = MasterReference(X, np.zeros_like(X), T, F, piece)
+    assert all(ref.points_count[ref.points[f]] == 2 and X[F[f], 1].tolist() == [0.5] * 3 for f in at)
+    others = [u for u in T[k] if u != t]
+    U = np.zeros_like(X)
+    U[v] = EPS * sum(w * (X[u] - X[t]) for w, u in zip(weights, others))
+    x = X + U
+    signed = np.array([exact_signed(x, F[f], x[v]) for f in at])
+    assert np.all(signed < 0)
+    lip = int(at[np.argmax(signed)])
+
+    pen = detect_penetrations_3d(X, T, F, piece, displacement=U)
+    i = np.flatnonzero(pen.vertex == v)
+    assert len(i) == 1
+    i = int(i[0])
+    assert pen.fragment[i] == 0 and pen.tet[i] == k and pen.twin[i] == t
+    assert pen.face[i] == lip
+    assert abs(pen.gap[i] - signed.max()) <= 1e-15 * abs(pen.gap[i])
+    # without the rule the nearest face the vertex's normal opposes is the master: another face
+    ref = MasterReference(X, U, T, F, piece)
+    cand, d = ref.nearest(v, 0)
+    assert lip not in cand[d == d.min()]
+
+    assert ref.at_copy(v, 0, T[k]) == (lip, pytest.approx(signed.max(), rel=1e-15), True)
+    vertex, fragment, tet, closed = brute_force_pairs(X, T, F, piece, U)
+    assert np.array_equal(pen.vertex, vertex) and np.array_equal(pen.fragment, fragment)
+    assert np.array_equal(pen.tet, tet) and pen.stats["closed_seams"] == closed
+    assert ref.check(pen, 1e-15)[1] == 1
