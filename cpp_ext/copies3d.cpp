@@ -15,6 +15,21 @@ namespace ngfracture
       for (int k = 0; k < 3; k++)
         d[k] = x[3 * p + k] - x[3 * q + k];
     }
+
+    // min over s in [0, 1] of max(g[0](s), g[1](s)), g[k](s) = (1 - s) g[k][0] + s g[k][1]: the
+    // deepest that a point of edge a lies behind both planes of B's wedge (a convex piecewise
+    // linear function: at an end, or where the two gaps cross)
+    double LowestAlongEdge (const double g[2][2])
+    {
+      double lowest = std::min(std::max(g[0][0], g[1][0]), std::max(g[0][1], g[1][1]));
+      double h0 = g[0][0] - g[1][0], h1 = g[0][1] - g[1][1];
+      if ((h0 < 0 && h1 > 0) || (h0 > 0 && h1 < 0))
+        {
+          double s = h0 / (h0 - h1);
+          lowest = std::min(lowest, g[0][0] + s * (g[0][1] - g[0][0]));
+        }
+      return lowest;
+    }
   }
 
   void PartnerAt (int64_t m, const int64_t * faces, const int64_t * key_order, const int64_t * key_start,
@@ -209,7 +224,15 @@ namespace ngfracture
             middle[k] = (g[k][0] + g[k][1]) / 2.0;
           }
         int near = middle[1] > middle[0] ? 1 : 0;          // np.argmax: the first largest
-        if (convex && std::max(middle[0], middle[1]) < -tol && ok)
+        bool inside = std::max(middle[0], middle[1]) < -tol;
+        if (!inside && convex && ok && LowestAlongEdge(g) < -tol)
+          {
+            // a part of the edge off its middle inside: the face whose plane the deepest end
+            // behind it is least deep behind (out through it the edge needs the least motion)
+            inside = true;
+            near = std::max(-g[1][0], -g[1][1]) < std::max(-g[0][0], -g[0][1]) ? 1 : 0;
+          }
+        if (convex && inside && ok)
           {
             pair.push_back(p);
             nearer.push_back(near);

@@ -59,10 +59,12 @@ namespace ngfracture
                           const int64_t * face, const int64_t * corner, double tol, std::vector<int64_t> & hit,
                           std::vector<double> & gap);
 
-  // The diagonal edge pairs (a on A, b on B, b's faces fb) at x whose midpoint of a lies
-  // behind both planes of B's convex (or flat) wedge deeper than tol. pair: their
-  // numbers, increasing; nearer: the less deep face (0 or 1, the first on a tie); gap:
-  // the gaps of a's two ends to that face (2 per pair).
+  // The diagonal edge pairs (a on A, b on B, b's faces fb) at x with a point of a behind
+  // both planes of B's convex (or flat) wedge deeper than tol. pair: their numbers,
+  // increasing; nearer: where the midpoint of a is that deep, the face it is less deep
+  // behind (0 or 1, the first on a tie), else the face whose plane the deepest end of a
+  // behind it is least deep behind (0 on a tie); gap: the gaps of a's two ends to that
+  // face (2 per pair).
   void WedgeInside (int64_t m, const double * x, const int64_t * faces, const int64_t * a, const int64_t * b,
                     const int64_t * fb, double tol, std::vector<int64_t> & pair, std::vector<int64_t> & nearer,
                     std::vector<double> & gap);

@@ -143,3 +143,32 @@ def test_no_rows_out_of_the_wedge_or_below_the_tolerance(quadrants, shift, tol):
     U = moved(arrays, setup, shift)
     rows = wedge_rows(setup.diagonal_edges, U, tol, setup.copy_index, setup.vertex_fragment)
     assert len(rows) == 0
+
+
+def test_an_edge_inside_the_wedge_towards_one_end_only_gets_the_row_of_that_end(quadrants):
+    """Q1's line moved by u(z), linear in z: (d, d, 0) at the top z = 1/2 (behind both of
+    Q3's faces there by d) and (3d, -3d, 0) at z = 1/4 (behind the plane x = 1/2 by 3d, in
+    front of y = 1/2 by 3d). The gaps are linear along the upper edge, its midpoint out of
+    the wedge (behind x = 1/2 by 2d, in front of y = 1/2 by d), the part above z = 3/8 in
+    it. Out through the plane y = 1/2 only the top end has to move (by d; through x = 1/2
+    both, by up to 3d): the top end gets the row of the face on y = 1/2, gap -d (less the
+    face's turn); the lower
+    edge (z <= 1/4, in front of y = 1/2 all along) gets none. As for the moves above, the
+    row is the higher fragment's end on Q1's face."""
+    arrays, setup = quadrants
+    X = arrays.points
+    d = 1e-4
+    U = np.zeros_like(X)
+    q1 = setup.vertex_fragment == 0
+    w = (X[q1, 2] - 0.25) / 0.25                        # 0 at z = 1/4, 1 at z = 1/2
+    U[q1] = np.stack([3 * d - 2 * d * w, -3 * d + 4 * d * w, 0 * w], axis=1)
+    rows = wedge_rows(setup.diagonal_edges, U, 1e-9, setup.copy_index, setup.vertex_fragment)
+    assert len(rows) == 1
+    vf = setup.vertex_fragment
+    assert vf[rows.slave[0]] == 2 and np.array_equal(X[rows.slave[0]], [0.5, 0.5, 0.5])
+    master = rows.master[0]
+    assert np.all(vf[master] == 0) and np.all(X[master, 1] == 0.5)   # Q1's face on y = 1/2
+    # Q1's face turns with u_y(z): unit normal (0, 1, -16 d) / sqrt(1 + 256 d^2)
+    assert abs(rows.dist[0] + d / np.sqrt(1 + 256 * d * d)) <= 1e-12 * d
+    # its linearisation, with the face's reference normal (0, 1, 0): -d
+    assert abs(rows.C[0] @ U.T.ravel() + rows.g[0] + d) <= 1e-12 * d

@@ -142,7 +142,17 @@ def reference_wedge_rows(pairs, displacement, tol, index, vertex_fragment):
                     for k in range(2)], axis=1)
     middle = gap.mean(axis=2)
     nearer = np.argmax(middle, axis=1)
-    inside = convex & (middle.max(axis=1) < -tol) & ok
+    by_middle = middle.max(axis=1) < -tol
+    # the lowest of max(g0(s), g1(s)) along the edge: at an end or where the two gaps cross
+    lowest = np.minimum(gap.max(axis=1)[:, 0], gap.max(axis=1)[:, 1])
+    h = gap[:, 0] - gap[:, 1]
+    cross = ((h[:, 0] < 0) & (h[:, 1] > 0)) | ((h[:, 0] > 0) & (h[:, 1] < 0))
+    s = h[:, 0] / np.where(cross, h[:, 0] - h[:, 1], 1.0)
+    lowest = np.where(cross, np.minimum(lowest, gap[:, 0, 0] + s * (gap[:, 0, 1] - gap[:, 0, 0])), lowest)
+    deepest = np.max(-gap, axis=2)                      # per face: its deepest end
+    off_middle = ~by_middle & (lowest < -tol)
+    nearer = np.where(off_middle, (deepest[:, 1] < deepest[:, 0]).astype(np.int64), nearer)
+    inside = convex & (by_middle | off_middle) & ok
     vf = np.asarray(vertex_fragment, dtype=np.int64)
     n = np.int64(max(int(pairs.edge_a.max(initial=0)), int(pairs.edge_b.max(initial=0))) + 1)
     code, reverse = pairs.edge_a * n + pairs.edge_b, pairs.edge_b * n + pairs.edge_a

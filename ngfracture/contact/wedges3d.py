@@ -14,14 +14,17 @@ a tetrahedron) finds nothing; the edge-to-edge rows leave pairs at copies of a p
 :func:`diagonal_edges` lists, once per mesh, every ordered pair (edge a on A, edge b on B)
 of boundary edges on the same two reference points on different fragments with no face of
 A at a coincident with a face of B at b. :func:`wedge_rows` tests them at a configuration:
-where B's wedge at b is convex and the midpoint of a lies behind both of its faces' planes
-deeper than ``tol`` (measured from b's midpoint), the ends of a behind the plane of the
-less deep face get the row of that face, projected at their copy on b (barycentric 1
-there), with the face's unit normal of the reference configuration: the rows at copies'
-form (:func:`~ngfracture.contact.copies3d.found_rows_at_copies`), so that the active set
+where B's wedge at b is convex and a point of a lies behind both of its faces' planes
+deeper than ``tol`` (measured from b's point there; the gaps are linear along the edge),
+the ends of a behind the plane of one face get the row of that face, projected at their
+copy on b (barycentric 1 there), with the face's unit normal of the reference
+configuration: the rows at copies' form
+(:func:`~ngfracture.contact.copies3d.found_rows_at_copies`), so that the active set
 re-linearises them as it does those. Out of B's wedge, the edge line keeps out of it
-through one face or the other: a union, of which the row keeps the one nearer to hold
-(docs/contact.md, "Rows at copies found by their planes").
+through one face or the other: a union, of which the rows keep the one nearer to hold
+(the face the midpoint is less deep behind, or, where only a part of the edge towards
+one end is inside, the face that the deepest end behind it is least deep behind;
+docs/contact.md, "Rows at copies found by their planes").
 
 Where B's wedge at b is reflex (wider than pi) its complement is convex: the intersection of
 the half-spaces in front of its two faces, and every other copy a of the edge must keep out
@@ -114,7 +117,7 @@ def diagonal_edges(edges, faces_at_edge, vertex_fragment, index):
 
 
 def wedge_rows(pairs, displacement, tol, index, vertex_fragment):
-    """Rows for the ends of junction edges whose midpoint lies deeper than ``tol`` in a diagonal neighbour's wedge.
+    """Rows for the ends of junction edges a point of which lies deeper than ``tol`` in a diagonal neighbour's wedge.
 
     Parameters
     ----------
@@ -123,7 +126,7 @@ def wedge_rows(pairs, displacement, tol, index, vertex_fragment):
     displacement : numpy.ndarray, shape (nv, 3)
         Displacements U: the configuration X + U tested.
     tol : float
-        Depth (a length) of the midpoint below the less deep face that makes rows.
+        Depth (a length) of a point of the edge behind both faces' planes that makes rows.
     index : ngfracture.contact.kinks3d.CopyIndex
         The index of the mesh's reference points X and boundary faces.
     vertex_fragment : numpy.ndarray of int, shape (nv,)
@@ -132,9 +135,12 @@ def wedge_rows(pairs, displacement, tol, index, vertex_fragment):
     Returns
     -------
     NodeToFaceRows
-        For every such pair the rows of a's ends behind the less deep face's plane, on that
+        For every such pair the rows of a's ends behind the chosen face's plane, on that
         face, projected at the end's copy (``g`` 0, ``dist`` the end's gap at X + U), in
-        the order of the pairs. Where both orders of two edges are inside, only the one
+        the order of the pairs. The face: where the midpoint of a is that deep, the one it
+        is less deep behind; else (a part of the edge towards one end inside, the other end
+        out) the face whose plane the deepest end behind it is least deep behind, so that
+        the rows move the edge out by the least. Where both orders of two edges are inside, only the one
         with a on the higher fragment gives rows (the fixed rows' direction): for opposite
         wedges the two are one condition, and rows of both, on different faces, would
         hold the copies out of both half-spaces instead of one.
@@ -148,7 +154,9 @@ def wedge_rows(pairs, displacement, tol, index, vertex_fragment):
     # unit normals at x (a face squeezed flat has no plane: no rows), B's wedge convex or
     # flat (the corner of B's second face off the edge behind or on the first's plane, as
     # edge_rows3d judges an edge), the gaps of a's ends to both planes measured from their
-    # copies on b, and the pairs whose midpoint's gap to the less deep face is below -tol
+    # copies on b (linear along the edge), and the pairs with a point of the edge behind
+    # both planes deeper than tol (the lowest of the larger gap: at an end or where the
+    # two gaps cross)
     inside, nearer, gap = _ext.WedgeInside(x, F, pairs.a, pairs.b, pairs.b_faces, float(tol))
     keep = ~_reverse_also_inside(pairs, inside, vertex_fragment)
     inside, nearer, gap = inside[keep], nearer[keep], gap[keep]
