@@ -4,6 +4,7 @@
 #include "numpy_order.hpp"
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace ngfracture
 {
@@ -16,18 +17,76 @@ namespace ngfracture
         d[k] = x[3 * p + k] - x[3 * q + k];
     }
 
-    // min over s in [0, 1] of max(g[0](s), g[1](s)), g[k](s) = (1 - s) g[k][0] + s g[k][1]: the
-    // deepest that a point of edge a lies behind both planes of B's wedge (a convex piecewise
-    // linear function: at an end, or where the two gaps cross)
-    double LowestAlongEdge (const double g[2][2])
+    // The unit normals of a wedge's two faces fw at x (ok: neither squeezed flat) and whether
+    // the wedge at edge (e0, e1) is convex or flat: the corner of its second face off the
+    // edge behind or on the first's plane.
+    bool WedgeNormals (const double * x, const int64_t * faces, const int64_t * fw, int64_t e0, int64_t e1,
+                       double unit[2][3], bool & convex)
     {
-      double lowest = std::min(std::max(g[0][0], g[1][0]), std::max(g[0][1], g[1][1]));
-      double h0 = g[0][0] - g[1][0], h1 = g[0][1] - g[1][1];
-      if ((h0 < 0 && h1 > 0) || (h0 > 0 && h1 < 0))
+      bool ok = true;
+      for (int k = 0; k < 2; k++)
         {
-          double s = h0 / (h0 - h1);
-          lowest = std::min(lowest, g[0][0] + s * (g[0][1] - g[0][0]));
+          double n[3];
+          AreaVector(x, faces + 3 * fw[k], n);
+          double length = NumpyNorm(n);
+          ok = ok && length > 0;                        // a face squeezed flat has no plane
+          double scale = length > 0 ? length : 1.0;
+          for (int c = 0; c < 3; c++)
+            unit[k][c] = n[c] / scale;
         }
+      const int64_t * second = faces + 3 * fw[1];
+      double d[3];
+      Difference(x, (second[0] + second[1] + second[2]) - (e0 + e1), e0, d);
+      convex = EinsumDot(unit[0], d) <= 0;
+      return ok;
+    }
+
+    // The angle (radians) by which a wedge's corner may lie behind a plane and still count
+    // as in front of it: faces of two wedges on one plane in the reference configuration
+    // (two pieces' faces on a flat outer surface, on the plane of a crack through the
+    // line) turn apart by the strains and the pieces' relative rotation.
+    constexpr double kOnPlane = 1e-2;
+
+    // Whether the corners off edge (e0, e1) of the two faces fw lie in front of the plane
+    // through x_e0 with unit normal n, or behind it by at most kOnPlane of their distance.
+    bool CornersInFront (const double * x, const int64_t * faces, const int64_t * fw, int64_t e0, int64_t e1,
+                         const double * n)
+    {
+      for (int k = 0; k < 2; k++)
+        {
+          const int64_t * f = faces + 3 * fw[k];
+          double d[3];
+          Difference(x, (f[0] + f[1] + f[2]) - (e0 + e1), e0, d);
+          double side = EinsumDot(n, d);
+          if (side < 0 && side < -kOnPlane * NumpyNorm(d))
+            return false;
+        }
+      return true;
+    }
+
+    // min over s in [0, 1] of max over the candidates c with use[c] of G[c](s) = (1 - s)
+    // G[c][0] + s G[c][1]: a convex piecewise linear function, lowest at an end or where
+    // two of the lines cross.
+    double LowestOfMax (const double G[4][2], const bool use[4])
+    {
+      auto at = [&] (double s)
+        {
+          double high = -std::numeric_limits<double>::infinity();
+          for (int c = 0; c < 4; c++)
+            if (use[c])
+              high = std::max(high, G[c][0] + s * (G[c][1] - G[c][0]));
+          return high;
+        };
+      double lowest = std::min(at(0.0), at(1.0));
+      for (int c = 0; c < 4; c++)
+        for (int k = c + 1; k < 4; k++)
+          {
+            if (!use[c] || !use[k])
+              continue;
+            double h0 = G[c][0] - G[k][0], h1 = G[c][1] - G[k][1];
+            if ((h0 < 0 && h1 > 0) || (h0 > 0 && h1 < 0))
+              lowest = std::min(lowest, at(h0 / (h0 - h1)));
+          }
       return lowest;
     }
   }
@@ -187,57 +246,66 @@ namespace ngfracture
   }
 
   void WedgeInside (int64_t m, const double * x, const int64_t * faces, const int64_t * a, const int64_t * b,
-                    const int64_t * fb, double tol, std::vector<int64_t> & pair, std::vector<int64_t> & nearer,
-                    std::vector<double> & gap)
+                    const int64_t * fb, const int64_t * fa, double tol, std::vector<int64_t> & pair,
+                    std::vector<int64_t> & nearer, std::vector<double> & gap)
   {
     pair.clear();
     nearer.clear();
     gap.clear();
     for (int64_t p = 0; p < m; p++)
       {
-        double unit[2][3], g[2][2], middle[2];
-        bool ok = true;
-        for (int k = 0; k < 2; k++)
+        const int64_t * ea = a + 2 * p, * eb = b + 2 * p;
+        double unit[4][3], G[4][2], d[3];
+        bool convex_b, convex_a;
+        bool ok_b = WedgeNormals(x, faces, fb + 2 * p, eb[0], eb[1], unit, convex_b);
+        bool ok_a = WedgeNormals(x, faces, fa + 2 * p, ea[0], ea[1], unit + 2, convex_a);
+        // G[k]: a's ends to B's face k, G[2 + k]: b's ends to A's face k (gaps from the copy)
+        for (int e = 0; e < 2; e++)
           {
-            double n[3];
-            AreaVector(x, faces + 3 * fb[2 * p + k], n);
-            double length = NumpyNorm(n);
-            ok = ok && length > 0;                        // a face squeezed flat has no plane
-            double scale = length > 0 ? length : 1.0;
-            for (int c = 0; c < 3; c++)
-              unit[k][c] = n[c] / scale;
+            Difference(x, ea[e], eb[e], d);
+            for (int k = 0; k < 2; k++)
+              G[k][e] = EinsumDot(unit[k], d);
+            Difference(x, eb[e], ea[e], d);
+            for (int k = 2; k < 4; k++)
+              G[k][e] = EinsumDot(unit[k], d);
           }
-        // the corner of B's second face off the edge: B's wedge is convex (or flat) where
-        // it lies behind (or on) the first's plane
-        const int64_t * second = faces + 3 * fb[2 * p + 1];
-        int64_t third = (second[0] + second[1] + second[2]) - (b[2 * p] + b[2 * p + 1]);
-        double d[3];
-        Difference(x, third, b[2 * p], d);
-        bool convex = EinsumDot(unit[0], d) <= 0;
-        for (int k = 0; k < 2; k++)
-          {
-            for (int e = 0; e < 2; e++)
-              {
-                Difference(x, a[2 * p + e], b[2 * p + e], d);
-                g[k][e] = EinsumDot(unit[k], d);
-              }
-            middle[k] = (g[k][0] + g[k][1]) / 2.0;
-          }
+        double middle[2] = { (G[0][0] + G[0][1]) / 2.0, (G[1][0] + G[1][1]) / 2.0 };
         int near = middle[1] > middle[0] ? 1 : 0;          // np.argmax: the first largest
-        bool inside = std::max(middle[0], middle[1]) < -tol;
-        if (!inside && convex && ok && LowestAlongEdge(g) < -tol)
+        // the midpoint behind both of B's planes: out through the one it is less deep
+        // behind, where that plane has A's wedge in front of it (else it separates nothing)
+        bool inside = convex_b && ok_b && std::max(middle[0], middle[1]) < -tol
+          && CornersInFront(x, faces, fa + 2 * p, ea[0], ea[1], unit[near]);
+        if (!inside && convex_b && convex_a && ok_b && ok_a)
           {
-            // a part of the edge off its middle inside: the face whose plane the deepest end
-            // behind it is least deep behind (out through it the edge needs the least motion)
-            inside = true;
-            near = std::max(-g[1][0], -g[1][1]) < std::max(-g[0][0], -g[0][1]) ? 1 : 0;
+            // the planes that can separate the wedges: B's faces with A's wedge in front,
+            // A's faces with B's in front; a point of the edge where every one of them
+            // reads a gap below -tol is inside
+            bool use[4];
+            for (int k = 0; k < 2; k++)
+              {
+                use[k] = CornersInFront(x, faces, fa + 2 * p, ea[0], ea[1], unit[k]);
+                use[2 + k] = CornersInFront(x, faces, fb + 2 * p, eb[0], eb[1], unit[2 + k]);
+              }
+            if ((use[0] || use[1] || use[2] || use[3]) && LowestOfMax(G, use) < -tol)
+              {
+                // the plane whose deepest end behind it is least deep: the rows that move
+                // the edges apart by the least
+                inside = true;
+                double best = std::numeric_limits<double>::infinity();
+                for (int c = 0; c < 4; c++)
+                  if (use[c] && std::max(-G[c][0], -G[c][1]) < best)
+                    {
+                      best = std::max(-G[c][0], -G[c][1]);
+                      near = c;
+                    }
+              }
           }
-        if (convex && inside && ok)
+        if (inside)
           {
             pair.push_back(p);
             nearer.push_back(near);
-            gap.push_back(g[near][0]);
-            gap.push_back(g[near][1]);
+            gap.push_back(G[near][0]);
+            gap.push_back(G[near][1]);
           }
       }
   }

@@ -59,15 +59,18 @@ namespace ngfracture
                           const int64_t * face, const int64_t * corner, double tol, std::vector<int64_t> & hit,
                           std::vector<double> & gap);
 
-  // The diagonal edge pairs (a on A, b on B, b's faces fb) at x with a point of a behind
-  // both planes of B's convex (or flat) wedge deeper than tol. pair: their numbers,
-  // increasing; nearer: where the midpoint of a is that deep, the face it is less deep
-  // behind (0 or 1, the first on a tie), else the face whose plane the deepest end of a
-  // behind it is least deep behind (0 on a tie); gap: the gaps of a's two ends to that
-  // face (2 per pair).
+  // The diagonal edge pairs (a on A, b on B, b's faces fb, a's faces fa) at x whose wedges
+  // overlap deeper than tol somewhere along the edge. Where the midpoint of a lies behind
+  // both planes of B's convex (or flat) wedge that deep: nearer the face it is less deep
+  // behind (0 or 1, the first on a tie). Else, both wedges convex: the planes that can
+  // separate them (B's face k, 0 or 1, with A's wedge in front of it; A's face k, 2 + k,
+  // with B's in front), each reading its gap (a's ends to B's face, b's ends to A's face,
+  // from the copies; linear along the edge), inside where all read below -tol at one
+  // point; nearer the one whose deepest end behind it is least deep (the first on a tie).
+  // pair: their numbers, increasing; gap: the two ends' gaps to the nearer face (2 per pair).
   void WedgeInside (int64_t m, const double * x, const int64_t * faces, const int64_t * a, const int64_t * b,
-                    const int64_t * fb, double tol, std::vector<int64_t> & pair, std::vector<int64_t> & nearer,
-                    std::vector<double> & gap);
+                    const int64_t * fb, const int64_t * fa, double tol, std::vector<int64_t> & pair,
+                    std::vector<int64_t> & nearer, std::vector<double> & gap);
 
   // The pairs of copies of a boundary edge (a, b, b's faces fb, partner: whether b's face
   // k is coincident with a face at a; wedges3d.edge_copies) at x whose B wedge at b is

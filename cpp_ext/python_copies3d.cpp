@@ -204,7 +204,7 @@ gap : numpy.ndarray
 )doc");
 
   m.def("WedgeInside",
-        [] (DArr x, LArr faces, LArr a, LArr b, LArr b_faces, double tol)
+        [] (DArr x, LArr faces, LArr a, LArr b, LArr b_faces, LArr a_faces, double tol)
         {
           const char * fn = "WedgeInside";
           Check(fn, "x", x, 2, 3);
@@ -212,47 +212,57 @@ gap : numpy.ndarray
           Check(fn, "a", a, 2, 2);
           Check(fn, "b", b, 2, 2, a.shape(0));
           Check(fn, "b_faces", b_faces, 2, 2, a.shape(0));
+          Check(fn, "a_faces", a_faces, 2, 2, a.shape(0));
           int64_t nv = x.shape(0), nf = faces.shape(0);
           CheckRange(fn, "faces", faces, nv);
           CheckRange(fn, "a", a, nv);
           CheckRange(fn, "b", b, nv);
           CheckRange(fn, "b_faces", b_faces, nf);
-          for (py::ssize_t p = 0; p < a.shape(0); p++)
-            for (int k = 0; k < 2; k++)
-              {
-                const int64_t * f = faces.data() + 3 * b_faces.data()[2 * p + k];
-                for (int e = 0; e < 2; e++)
+          CheckRange(fn, "a_faces", a_faces, nf);
+          auto holds = [&] (LArr & fw, LArr & edge, const char * name)
+            {
+              for (py::ssize_t p = 0; p < a.shape(0); p++)
+                for (int k = 0; k < 2; k++)
                   {
-                    int64_t v = b.data()[2 * p + e];
-                    if (f[0] != v && f[1] != v && f[2] != v)
-                      throw std::invalid_argument("ngfracture.WedgeInside: b_faces[" + std::to_string(p) + ", "
-                                                  + std::to_string(k) + "] does not hold edge b");
+                    const int64_t * f = faces.data() + 3 * fw.data()[2 * p + k];
+                    for (int e = 0; e < 2; e++)
+                      {
+                        int64_t v = edge.data()[2 * p + e];
+                        if (f[0] != v && f[1] != v && f[2] != v)
+                          throw std::invalid_argument(std::string("ngfracture.WedgeInside: ") + name + "_faces["
+                                                      + std::to_string(p) + ", " + std::to_string(k)
+                                                      + "] does not hold edge " + name);
+                      }
                   }
-              }
+            };
+          holds(b_faces, b, "b");
+          holds(a_faces, a, "a");
           std::vector<int64_t> pair, nearer;
           std::vector<double> gap;
           {
             py::gil_scoped_release release;
-            WedgeInside(a.shape(0), x.data(), faces.data(), a.data(), b.data(), b_faces.data(), tol, pair, nearer,
-                        gap);
+            WedgeInside(a.shape(0), x.data(), faces.data(), a.data(), b.data(), b_faces.data(), a_faces.data(), tol,
+                        pair, nearer, gap);
           }
           py::array_t<double> G = ToNumpy(gap, 2);
           if (gap.empty())
             G = py::array_t<double>(std::vector<py::ssize_t>{ 0, 2 });
           return py::make_tuple(ToNumpy(pair), ToNumpy(nearer), G);
         },
-        py::arg("x"), py::arg("faces"), py::arg("a"), py::arg("b"), py::arg("b_faces"), py::arg("tol"),
-        R"doc(The diagonal edge pairs whose edge a's midpoint lies deeper than tol in B's convex wedge.
+        py::arg("x"), py::arg("faces"), py::arg("a"), py::arg("b"), py::arg("b_faces"), py::arg("a_faces"),
+        py::arg("tol"),
+        R"doc(The diagonal edge pairs whose wedges overlap deeper than tol somewhere along the edge.
 
 Returns
 -------
 pair : numpy.ndarray of int64
     The pairs inside, increasing.
 nearer : numpy.ndarray of int64
-    The less deep of B's two faces (0 or 1).
+    The face whose rows hold them apart: 0 or 1 one of B's (a's ends its slaves), 2 or 3
+    one of A's (b's ends its slaves).
 gap : numpy.ndarray, shape (k, 2)
-    The gaps of a's two ends to that face's plane at x, bit for bit the numpy
-    computation of wedges3d.wedge_rows.
+    The gaps of the slaves to that face's plane at x, bit for bit the numpy computation
+    of wedges3d.wedge_rows.
 )doc");
 
   m.def("ReflexWedgeGaps",

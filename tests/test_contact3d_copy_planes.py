@@ -36,6 +36,7 @@ from ngfracture.contact.setup3d import MeshSetup3d
 from ngfracture.contact.wedges3d import diagonal_edges, wedge_rows
 from ngfracture.geometry.solid import merge_bodies
 from ngfracture.geometry.structured import box_mesh
+from ngfracture.output.overlap3d import fragment_overlap_volume
 
 LOW, HIGH, Z = np.linspace(0.0, 0.5, 3), np.linspace(0.5, 1.0, 3), np.linspace(0.0, 0.5, 3)
 
@@ -172,3 +173,65 @@ def test_an_edge_inside_the_wedge_towards_one_end_only_gets_the_row_of_that_end(
     assert abs(rows.dist[0] + d / np.sqrt(1 + 256 * d * d)) <= 1e-12 * d
     # its linearisation, with the face's reference normal (0, 1, 0): -d
     assert abs(rows.C[0] @ U.T.ravel() + rows.g[0] + d) <= 1e-12 * d
+
+
+def _unit(degrees):
+    t = np.radians(degrees)
+    return np.array([np.cos(t), np.sin(t), 0.0])
+
+
+@pytest.fixture(scope="module")
+def surface_blocks():
+    """Three blocks around the line x = y = 0 meshed apart, quadrants mapped linearly onto the
+    sectors A [0, 60] (fragment 0), C [60, 120] (1) and B [120, 180] (2), the outside below
+    y = 0: A's and B's wedges at the line are both bounded by the plane y = 0 (as two
+    pieces' faces on a flat outer surface) and share no face."""
+    neg, pos, zs = np.linspace(-0.5, 0.0, 3), np.linspace(0.0, 0.5, 3), [0.0, 0.25, 0.5]
+    arrays = merge_bodies([("a", box_mesh(pos, pos, zs)), ("c", box_mesh(neg, pos, zs)), ("b", box_mesh(neg, neg, zs))])
+    P = arrays.points
+    x, y = P[:, :1], P[:, 1:2]
+    q1 = x * _unit(0) + y * _unit(60)
+    q2 = y * _unit(60) - x * _unit(120)
+    q3 = -x * _unit(120) - y * _unit(180)
+    mapped = np.where((x >= 0) & (y >= 0), q1, np.where(y >= 0, q2, q3)) + 0.0   # one formula per point
+    mapped[:, 2] = P[:, 2]
+    arrays.points = mapped
+    fragment = (arrays.regions - 1).astype(np.int64)
+    return arrays, MeshSetup3d(arrays.points, arrays.tets, arrays.faces, fragment)
+
+
+def test_wedges_on_one_plane_overlap_exactly_where_their_rows_read_a_penetration(surface_blocks):
+    """A moved by random in-plane translations d (|d_x|, |d_y| <= 1e-3): A and B overlap
+    (exact clipping of their tetrahedra) exactly where the wedge rows of the line read a
+    negative gap. The planes that can separate them are B's face at 120 degrees and A's at
+    60 (the plane y = 0 has the other wedge behind it), with the gaps n_B . d and -n_A . d;
+    a translation along y = 0 towards B, which B's planes read as on one (gap 0) and behind
+    the other, overlaps: the midpoint rule alone, behind both of B's planes, misses it.
+    Every row is on one of the two separating planes, never on y = 0."""
+    arrays, setup = surface_blocks
+    X, T = arrays.points, arrays.tets
+    vf = setup.vertex_fragment
+    piece = vf[T[:, 0]]
+    n_b, n_a = _unit(30), _unit(150)                       # outward normals of B at 120, A at 60
+    rng = np.random.default_rng(3)
+    moves = [np.array([-1e-3, 0.0])] + [1e-3 * rng.uniform(-1, 1, 2) for _ in range(60)]
+    checked = missed_by_middle = 0
+    for d in moves:
+        separating = np.array([n_b[:2] @ d, -(n_a[:2] @ d)])
+        if np.abs(separating).min() < 1e-6:
+            continue                                        # on a boundary of the allowed set
+        U = np.zeros_like(X)
+        U[vf == 0, :2] = d
+        rows = wedge_rows(setup.diagonal_edges, U, 0.0, setup.copy_index, vf)
+        overlap = fragment_overlap_volume(X + U, T, piece)
+        ab = sum(v for (s, t), v in zip(overlap.pairs, overlap.volumes) if {piece[s], piece[t]} == {0, 2})
+        assert (ab > 0) == (len(rows) > 0), (d, ab, rows.dist)
+        if len(rows):
+            assert separating.max() < 0
+            # every row on a plane that separates the wedges (B's at 120, A's at 60), with its gap
+            plane = np.abs(rows.normal @ n_b) > 1 - 1e-12
+            assert np.all(plane | (np.abs(rows.normal @ n_a) > 1 - 1e-12))
+            assert np.allclose(rows.dist, np.where(plane, separating[0], separating[1]), rtol=1e-12, atol=0)
+            missed_by_middle += max(-d[1], separating[0]) >= 0      # B's plane y = 0 reads -d_y
+        checked += 1
+    assert checked >= 50 and missed_by_middle >= 1

@@ -123,46 +123,87 @@ def reference_behind_partner_rows(partners, displacement, tol, index):
     return rows_at_copy(slave[hit], face[hit], corner[hit], gap[hit], index)
 
 
+def reference_wedge_normals(x, F, fw, edge):
+    """Unit normals of a wedge's two faces per pair, whether neither is squeezed flat, and
+    whether the wedge is convex or flat (the second face's corner off the edge behind or on
+    the first's plane)."""
+    normals, ok = [], np.ones(len(fw), dtype=bool)
+    for k in range(2):
+        tri = x[F[fw[:, k]]]
+        n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+        length = np.linalg.norm(n, axis=1)
+        ok &= length > 0
+        normals.append(n / np.where(length > 0, length, 1.0)[:, None])
+    third = F[fw[:, 1]].sum(axis=1) - edge.sum(axis=1)
+    convex = np.einsum("ij,ij->i", normals[0], x[third] - x[edge[:, 0]]) <= 0
+    return normals, ok, convex
+
+
+def reference_corners_in_front(x, F, fw, edge, n):
+    """Both faces' corners off the edge in front of the plane through the edge's first end
+    with normal n, or behind it by at most 1e-2 of their distance."""
+    front = np.ones(len(fw), dtype=bool)
+    for k in range(2):
+        d = x[F[fw[:, k]].sum(axis=1) - edge.sum(axis=1)] - x[edge[:, 0]]
+        side = np.einsum("ij,ij->i", n, d)
+        front &= ~((side < 0) & (side < -1e-2 * np.linalg.norm(d, axis=1)))
+    return front
+
+
+def reference_lowest_of_max(G, use):
+    """Per pair the lowest over s in [0, 1] of the largest G[c](s) of the used candidates."""
+    def at(s):
+        line = G[:, :, 0] + s[:, None] * (G[:, :, 1] - G[:, :, 0])
+        return np.where(use, line, -np.inf).max(axis=1)
+    m = len(G)
+    lowest = np.minimum(at(np.zeros(m)), at(np.ones(m)))
+    for c in range(4):
+        for k in range(c + 1, 4):
+            h0, h1 = G[:, c, 0] - G[:, k, 0], G[:, c, 1] - G[:, k, 1]
+            cross = use[:, c] & use[:, k] & (((h0 < 0) & (h1 > 0)) | ((h0 > 0) & (h1 < 0)))
+            s = h0 / np.where(cross, h0 - h1, 1.0)
+            lowest = np.where(cross, np.minimum(lowest, at(s)), lowest)
+    return lowest
+
+
 def reference_wedge_rows(pairs, displacement, tol, index, vertex_fragment):
     """The numpy computation of wedges3d.wedge_rows."""
     X, F = index.points, index.faces
     nv = len(X)
     x = X + np.asarray(displacement, dtype=np.float64)
-    a, b, fb = pairs.a, pairs.b, pairs.b_faces
-    normals, ok = [], np.ones(len(a), dtype=bool)
-    for k in range(2):
-        tri = x[F[fb[:, k]]]
-        n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
-        length = np.linalg.norm(n, axis=1)
-        ok &= length > 0
-        normals.append(n / np.where(length > 0, length, 1.0)[:, None])
-    third = F[fb[:, 1]].sum(axis=1) - b.sum(axis=1)
-    convex = np.einsum("ij,ij->i", normals[0], x[third] - x[b[:, 0]]) <= 0
-    gap = np.stack([np.stack([np.einsum("ij,ij->i", normals[k], x[a[:, e]] - x[b[:, e]]) for e in range(2)], axis=1)
-                    for k in range(2)], axis=1)
-    middle = gap.mean(axis=2)
+    a, b, fb, fa = pairs.a, pairs.b, pairs.b_faces, pairs.a_faces
+    nb, ok_b, convex_b = reference_wedge_normals(x, F, fb, b)
+    na, ok_a, convex_a = reference_wedge_normals(x, F, fa, a)
+    normals = nb + na
+    # G[:, c, e]: a's ends to B's faces (c = 0, 1), b's ends to A's faces (c = 2, 3)
+    G = np.stack([np.stack([np.einsum("ij,ij->i", normals[c], x[a[:, e]] - x[b[:, e]] if c < 2 else x[b[:, e]] - x[a[:, e]])
+                            for e in range(2)], axis=1) for c in range(4)], axis=1)
+    middle = G[:, :2].mean(axis=2)
     nearer = np.argmax(middle, axis=1)
-    by_middle = middle.max(axis=1) < -tol
-    # the lowest of max(g0(s), g1(s)) along the edge: at an end or where the two gaps cross
-    lowest = np.minimum(gap.max(axis=1)[:, 0], gap.max(axis=1)[:, 1])
-    h = gap[:, 0] - gap[:, 1]
-    cross = ((h[:, 0] < 0) & (h[:, 1] > 0)) | ((h[:, 0] > 0) & (h[:, 1] < 0))
-    s = h[:, 0] / np.where(cross, h[:, 0] - h[:, 1], 1.0)
-    lowest = np.where(cross, np.minimum(lowest, gap[:, 0, 0] + s * (gap[:, 0, 1] - gap[:, 0, 0])), lowest)
-    deepest = np.max(-gap, axis=2)                      # per face: its deepest end
-    off_middle = ~by_middle & (lowest < -tol)
-    nearer = np.where(off_middle, (deepest[:, 1] < deepest[:, 0]).astype(np.int64), nearer)
-    inside = convex & (by_middle | off_middle) & ok
+    use = np.stack([reference_corners_in_front(x, F, fa, a, normals[0]), reference_corners_in_front(x, F, fa, a, normals[1]),
+                    reference_corners_in_front(x, F, fb, b, normals[2]), reference_corners_in_front(x, F, fb, b, normals[3])],
+                   axis=1)
+    by_middle = convex_b & ok_b & (middle.max(axis=1) < -tol) & use[np.arange(len(a)), nearer]
+    both = ~by_middle & convex_b & convex_a & ok_b & ok_a & use.any(axis=1)
+    other = both & (reference_lowest_of_max(G, use) < -tol)
+    deepest = np.where(use, np.max(-G, axis=2), np.inf)
+    nearer = np.where(other, np.argmin(deepest, axis=1), nearer)
+    inside = by_middle | other
     vf = np.asarray(vertex_fragment, dtype=np.int64)
     n = np.int64(max(int(pairs.edge_a.max(initial=0)), int(pairs.edge_b.max(initial=0))) + 1)
     code, reverse = pairs.edge_a * n + pairs.edge_b, pairs.edge_b * n + pairs.edge_a
     inside &= ~(inside & isin_ints(reverse, code[inside]) & (vf[pairs.a[:, 0]] < vf[pairs.b[:, 0]]))
-    pair, end = np.nonzero(inside[:, None] & (gap[np.arange(len(a)), nearer] < 0))
+    chosen = G[np.arange(len(a)), nearer]
+    pair, end = np.nonzero(inside[:, None] & (chosen < 0))
     if not len(pair):
         return no_face_rows(nv)
-    face = fb[pair, nearer[pair]]
-    corner = np.argmax(F[face] == b[pair, end][:, None], axis=1)
-    return rows_at_copy(a[pair, end], face, corner, gap[pair, nearer[pair], end], index)
+    k = nearer[pair]
+    on_b = k < 2
+    slave = np.where(on_b, a[pair, end], b[pair, end])
+    copy = np.where(on_b, b[pair, end], a[pair, end])
+    face = np.where(on_b, fb[pair, k % 2], fa[pair, k % 2])
+    corner = np.argmax(F[face] == copy[:, None], axis=1)
+    return rows_at_copy(slave, face, corner, chosen[pair, end], index)
 
 
 def reference_edge_copies(edges, faces_at_edge, index):
@@ -378,7 +419,11 @@ def test_bad_input_names_the_argument(blocks):
     other = d.b_faces.copy()
     other[0, 1] = next(f for f in range(len(F)) if not set(d.b[0]) <= set(F[f]))
     with pytest.raises(ValueError, match=r"b_faces\[0, 1\] does not hold edge b"):
-        ext.WedgeInside(x, F, d.a, d.b, other, 0.0)
+        ext.WedgeInside(x, F, d.a, d.b, other, d.a_faces, 0.0)
+    other = d.a_faces.copy()
+    other[0, 0] = next(f for f in range(len(F)) if not set(d.a[0]) <= set(F[f]))
+    with pytest.raises(ValueError, match=r"a_faces\[0, 0\] does not hold edge a"):
+        ext.WedgeInside(x, F, d.a, d.b, d.b_faces, other, 0.0)
     e = setup.edge_copies
     with pytest.raises(ValueError, match="partner must have shape"):
         ext.ReflexWedgeGaps(x, F, e.a, e.b, e.b_faces, e.partner[:-1], 0.0)

@@ -14,17 +14,20 @@ a tetrahedron) finds nothing; the edge-to-edge rows leave pairs at copies of a p
 :func:`diagonal_edges` lists, once per mesh, every ordered pair (edge a on A, edge b on B)
 of boundary edges on the same two reference points on different fragments with no face of
 A at a coincident with a face of B at b. :func:`wedge_rows` tests them at a configuration:
-where B's wedge at b is convex and a point of a lies behind both of its faces' planes
-deeper than ``tol`` (measured from b's point there; the gaps are linear along the edge),
-the ends of a behind the plane of one face get the row of that face, projected at their
-copy on b (barycentric 1 there), with the face's unit normal of the reference
-configuration: the rows at copies' form
+where B's wedge at b is convex and the midpoint of a lies behind both of its faces' planes
+deeper than ``tol`` (measured from b's midpoint), the ends of a behind the plane of the
+less deep face, where A's wedge lies in front of that plane, get the row of that face,
+projected at their copy on b (barycentric 1 there), with the face's unit normal of the
+reference configuration: the rows at copies' form
 (:func:`~ngfracture.contact.copies3d.found_rows_at_copies`), so that the active set
 re-linearises them as it does those. Out of B's wedge, the edge line keeps out of it
-through one face or the other: a union, of which the rows keep the one nearer to hold
-(the face the midpoint is less deep behind, or, where only a part of the edge towards
-one end is inside, the face that the deepest end behind it is least deep behind;
-docs/contact.md, "Rows at copies found by their planes").
+through one face or the other: a union, of which the row keeps the one nearer to hold.
+Elsewhere, both wedges convex, the wedges overlap where every plane that can separate
+them (a face of B with A's wedge in front of it, a face of A with B's in front) reads a
+gap below ``-tol`` at one point of the edge (the gaps are linear along it), and the rows
+are those of the separating plane that the deepest end behind it is least deep behind:
+a's ends on B's face or b's ends on A's face (docs/contact.md, "Rows at copies found by
+their planes").
 
 Where B's wedge at b is reflex (wider than pi) its complement is convex: the intersection of
 the half-spaces in front of its two faces, and every other copy a of the edge must keep out
@@ -64,12 +67,15 @@ class DiagonalEdges:
         The two boundary faces of B at edge b.
     edge_a, edge_b : numpy.ndarray of int64, shape (m,)
         The numbers of edges a and b among the boundary edges.
+    a_faces : numpy.ndarray of int64, shape (m, 2)
+        The two boundary faces of A at edge a.
     """
     a: np.ndarray
     b: np.ndarray
     b_faces: np.ndarray
     edge_a: np.ndarray
     edge_b: np.ndarray
+    a_faces: np.ndarray
 
     def __len__(self):
         return len(self.a)
@@ -105,7 +111,8 @@ def diagonal_edges(edges, faces_at_edge, vertex_fragment, index):
     at = np.asarray(faces_at_edge, dtype=np.int64).reshape(-1, 2)
     vf = np.asarray(vertex_fragment, dtype=np.int64)
     pid = index.point
-    none = DiagonalEdges(*(np.zeros((0, 2), np.int64) for _ in range(3)), *(np.zeros(0, np.int64) for _ in range(2)))
+    none = DiagonalEdges(*(np.zeros((0, 2), np.int64) for _ in range(3)), *(np.zeros(0, np.int64) for _ in range(2)),
+                         np.zeros((0, 2), np.int64))
     if not len(E):
         return none
     # C++ (cpp_ext/contact_setup3d.cpp): the edges on the same two points pairwise, on two
@@ -113,11 +120,11 @@ def diagonal_edges(edges, faces_at_edge, vertex_fragment, index):
     # sorted by (a, b). The same arrays as the numpy computation that
     # tests/test_contact3d_setup_kernels.py keeps and compares
     a, b, ends_b = _ext.DiagonalEdgePairs(E, at, vf, pid, index.face_key)
-    return DiagonalEdges(take_rows(E, a), ends_b, take_rows(at, b), a, b)
+    return DiagonalEdges(take_rows(E, a), ends_b, take_rows(at, b), a, b, take_rows(at, a))
 
 
 def wedge_rows(pairs, displacement, tol, index, vertex_fragment):
-    """Rows for the ends of junction edges a point of which lies deeper than ``tol`` in a diagonal neighbour's wedge.
+    """Rows for the ends of junction edges whose wedge overlaps a diagonal neighbour's deeper than ``tol``.
 
     Parameters
     ----------
@@ -126,7 +133,8 @@ def wedge_rows(pairs, displacement, tol, index, vertex_fragment):
     displacement : numpy.ndarray, shape (nv, 3)
         Displacements U: the configuration X + U tested.
     tol : float
-        Depth (a length) of a point of the edge behind both faces' planes that makes rows.
+        Depth (a length) of the overlap that makes rows: of the midpoint of a behind both of
+        B's planes, or of a point of the edge behind every separating plane.
     index : ngfracture.contact.kinks3d.CopyIndex
         The index of the mesh's reference points X and boundary faces.
     vertex_fragment : numpy.ndarray of int, shape (nv,)
@@ -135,12 +143,12 @@ def wedge_rows(pairs, displacement, tol, index, vertex_fragment):
     Returns
     -------
     NodeToFaceRows
-        For every such pair the rows of a's ends behind the chosen face's plane, on that
-        face, projected at the end's copy (``g`` 0, ``dist`` the end's gap at X + U), in
-        the order of the pairs. The face: where the midpoint of a is that deep, the one it
-        is less deep behind; else (a part of the edge towards one end inside, the other end
-        out) the face whose plane the deepest end behind it is least deep behind, so that
-        the rows move the edge out by the least. Where both orders of two edges are inside, only the one
+        For every such pair the rows of the slaves behind the chosen face's plane, on that
+        face, projected at the slave's copy (``g`` 0, ``dist`` the slave's gap at X + U),
+        in the order of the pairs. The face: where the midpoint of a is that deep, the face
+        of B it is less deep behind if that face separates (a's ends the slaves); else the separating plane whose
+        deepest end behind it is least deep behind, so that the rows move the edges apart
+        by the least: a face of B (a's ends the slaves) or of A (b's ends). Where both orders of two edges are inside, only the one
         with a on the higher fragment gives rows (the fixed rows' direction): for opposite
         wedges the two are one condition, and rows of both, on different faces, would
         hold the copies out of both half-spaces instead of one.
@@ -150,23 +158,25 @@ def wedge_rows(pairs, displacement, tol, index, vertex_fragment):
     if not len(pairs):
         return no_face_rows(nv)
     x = X + np.asarray(displacement, dtype=np.float64)
-    # C++ (cpp_ext/copies3d.cpp), bit for bit the numpy computation: per pair B's two
-    # unit normals at x (a face squeezed flat has no plane: no rows), B's wedge convex or
-    # flat (the corner of B's second face off the edge behind or on the first's plane, as
-    # edge_rows3d judges an edge), the gaps of a's ends to both planes measured from their
-    # copies on b (linear along the edge), and the pairs with a point of the edge behind
-    # both planes deeper than tol (the lowest of the larger gap: at an end or where the
-    # two gaps cross)
-    inside, nearer, gap = _ext.WedgeInside(x, F, pairs.a, pairs.b, pairs.b_faces, float(tol))
+    # C++ (cpp_ext/copies3d.cpp), bit for bit the numpy computation that
+    # tests/test_copies3d_kernels.py keeps: per pair both wedges' unit normals at x (a face
+    # squeezed flat has no plane: no rows), each wedge convex or flat (the corner of its
+    # second face off the edge behind or on the first's plane, as edge_rows3d judges an
+    # edge), the gaps of a's ends to B's planes and of b's ends to A's (from their copies,
+    # linear along the edge), which planes separate, and the pairs that overlap
+    inside, nearer, gap = _ext.WedgeInside(x, F, pairs.a, pairs.b, pairs.b_faces, pairs.a_faces, float(tol))
     keep = ~_reverse_also_inside(pairs, inside, vertex_fragment)
     inside, nearer, gap = inside[keep], nearer[keep], gap[keep]
     pair, end = np.nonzero(gap < 0)                                   # the ends behind that face's plane
     if not len(pair):
         return no_face_rows(nv)
-    p = inside[pair]
-    face = pairs.b_faces[p, nearer[pair]]
-    corner = np.argmax(F[face] == pairs.b[p, end][:, None], axis=1)
-    return rows_at_copy(pairs.a[p, end], face, corner, gap[pair, end], index)
+    p, k = inside[pair], nearer[pair]
+    on_b = k < 2                                  # a face of B, a's ends the slaves; else one of A, b's ends
+    slave = np.where(on_b, pairs.a[p, end], pairs.b[p, end])
+    copy = np.where(on_b, pairs.b[p, end], pairs.a[p, end])
+    face = np.where(on_b, pairs.b_faces[p, k % 2], pairs.a_faces[p, k % 2])
+    corner = np.argmax(F[face] == copy[:, None], axis=1)
+    return rows_at_copy(slave, face, corner, gap[pair, end], index)
 
 
 def _reverse_also_inside(pairs, inside, vertex_fragment):
