@@ -21,6 +21,26 @@ namespace
         throw std::invalid_argument(std::string("ngfracture.") + fn + ": key_start and key_count of face "
                                     + std::to_string(f) + " leave key_order");
   }
+
+  // both faces fw[p] (m x 2) of every pair hold both ends of edge[p] (m x 2); `name` the
+  // edge's name in the message ("a" or "b": the array <name>_faces)
+  void CheckFacesHoldEdges (const char * fn, const LArr & faces, const LArr & fw, const LArr & edge,
+                            const std::string & name)
+  {
+    for (py::ssize_t p = 0; p < edge.shape(0); p++)
+      for (int k = 0; k < 2; k++)
+        {
+          const int64_t * f = faces.data() + 3 * fw.data()[2 * p + k];
+          for (int e = 0; e < 2; e++)
+            {
+              int64_t v = edge.data()[2 * p + e];
+              if (f[0] != v && f[1] != v && f[2] != v)
+                throw std::invalid_argument(std::string("ngfracture.") + fn + ": " + name + "_faces["
+                                            + std::to_string(p) + ", " + std::to_string(k)
+                                            + "] does not hold edge " + name);
+            }
+        }
+  }
 }
 
 void ExportCopies3d (py::module & m)
@@ -219,24 +239,8 @@ gap : numpy.ndarray
           CheckRange(fn, "b", b, nv);
           CheckRange(fn, "b_faces", b_faces, nf);
           CheckRange(fn, "a_faces", a_faces, nf);
-          auto holds = [&] (LArr & fw, LArr & edge, const char * name)
-            {
-              for (py::ssize_t p = 0; p < a.shape(0); p++)
-                for (int k = 0; k < 2; k++)
-                  {
-                    const int64_t * f = faces.data() + 3 * fw.data()[2 * p + k];
-                    for (int e = 0; e < 2; e++)
-                      {
-                        int64_t v = edge.data()[2 * p + e];
-                        if (f[0] != v && f[1] != v && f[2] != v)
-                          throw std::invalid_argument(std::string("ngfracture.WedgeInside: ") + name + "_faces["
-                                                      + std::to_string(p) + ", " + std::to_string(k)
-                                                      + "] does not hold edge " + name);
-                      }
-                  }
-            };
-          holds(b_faces, b, "b");
-          holds(a_faces, a, "a");
+          CheckFacesHoldEdges(fn, faces, b_faces, b, "b");
+          CheckFacesHoldEdges(fn, faces, a_faces, a, "a");
           std::vector<int64_t> pair, nearer;
           std::vector<double> gap;
           {
@@ -282,18 +286,7 @@ gap : numpy.ndarray, shape (k, 2)
           CheckRange(fn, "a", a, nv);
           CheckRange(fn, "b", b, nv);
           CheckRange(fn, "b_faces", b_faces, nf);
-          for (py::ssize_t p = 0; p < a.shape(0); p++)
-            for (int k = 0; k < 2; k++)
-              {
-                const int64_t * f = faces.data() + 3 * b_faces.data()[2 * p + k];
-                for (int e = 0; e < 2; e++)
-                  {
-                    int64_t v = b.data()[2 * p + e];
-                    if (f[0] != v && f[1] != v && f[2] != v)
-                      throw std::invalid_argument("ngfracture.ReflexWedgeGaps: b_faces[" + std::to_string(p) + ", "
-                                                  + std::to_string(k) + "] does not hold edge b");
-                  }
-              }
+          CheckFacesHoldEdges(fn, faces, b_faces, b, "b");
           std::vector<int64_t> pair;
           std::vector<double> gap;
           {
