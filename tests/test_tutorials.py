@@ -19,7 +19,7 @@ from nbclient import NotebookClient
 ROOT = Path(__file__).resolve().parent.parent
 TUTORIALS = ROOT / "tutorials"
 NOTEBOOKS = sorted(TUTORIALS.glob("[0-9][0-9]_*.ipynb"))
-TIMEOUT = 900  # seconds per cell; the run of tutorial 8 (a 3D fragmentation, 26 steps) takes about 6 minutes of CPU
+TIMEOUT = 900  # seconds per cell; the run of tutorial 8 (a 3D fragmentation, 27 steps) takes about 3 minutes of CPU
 
 
 def _sync_module():
