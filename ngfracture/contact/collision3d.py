@@ -68,7 +68,11 @@ wedge, and the nearest face is the coincident lip at another copy, which v is in
 (the coarse confined sphere at x = 2.70e-3: v 1.4e-5 behind the lip at t, reported
 2.35e-5 deep on the lip at the third copy, whose row did not hold it; the coarse free
 sphere's step after x = 1.931e-3, two copies on F: v 8.85e-6 behind the crack face at
-t). If neither gives a face, the holding
+t). Where t is F's only copy of the point, the same for the lips whose other side is on F
+too: a crack of F that ends at t (its front through the point), into whose slit v can
+slide and on across its other lip (the coarse random box of ``random_solids.draw(2,
+coarse=True)``: a copy 1.8e-4 behind such a lip, the nearest face its coincident lip,
+which v was in front of). If neither gives a face, the holding
 tetrahedron has no boundary face at t and three or more copies lie on F (v slid past the
 faces of the tetrahedra at t deeper into t's star where several cracks meet): the lip at
 t, of any tetrahedron, that v is least deep behind, if v is behind one; the nearest face

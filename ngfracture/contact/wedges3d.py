@@ -146,9 +146,10 @@ def wedge_rows(pairs, displacement, tol, index, vertex_fragment):
         For every such pair the rows of the slaves behind the chosen face's plane, on that
         face, projected at the slave's copy (``g`` 0, ``dist`` the slave's gap at X + U),
         in the order of the pairs. The face: where the midpoint of a is that deep, the face
-        of B it is less deep behind if that face separates (a's ends the slaves); else the separating plane whose
-        deepest end behind it is least deep behind, so that the rows move the edges apart
-        by the least: a face of B (a's ends the slaves) or of A (b's ends). Where both orders of two edges are inside, only the one
+        of B it is less deep behind if that face separates (a's ends the slaves); else
+        the separating plane whose deepest end behind it is least deep behind, so that the
+        rows move the edges apart by the least: a face of B (a's ends the slaves) or of A
+        (b's ends). Where both orders of two edges are inside, only the one
         with a on the higher fragment gives rows (the fixed rows' direction): for opposite
         wedges the two are one condition, and rows of both, on different faces, would
         hold the copies out of both half-spaces instead of one.
