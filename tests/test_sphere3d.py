@@ -231,7 +231,7 @@ def test_run_confined(tmp_path):
 def test_run_free(tmp_path):
     """sphere3d_free on the coarse mesh: the same invariants per step to the end of its
     load range, and it falls apart (the core and at least two glass pieces), as the 2D
-    disintegration (68 steps, 31 fragments at the end: docs/solid.md, "The coarse runs")."""
+    disintegration (67 steps, 40 fragments at the end: docs/solid.md, "The coarse runs")."""
     steps, result = run_with_checks(sphere3d_free(**COARSE), tmp_path)
     assert result.ok and result.reason in ("load_max", "broken"), result.message
     assert steps[-1][5] >= 3
