@@ -249,24 +249,23 @@ namespace ngfracture
         }
       double depth = 0;
       int32_t sep = t_copy >= 0 ? SeparatingFace(m, vfaces, T, v, t_copy, m.tets + 4*t, depth) : -1;
-      // none, and two or more copies of the point on F (a crack inside F, or cracks
-      // meeting inside F): v's wedge can lie across the plane of the lip it crossed
-      // into t's wedge; that lip still separates v if v is behind it (the nearest face
-      // of F may be the coincident lip of another copy, v in front of it)
-      if (sep < 0 && t_copy >= 0 && copies.CountOn(D.vfrag, v, F) >= 2)
-        sep = SeparatingFace(m, vfaces, T, v, t_copy, m.tets + 4*t, depth, &copies);
-      // none, t the only copy on F, and a lip of the holding tetrahedron at t whose other
-      // side is on F too: a crack of F ends at t (its front passes through the point). v
-      // can have slid into the crack's slit and on across its other lip, whose plane has
-      // v's wedge on its inner side; the nearest face of F can then be the coincident lip,
-      // v in front of it, whose row does not hold v
-      if (sep < 0 && t_copy >= 0 && copies.CountOn(D.vfrag, v, F) == 1)
-        sep = SeparatingFace(m, vfaces, T, v, t_copy, m.tets + 4*t, depth, &copies, F);
+      int64_t on_F = t_copy >= 0 ? copies.CountOn(D.vfrag, v, F) : 0;
+      // none: the lips of the holding tetrahedron at t, the one v is least deep behind if
+      // it is behind one. With two or more copies of the point on F (a crack inside F, or
+      // cracks meeting inside F) every lip: v's wedge can lie across the plane of the lip
+      // it crossed into t's wedge, and the nearest face of F may be the coincident lip of
+      // another copy, v in front of it. With t the only copy on F, the lips whose other
+      // side is on F too: a crack of F ends at t (its front passes through the point), and
+      // v can have slid into the crack's slit and on across its other lip, whose plane has
+      // v's wedge on its inner side (the nearest face of F can then be the coincident
+      // lip, v in front of it); a seam between pieces keeps the nearest face
+      if (sep < 0 && t_copy >= 0)
+        sep = SeparatingFace(m, vfaces, T, v, t_copy, m.tets + 4*t, depth, &copies, on_F >= 2 ? -1 : F);
       // none, three or more copies on F, and the holding tetrahedron has no face on the
       // boundary at t: v slid past the faces of the tetrahedra at t deeper into t's star
       // where several cracks meet; the lip at t that v is least deep behind (the
       // nearest face of F may be one v is in front of, whose row does not hold it)
-      if (sep < 0 && t_copy >= 0 && copies.CountOn(D.vfrag, v, F) >= 3
+      if (sep < 0 && t_copy >= 0 && on_F >= 3
           && !HasBoundaryFaceAt(m, vfaces, t_copy, m.tets + 4*t))
         sep = SeparatingFace(m, vfaces, T, v, t_copy, nullptr, depth, &copies);
       if (sep >= 0)

@@ -17,11 +17,11 @@ namespace ngfracture
         d[k] = x[3 * p + k] - x[3 * q + k];
     }
 
-    // The unit normals of a wedge's two faces fw at x (ok: neither squeezed flat) and whether
-    // the wedge at edge (e0, e1) is convex or flat: the corner of its second face off the
-    // edge behind or on the first's plane.
+    // The unit normals of a wedge's two faces fw at x (ok: neither squeezed flat) and the
+    // side of the corner of its second face off the edge (e0, e1) to the first's plane:
+    // the wedge is convex or flat where it is <= 0, reflex where it is > 0.
     bool WedgeNormals (const double * x, const int64_t * faces, const int64_t * fw, int64_t e0, int64_t e1,
-                       double unit[2][3], bool & convex)
+                       double unit[2][3], double & corner)
     {
       bool ok = true;
       for (int k = 0; k < 2; k++)
@@ -37,7 +37,7 @@ namespace ngfracture
       const int64_t * second = faces + 3 * fw[1];
       double d[3];
       Difference(x, (second[0] + second[1] + second[2]) - (e0 + e1), e0, d);
-      convex = EinsumDot(unit[0], d) <= 0;
+      corner = EinsumDot(unit[0], d);
       return ok;
     }
 
@@ -255,10 +255,10 @@ namespace ngfracture
     for (int64_t p = 0; p < m; p++)
       {
         const int64_t * ea = a + 2 * p, * eb = b + 2 * p;
-        double unit[4][3], G[4][2], d[3];
-        bool convex_b, convex_a;
-        bool ok_b = WedgeNormals(x, faces, fb + 2 * p, eb[0], eb[1], unit, convex_b);
-        bool ok_a = WedgeNormals(x, faces, fa + 2 * p, ea[0], ea[1], unit + 2, convex_a);
+        double unit[4][3], G[4][2], d[3], corner_b, corner_a;
+        bool ok_b = WedgeNormals(x, faces, fb + 2 * p, eb[0], eb[1], unit, corner_b);
+        bool ok_a = WedgeNormals(x, faces, fa + 2 * p, ea[0], ea[1], unit + 2, corner_a);
+        bool convex_b = corner_b <= 0, convex_a = corner_a <= 0;
         // G[k]: a's ends to B's face k, G[2 + k]: b's ends to A's face k (gaps from the copy)
         for (int e = 0; e < 2; e++)
           {
@@ -318,27 +318,10 @@ namespace ngfracture
     gap.clear();
     for (int64_t p = 0; p < m; p++)
       {
-        double unit[2][3], g[2][2];
-        bool ok = true;
-        for (int k = 0; k < 2; k++)
-          {
-            double n[3];
-            AreaVector(x, faces + 3 * fb[2 * p + k], n);
-            double length = NumpyNorm(n);
-            ok = ok && length > 0;                        // a face squeezed flat has no plane
-            double scale = length > 0 ? length : 1.0;
-            for (int c = 0; c < 3; c++)
-              unit[k][c] = n[c] / scale;
-          }
-        if (!ok)
-          continue;
+        double unit[2][3], g[2][2], d[3], corner;
         // reflex: the corner of B's second face off the edge strictly in front of the
         // first's plane (WedgeInside's test of a convex or flat wedge, negated)
-        const int64_t * second = faces + 3 * fb[2 * p + 1];
-        int64_t third = (second[0] + second[1] + second[2]) - (b[2 * p] + b[2 * p + 1]);
-        double d[3];
-        Difference(x, third, b[2 * p], d);
-        if (!(EinsumDot(unit[0], d) > 0))
+        if (!WedgeNormals(x, faces, fb + 2 * p, b[2 * p], b[2 * p + 1], unit, corner) || !(corner > 0))
           continue;
         double least = 0.0;
         for (int k = 0; k < 2; k++)

@@ -125,8 +125,8 @@ def reference_behind_partner_rows(partners, displacement, tol, index):
 
 def reference_wedge_normals(x, F, fw, edge):
     """Unit normals of a wedge's two faces per pair, whether neither is squeezed flat, and
-    whether the wedge is convex or flat (the second face's corner off the edge behind or on
-    the first's plane)."""
+    the side of the second face's corner off the edge to the first's plane (convex or
+    flat where <= 0, reflex where > 0)."""
     normals, ok = [], np.ones(len(fw), dtype=bool)
     for k in range(2):
         tri = x[F[fw[:, k]]]
@@ -135,8 +135,7 @@ def reference_wedge_normals(x, F, fw, edge):
         ok &= length > 0
         normals.append(n / np.where(length > 0, length, 1.0)[:, None])
     third = F[fw[:, 1]].sum(axis=1) - edge.sum(axis=1)
-    convex = np.einsum("ij,ij->i", normals[0], x[third] - x[edge[:, 0]]) <= 0
-    return normals, ok, convex
+    return normals, ok, np.einsum("ij,ij->i", normals[0], x[third] - x[edge[:, 0]])
 
 
 def reference_corners_in_front(x, F, fw, edge, n):
@@ -172,8 +171,9 @@ def reference_wedge_rows(pairs, displacement, tol, index, vertex_fragment):
     nv = len(X)
     x = X + np.asarray(displacement, dtype=np.float64)
     a, b, fb, fa = pairs.a, pairs.b, pairs.b_faces, pairs.a_faces
-    nb, ok_b, convex_b = reference_wedge_normals(x, F, fb, b)
-    na, ok_a, convex_a = reference_wedge_normals(x, F, fa, a)
+    nb, ok_b, corner_b = reference_wedge_normals(x, F, fb, b)
+    na, ok_a, corner_a = reference_wedge_normals(x, F, fa, a)
+    convex_b, convex_a = corner_b <= 0, corner_a <= 0
     normals = nb + na
     # G[:, c, e]: a's ends to B's faces (c = 0, 1), b's ends to A's faces (c = 2, 3)
     G = np.stack([np.stack([np.einsum("ij,ij->i", normals[c], x[a[:, e]] - x[b[:, e]] if c < 2 else x[b[:, e]] - x[a[:, e]])
@@ -233,15 +233,8 @@ def reference_reflex_wedge_rows(pairs, displacement, tol, index):
     nv = len(X)
     x = X + np.asarray(displacement, dtype=np.float64)
     a, b, fb = pairs.a, pairs.b, pairs.b_faces
-    normals, ok = [], np.ones(len(a), dtype=bool)
-    for k in range(2):
-        tri = x[F[fb[:, k]]]
-        n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
-        length = np.linalg.norm(n, axis=1)
-        ok &= length > 0
-        normals.append(n / np.where(length > 0, length, 1.0)[:, None])
-    third = F[fb[:, 1]].sum(axis=1) - b.sum(axis=1)
-    reflex = np.einsum("ij,ij->i", normals[0], x[third] - x[b[:, 0]]) > 0
+    normals, ok, corner = reference_wedge_normals(x, F, fb, b)
+    reflex = corner > 0
     gap = np.stack([np.stack([np.einsum("ij,ij->i", normals[k], x[a[:, e]] - x[b[:, e]]) for e in range(2)], axis=1)
                     for k in range(2)], axis=1)                              # (pair, face, end)
     least = np.where(pairs.partner[:, :, None], 0.0, gap).min(axis=(1, 2))
