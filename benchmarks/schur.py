@@ -20,8 +20,18 @@ seconds, their sums and the ratios to "cholesky". ``--hole-rows N`` adds one row
 component) at each of the N free vertices nearest the hole (radius 0.25), as the contact
 rows of a cracked hole add to the stick rows.
 
+``--g-vertices N ...``: G = K_ff^-1 on the dofs of the N free vertices nearest the plane
+z = 0 of the default sphere's tangent (the dofs of a crack's lips, as the Schur
+complement by dofs keeps it, ``sparse_schur.DofSchur``): the reach solves of their unit
+rows, then the product Y^T D^-1 Y dense over every reached row
+(``triangular.weighted_products``) and by pairs of column blocks
+(``triangular.paired_block_products``) on one thread and on ``PAIRED_BLOCK_THREADS``,
+best of three; seconds and their ratios to one factorisation + solve of the tangent
+(the unit), the largest difference of the products relative to G's largest entry, and
+whether the paired products on one and on more threads agree to the last bit.
+
 Usage: python benchmarks/schur.py [--factors 1 2 4 8 16] [--sphere FINE ... [--maxh H]
-       [--hole-rows N]] [--json FILE [--force]]
+       [--hole-rows N]] [--g-vertices N ...] [--json FILE [--force]]
 """
 import argparse
 import time
@@ -119,6 +129,58 @@ def sphere_case(fine, maxh=None, extra_rows=0, repeat=3):
     return out
 
 
+def g_case(vertices, repeat=3):
+    """G on the dofs of ``vertices`` free vertices near z = 0, each way (module docstring)."""
+    from ngfracture.linalg import triangular
+    from ngfracture.linalg.sparse import reproducible_threads, single_threaded_blas
+    scene = scenes.sphere3d()
+    prob = ElasticProblem(scene.mesh, scene.material)
+    scene.apply_load(prob, scene.dx)
+    rows = prob.assemble_constraints()
+    f = factor_module.EliminatedFactor(prob.tangent(), rows.fixed_dofs, prob.support(rows).pins, inverse="superlu")
+    t0 = time.perf_counter()
+    with reproducible_threads():
+        f.factorise()
+    f.solve(np.ones(f.ndof))
+    unit = time.perf_counter() - t0
+    nv = f.ndof // 3
+    X = np.array([v.point for v in scene.mesh.vertices])
+    free = np.flatnonzero(f.factor_free[:nv])
+    near = free[np.argsort(np.abs(X[free, 2]), kind="stable")[:vertices]]
+    dofs = np.concatenate([near, near + nv, near + 2 * nv])
+    units = sp.csr_matrix((np.ones(len(dofs)), (np.arange(len(dofs)), dofs)), shape=(len(dofs), f.ndof))
+    index = -np.ones(f.ndof, dtype=np.int64)
+    index[f.factor_free] = np.arange(f._lu.shape[0])
+    arrays, n = f._factor_arrays(), f._lu.shape[0]
+    weights = 1.0 / arrays[2]
+    out = {"vertices": vertices, "dofs": int(len(dofs)), "factorised_dofs": n, "unit_s": unit}
+    G = {}
+
+    def best(name, run):
+        seconds = np.inf
+        for _ in range(repeat):
+            t = time.perf_counter()
+            G[name] = run()
+            seconds = min(seconds, time.perf_counter() - t)
+        out[f"{name}_s"], out[f"{name}_over_unit"] = seconds, seconds / unit
+
+    with single_threaded_blas():
+        best("reach", lambda: triangular.reach_solves(f._lu, arrays, index, units, f._supernodal()))
+        columns = [y for y, _ in G["reach"]]
+        best("dense", lambda: triangular.weighted_products(columns, weights, n))
+        threads = triangular.PAIRED_BLOCK_THREADS
+        for count in (1, threads):
+            triangular.PAIRED_BLOCK_THREADS = count
+            best(f"paired_{count}", lambda: triangular.paired_block_products(columns, weights, n))
+        triangular.PAIRED_BLOCK_THREADS = threads
+    scale = np.abs(G["dense"]).max()
+    out["paired_difference"] = float(np.abs(G["paired_1"] - G["dense"]).max() / scale)
+    out["paired_threads_bitwise"] = bool(np.array_equal(G["paired_1"], G[f"paired_{threads}"]))
+    out["dense_over_paired"] = out["dense_s"] / out[f"paired_{threads}_s"]
+    print(out, flush=True)
+    return out
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--factors", nargs="+", type=float, default=[1, 2, 4, 8, 16])
@@ -127,9 +189,14 @@ def main(argv=None):
     parser.add_argument("--maxh", type=float, default=None, help="the sphere's maxh (with --sphere)")
     parser.add_argument("--hole-rows", type=int, default=0,
                         help="rows at this many vertices nearest the hole besides the stick rows (with --sphere)")
+    parser.add_argument("--g-vertices", nargs="+", type=int, default=None, metavar="N",
+                        help="G of the Schur complement by dofs at N vertices of the default sphere instead")
     benchmark_json.add_options(parser)
     args = parser.parse_args(argv)
     benchmark_json.refuse_existing(parser, args)
+    if args.g_vertices:
+        benchmark_json.write(args, {"g_cases": [g_case(v) for v in args.g_vertices]})
+        return
     if args.sphere:
         cases = [sphere_case(fine, args.maxh, args.hole_rows) for fine in args.sphere]
         benchmark_json.write(args, {"sphere_cases": cases})

@@ -11,8 +11,8 @@ rows, against all rows. Rows are recognised by their stored indices and values, 
 Rows whose values change from call to call on the same dofs (3D contact rows, re-linearised
 at every round of the active set: a call meets a quarter of its rows with new values) are
 not recognised by their keys. For them S is built from the dofs instead (:class:`DofSchur`):
-G = E^T K_ff^-1 E on the factorised dofs the rows touch (E their unit columns), made row by
-row as above from the unit rows of those dofs, kept and grown with the dofs a call adds;
+G = E^T K_ff^-1 E on the factorised dofs the rows touch (E their unit columns), made from
+the reach solves of those dofs' unit rows, kept and grown with the dofs a call adds;
 then S = C_d G C_d^T costs a sparse product per call and no triangular solve. A call whose
 rows are all among those of the last call that made the product (bitwise: a contact round's
 equations after its complementarity problem over all candidates) takes its S from that
@@ -22,7 +22,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from .kept import row_keys
-from .triangular import column_products, reach_solves, schur_product
+from .triangular import column_products, paired_block_products, reach_solves, schur_product
 
 
 class SparseSchur:
@@ -115,8 +115,13 @@ class DofSchur:
     """S = C K_ff^-1 C^T as C_d G C_d^T, G = K_ff^-1 on the factorised dofs the rows touch.
 
     For rows whose values change from call to call on the same dofs (see the module
-    docstring): G is the :class:`SparseSchur` of the dofs' unit rows, kept and grown by the
-    dofs a call adds; a call then costs a sparse product and no triangular solve.
+    docstring): G is kept and grown by the dofs a call adds; a call then costs a sparse
+    product and no triangular solve. Where every pivot was diagonal (U = D L^T), G is made
+    from the reach solves of the dofs' unit rows by the paired block products
+    (:func:`linalg.triangular.paired_block_products`) and grown by one solve of K_ff per new
+    dof (a few dofs against thousands: their columns of K_ff^-1 directly, instead of their
+    products against every column met before); else it is the :class:`SparseSchur` of the
+    unit rows.
 
     Parameters
     ----------
@@ -125,6 +130,7 @@ class DofSchur:
     """
 
     def __init__(self, lu, arrays, supernodal, index):
+        self._lu, self._arrays, self._supernodal = lu, arrays, supernodal
         self._units = SparseSchur(lu, arrays, supernodal, index)
         self._index, self._symmetric = index, arrays[2] is not None     # U = D L^T: G symmetric
         self._dofs, self._order, self._G = np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), None
@@ -152,12 +158,11 @@ class DofSchur:
         need = np.unique(C.indices[factorised])
         fresh = need[~np.isin(need, self._dofs)]
         if fresh.size or self._G is None:
-            # new dofs join at the end: the unit rows of the others are the last call's
+            # new dofs join at the end: G's block of the others stays as it was
+            known = len(self._dofs)
             self._dofs = np.concatenate([self._dofs, fresh])
             self._order = np.argsort(self._dofs, kind="stable")
-            p = len(self._dofs)
-            units = sp.csr_matrix((np.ones(p), (np.arange(p), self._dofs)), shape=(p, C.shape[1]))
-            self._G = self._units.complement(units)
+            self._G = self._grown(known, C.shape[1])
         at = self._order[np.searchsorted(self._dofs, C.indices[factorised], sorter=self._order)]
         rows = np.repeat(np.arange(C.shape[0]), np.diff(C.indptr))[factorised]
         Cd = sp.csr_matrix((C.data[factorised], (rows, at)), shape=(C.shape[0], len(self._dofs)))
@@ -174,5 +179,24 @@ class DofSchur:
         self._made = ({key: i for i, key in enumerate(keys)}, S)
         return S
 
+    def _grown(self, known, ndof):
+        """G on ``self._dofs``, of which the first ``known`` are those of the G before."""
+        if not self._symmetric:
+            p = len(self._dofs)
+            return self._units.complement(sp.csr_matrix((np.ones(p), (np.arange(p), self._dofs)), shape=(p, ndof)))
+        at = self._index[self._dofs]
+        if self._G is None:
+            p, n = len(at), self._lu.shape[0]
+            units = sp.csr_matrix((np.ones(p), (np.arange(p), self._dofs)), shape=(p, ndof))
+            solved = reach_solves(self._lu, self._arrays, self._index, units, self._supernodal)
+            return paired_block_products([y for y, _ in solved], 1.0 / self._arrays[2], n)
+        E = np.zeros((self._lu.shape[0], len(at) - known), order="F")
+        E[at[known:], np.arange(len(at) - known)] = 1.0
+        B = (self._supernodal.solve(E) if self._supernodal is not None else self._lu.solve(E))[at]
+        G = np.empty((len(at), len(at)))
+        G[:known, :known] = self._G
+        G[:known, known:], G[known:, :known] = B[:known], B[:known].T
+        G[known:, known:] = 0.5 * (B[known:] + B[known:].T)
+        return G
 
 __all__ = ["DofSchur", "SparseSchur"]
