@@ -3,6 +3,7 @@
 #include "vertex_average.hpp"
 #include "internal_force.hpp"
 #include "sparse_triangular.hpp"
+#include "rows_product.hpp"
 #include "supernodal_solve.hpp"
 
 namespace py = pybind11;
@@ -243,6 +244,36 @@ Returns
     that cancel exactly included.)doc");
 }
 
+static void ExportRowsProduct (py::module & m)
+{
+  using I64 = py::array_t<int64_t, py::array::c_style | py::array::forcecast>;
+  using I32 = py::array_t<int32_t, py::array::c_style | py::array::forcecast>;
+  using F64 = py::array_t<double, py::array::c_style | py::array::forcecast>;
+  m.def("RowsProduct", [] (I64 cp, I32 ci, F64 cx, F64 G, int threads)
+        {
+          if (G.ndim() != 2 || G.shape(0) != G.shape(1))
+            throw py::value_error("ngfracture.RowsProduct: G must be square");
+          int64_t p = G.shape(0), m = cp.shape(0) - 1;
+          if (cp.ndim() != 1 || m < 0 || ci.shape(0) < cp.data()[m] || cx.shape(0) < cp.data()[m])
+            throw py::value_error("ngfracture.RowsProduct: C must be CSR (cp of m + 1 pointers)");
+          for (int64_t k = 0; k < cp.data()[m]; k++)
+            if (ci.data()[k] < 0 || ci.data()[k] >= p)
+              throw py::value_error("ngfracture.RowsProduct: a column of C is outside G");
+          F64 S(std::vector<py::ssize_t>{m, m});
+          {
+            py::gil_scoped_release release;
+            RowsProduct(m, p, cp.data(), ci.data(), cx.data(), G.data(), S.mutable_data(), std::max(1, threads));
+          }
+          return S;
+        }, py::arg("cp"), py::arg("ci"), py::arg("cx"), py::arg("G"), py::arg("threads") = 1,
+        R"doc(S = C G C^T for sparse rows C (CSR: cp, ci, cx) and a dense symmetric G, exactly
+symmetric and the same to the last bit on any number of threads.
+
+Returns
+-------
+numpy.ndarray, shape (m, m))doc");
+}
+
 static void ExportSupernodalLDL (py::module & m)
 {
   using I64 = py::array_t<int64_t, py::array::c_style | py::array::forcecast>;
@@ -325,6 +356,7 @@ PYBIND11_MODULE(_ngfracture, m)
   ExportTangentStiffness(m);
   ExportSparseTriangular(m);
   ExportSupernodalLDL(m);
+  ExportRowsProduct(m);
   ExportCrack(m);
   ExportCollision(m);
   ExportCollision3d(m);

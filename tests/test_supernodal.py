@@ -249,9 +249,9 @@ def test_the_paired_block_product_is_the_dense_one_whatever_the_blocks_and_threa
     expected = Y.T @ (w[:, None] * Y)
     scale = (np.abs(Y).T @ (w[:, None] * np.abs(Y))).max()
     monkeypatch.setattr(triangular, "PAIRED_BLOCK_COLUMNS", 4)
-    monkeypatch.setattr(triangular, "PAIRED_BLOCK_THREADS", 1)
+    monkeypatch.setattr(triangular, "PRODUCT_THREADS", 1)
     one = triangular.paired_block_products(ys, w, n)
-    monkeypatch.setattr(triangular, "PAIRED_BLOCK_THREADS", threads)
+    monkeypatch.setattr(triangular, "PRODUCT_THREADS", threads)
     S = triangular.paired_block_products(ys, w, n)
     assert np.array_equal(S, one) and np.array_equal(S, S.T)
     assert np.abs(S - expected).max() <= 1e-14 * scale
@@ -259,6 +259,30 @@ def test_the_paired_block_product_is_the_dense_one_whatever_the_blocks_and_threa
     w[ys[0][0][0]] = -1.0
     expected = Y.T @ (w[:, None] * Y)
     assert np.abs(triangular.paired_block_products(ys, w, n) - expected).max() <= 1e-14 * scale
+
+
+def test_the_rows_product_is_c_g_ct_exactly_symmetric_on_any_number_of_threads():
+    """S = C G C^T of sparse rows and a dense symmetric G (the Schur complement by dofs, in
+    C++) equals the dense product to rounding (1e-14 of the largest term), is exactly
+    symmetric and the same to the last bit on 1, 2 and 5 threads (more threads than
+    blocks of rows too); an empty row gives zeros, a column outside G is refused."""
+    rng = np.random.default_rng(14)
+    p, m = 40, 37
+    A = rng.standard_normal((p, p))
+    G = A @ A.T
+    G = 0.5 * (G + G.T)
+    C = sp.random(m, p, density=0.2, random_state=15, format="csr")
+    C[3] = 0.0
+    C.eliminate_zeros()
+    expected = C.toarray() @ G @ C.toarray().T
+    scale = (np.abs(C.toarray()) @ np.abs(G) @ np.abs(C.toarray()).T).max()
+    one = ext.RowsProduct(C.indptr.astype(np.int64), C.indices, C.data, G, 1)
+    assert np.abs(one - expected).max() <= 1e-14 * scale
+    assert np.array_equal(one, one.T) and np.all(one[3] == 0.0)
+    for threads in (2, 5):
+        assert np.array_equal(ext.RowsProduct(C.indptr.astype(np.int64), C.indices, C.data, G, threads), one)
+    with pytest.raises(ValueError, match="outside G"):
+        ext.RowsProduct(C.indptr.astype(np.int64), C.indices, C.data, G[:5, :5], 1)
 
 
 def test_the_schur_complement_of_rows_met_before_keeps_their_entries(monkeypatch):

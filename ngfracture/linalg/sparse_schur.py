@@ -21,7 +21,9 @@ product's, entry for entry the same numbers.
 import numpy as np
 import scipy.sparse as sp
 
+from .. import _ngfracture as _ext
 from .kept import row_keys
+from . import triangular
 from .triangular import column_products, paired_block_products, reach_solves, schur_product
 
 
@@ -174,8 +176,11 @@ class DofSchur:
             # product's own numbers
             positions = np.array([place[key] for key in keys], dtype=np.int64)
             return made[np.ix_(positions, positions)]
-        S = (Cd @ (Cd @ self._G).T).T
-        S = 0.5 * (S + S.T) if self._symmetric else S
+        if self._symmetric:      # C++: exactly symmetric, the same bits on any number of threads
+            S = _ext.RowsProduct(Cd.indptr.astype(np.int64), Cd.indices, Cd.data, self._G,
+                                 triangular.PRODUCT_THREADS)
+        else:
+            S = (Cd @ (Cd @ self._G).T).T
         self._made = ({key: i for i, key in enumerate(keys)}, S)
         return S
 

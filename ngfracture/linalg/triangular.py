@@ -232,9 +232,10 @@ def weighted_products(y_columns, weights, n):
 #: columns per block of :func:`paired_block_products` (0.32 to 0.36 of the dense product's
 #: work at 128 to 512 on the sphere's 4800 dofs; blocks of 128 keep it near the least)
 PAIRED_BLOCK_COLUMNS = 128
-#: threads of :func:`paired_block_products`: each block is one single-threaded BLAS call,
-#: so the result does not depend on how many there are
-PAIRED_BLOCK_THREADS = 2
+#: threads of the dense products of the Schur complement by dofs (:func:`paired_block_products`,
+#: ``_ngfracture.RowsProduct``): every block or entry is computed the same way whichever
+#: thread takes it, so the result does not depend on how many there are
+PRODUCT_THREADS = 2
 
 
 def paired_block_products(y_columns, weights, n):
@@ -247,7 +248,7 @@ def paired_block_products(y_columns, weights, n):
     ``PAIRED_BLOCK_COLUMNS``, a pair of blocks is one dense product over the rows both
     reach, a third of the work of :func:`weighted_products`' product over every row any
     column reaches (the sphere's 4800 dofs; docs/solvers.md, "Sparse Schur complement").
-    The pairs run on ``PAIRED_BLOCK_THREADS`` threads, one BLAS thread each, every pair
+    The pairs run on ``PRODUCT_THREADS`` threads, one BLAS thread each, every pair
     computed the same way whichever thread takes it.
 
     Parameters
@@ -281,7 +282,7 @@ def paired_block_products(y_columns, weights, n):
         return W_i[at_i].T @ W_j[at_j]
 
     S = np.zeros((m, m))
-    with single_threaded_blas(), ThreadPoolExecutor(PAIRED_BLOCK_THREADS) as pool:
+    with single_threaded_blas(), ThreadPoolExecutor(PRODUCT_THREADS) as pool:
         for (i, j), block in zip(pairs, pool.map(product, pairs)):
             a = order[i * PAIRED_BLOCK_COLUMNS:(i + 1) * PAIRED_BLOCK_COLUMNS]
             b = order[j * PAIRED_BLOCK_COLUMNS:(j + 1) * PAIRED_BLOCK_COLUMNS]
