@@ -31,7 +31,7 @@ def solved_with_one_tensile_row(exact_choice):
     active = ActiveSet3d(geometry, 1e-12)
     cand = active.update(U, {"collision": 0.0})
     want, kept, _ = active.primal_dual(cand)
-    kept, settled = active.choose(cand, want, kept, 1, lambda rows, idx: None)
+    kept, settled = active.choose(cand, want, kept, 1, lambda rows, idx, released=None: None)
     assert not settled and len(kept) > 100
     lam = -np.ones(len(kept))
     lam[0] = 1.0                                      # tensile
@@ -42,7 +42,7 @@ def solved_with_one_tensile_row(exact_choice):
     codes = cand.keys.codes
     assert len(np.setdiff1d(last, codes[kept2])) == 1          # the update releases the tensile row
 
-    def complementarity(rows, idx):
+    def complementarity(rows, idx, released=None):
         return idx[np.isin(codes[idx], last)] if exact_choice else None
 
     chosen, settled = active.choose(cand, want, kept2, active.pdas_rounds + 1, complementarity)
@@ -74,12 +74,12 @@ def test_a_cycle_makes_every_wanted_row_a_candidate():
     B = np.append(A, G)
     calls = []
 
-    def complementarity(rows, idx):
+    def complementarity(rows, idx, released=None):
         calls.append(set(codes[idx].tolist()))
         return B if codes[F] in calls[-1] else A
 
     exact = active.pdas_rounds + 1
-    active.choose(cand, A, A, exact, lambda rows, idx: A)                     # A imposed
+    active.choose(cand, A, A, exact, lambda rows, idx, released=None: A)                     # A imposed
     active.record(cand.keys, A, -np.ones(len(A)), 1.0)
     chosen, settled = active.choose(cand, np.append(A, F), np.append(A, F), exact + 1, complementarity)
     assert not settled and np.array_equal(np.sort(chosen), np.sort(B))        # F wanted: B
@@ -109,13 +109,13 @@ def test_a_warm_solve_asks_the_complementarity_problem_from_its_second_round():
         want, kept, _ = active.primal_dual(cand)
         codes = cand.keys.codes
         dropped = kept[-1]                       # wanted in round 1, not imposed
-        imposed, settled = active.choose(cand, want, kept[:-1], 1, lambda rows, idx: None)
+        imposed, settled = active.choose(cand, want, kept[:-1], 1, lambda rows, idx, released=None: None)
         assert not settled and not active.exact
         active.record(cand.keys, imposed, -np.ones(len(imposed)), 1.0)
         cand = active.update(U, {"collision": 0.0})
         calls = []
 
-        def complementarity(rows, idx):
+        def complementarity(rows, idx, released=None):
             calls.append(codes[idx])
             return idx[np.isin(codes[idx], codes[imposed])]
 
@@ -146,7 +146,7 @@ def test_a_row_the_complementarity_problem_released_stays_a_candidate():
         assert len(found) > 10
         chosen = np.setdiff1d(kept, found[:5])                   # five found rows released
         round_number = active.pdas_rounds + 1 if exact else 1
-        active.choose(cand, want, kept, round_number, lambda rows, idx: chosen)
+        active.choose(cand, want, kept, round_number, lambda rows, idx, released=None: chosen)
         assert active.exact == exact                             # round 1: the update chooses
         active.record(cand.keys, chosen, -np.ones(len(chosen)), 1.0)
         cand = active.update(np.zeros_like(U), {"collision": 0.0})   # the blocks apart: nothing found
@@ -165,11 +165,11 @@ def test_rows_frozen_at_another_set_get_an_update_at_a_new_set():
     active = ActiveSet3d(geometry, 1e-12)
     cand = active.update(U, {"collision": 0.0})
     want, kept, other = active.primal_dual(cand)
-    active.choose(cand, want, kept, 1, lambda rows, idx: None)
+    active.choose(cand, want, kept, 1, lambda rows, idx, released=None: None)
     active.record(cand.keys, kept, -np.ones(len(kept)), 1.0)
     active.moving, active.last_penetration = False, 1e-15       # frozen at a set of tiny overlap
     subset = kept[1:]
-    chosen, settled = active.choose(cand, subset, subset, 2, lambda rows, idx: None)
+    chosen, settled = active.choose(cand, subset, subset, 2, lambda rows, idx, released=None: None)
     assert not settled
     verdict, penetration, _ = active.settle(cand, other, U)
     assert penetration > 1e-3 and verdict == "update"

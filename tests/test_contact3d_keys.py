@@ -123,8 +123,8 @@ def test_codes_choose_as_tuples():
         tuples = Candidates(cand.rows, list(cand.keys), cand.gap)
         a, b = coded.primal_dual(cand), plain.primal_dual(tuples)
         assert all(np.array_equal(p, q) for p, q in zip(a, b))
-        ka, sa = coded.choose(cand, a[0], a[1], rnd, lambda rows, idx: None)
-        kb, sb = plain.choose(tuples, b[0], b[1], rnd, lambda rows, idx: None)
+        ka, sa = coded.choose(cand, a[0], a[1], rnd, lambda rows, idx, released=None: None)
+        kb, sb = plain.choose(tuples, b[0], b[1], rnd, lambda rows, idx, released=None: None)
         assert np.array_equal(ka, kb) and sa == sb and (rnd > 1 or len(ka) > 100)
         lam = np.where(rng.random(len(ka)) < 0.2, 1.0, -1.0)      # some rows released
         assert coded.record(cand.keys, ka, lam, 1.0) == plain.record(tuples.keys, kb, lam, 1.0)

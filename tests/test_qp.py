@@ -174,3 +174,29 @@ def test_a_guess_that_releases_every_row_of_free_pieces_is_mended(seed):
     cold = convex_qp(H, c, A_eq, b_eq, A_in, b_in)
     assert np.array_equal(answer.held, cold[3])
     assert np.abs(answer.x - cold[0]).max() < rounding * np.abs(cold[0]).max()
+
+
+@pytest.mark.parametrize("seed", range(2))
+def test_a_guess_at_the_answer_ends_in_one_sweep_and_any_guess_at_the_same_point(seed):
+    """Started from a guess of the held bounds (a contact solve's rounds meet almost the
+    same problem): from the answer's own working set one sweep and no dual step; from that
+    set with some bounds flipped, and from holding nothing or everything, the same
+    Kuhn-Tucker point (1e-10) and working set. A guess of another length is refused."""
+    rng = np.random.default_rng(400 + seed)
+    n = 300
+    B = rng.standard_normal((n, n)) / np.sqrt(n)
+    H, c = B @ B.T + 1e-2 * np.eye(n), rng.standard_normal(n)
+    A_eq, b_eq = rng.standard_normal((6, n)), rng.standard_normal(6)
+    bounded = np.arange(6, n)
+    A_in, b_in = bounds_of(n, bounded)
+    cold = bound_qp(H, c, A_eq, b_eq, bounded)
+    warm = bound_qp(H, c, A_eq, b_eq, bounded, guess=cold.held)
+    assert warm.sweeps == 1 and not warm.dual_steps
+    flipped = cold.held.copy()
+    flipped[rng.choice(len(bounded), 12, replace=False)] ^= True
+    for guess in (cold.held, flipped, np.zeros(len(bounded), bool), np.ones(len(bounded), bool)):
+        answer = bound_qp(H, c, A_eq, b_eq, bounded, guess=guess)
+        assert kuhn_tucker_error(H, c, A_eq, b_eq, A_in, b_in, answer.x, answer.u_eq, answer.u_bound) < 1e-10
+        assert np.array_equal(answer.held, cold.held)
+    with pytest.raises(ValueError, match="guess"):
+        bound_qp(H, c, A_eq, b_eq, bounded, guess=cold.held[1:])

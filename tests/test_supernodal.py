@@ -23,7 +23,7 @@ def random_rows(factor, k, rng):
                          shape=(k, factor.ndof))
 
 
-def plate_factor(schur_by_dofs=False):
+def plate_factor(schur_by_dofs=False, paired_products=False):
     """The default plate's tangent at its first increment, factorised as the simulation does."""
     scene = scenes.plate()
     prob = ElasticProblem(scene.mesh, scene.material)
@@ -31,7 +31,7 @@ def plate_factor(schur_by_dofs=False):
     rows = prob.assemble_constraints()
     support = prob.support(rows)
     factor = factor_module.EliminatedFactor(prob.tangent(), rows.fixed_dofs, support.pins,
-                                            schur_by_dofs=schur_by_dofs)
+                                            schur_by_dofs=schur_by_dofs, paired_products=paired_products)
     factor.factorise()
     return factor
 
@@ -307,6 +307,25 @@ def test_the_schur_complement_of_rows_met_before_keeps_their_entries(monkeypatch
     assert np.array_equal(S2, S2.T)
     reference = second @ factor.solve(second.T.toarray())
     assert np.abs(S2 - reference).max() <= 1e-12 * np.abs(reference).max()
+
+
+def test_the_row_by_row_schur_complement_by_paired_products_is_the_plain_one(monkeypatch):
+    """With ``paired_products`` (3D) the row-by-row S takes its new rows' products by pairs
+    of column blocks: the same S as the one product to rounding (1e-14 of its largest
+    entry) and as full solves (1e-12), exactly symmetric, on a first call and on a call
+    that keeps some rows of it and adds others."""
+    monkeypatch.setattr(factor_module, "SPARSE_SCHUR_MIN_DOFS", 0)
+    monkeypatch.setattr(triangular, "PAIRED_BLOCK_COLUMNS", 8)
+    plain, paired = plate_factor(), plate_factor(paired_products=True)
+    rng = np.random.default_rng(16)
+    first = random_rows(plain, 40, rng)
+    second = sp.vstack([first[::3], random_rows(plain, 25, rng)]).tocsr()
+    for C in (first, second):
+        S, reference = paired.schur(C), plain.schur(C)
+        assert np.array_equal(S, S.T)
+        assert np.abs(S - reference).max() <= 1e-14 * np.abs(reference).max()
+        solved = C @ plain.solve(C.T.toarray())
+        assert np.abs(S - solved).max() <= 1e-12 * np.abs(solved).max()
 
 
 def test_the_schur_complement_by_dofs_solves_no_row_whose_dofs_were_met(monkeypatch):

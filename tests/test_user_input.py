@@ -138,7 +138,7 @@ def test_a_complementarity_problem_that_raises_is_a_recorded_note(monkeypatch):
     exact = ContactSolver(prob, tol=0.02, pdas_rounds=0).solve()
     assert exact.converged and exact.lcp >= 1 and exact.notes == []
 
-    def fails(self, rows):
+    def fails(self, rows, released=None):
         raise QPError("made to fail")
     monkeypatch.setattr(contact_solver.NewtonSolver, "unilateral_multipliers", fails)
     _, prob = pressed_blocks()

@@ -267,6 +267,7 @@ class ActiveSet:
         self.tried = np.zeros(0, dtype=np.int64)         # codes of every row imposed so far, sorted
         self.wanted = np.zeros(0, dtype=np.int64)        # codes of every row wanted so far, sorted
         self.exact = False                      # the complementarity problem chooses the set
+        self.released = None                    # codes of the rows the last one released, sorted
         self.force_scale = 0.0                  # the largest force of any solve so far
         self.moving = True                      # rows re-linearised every round
         self.last_penetration = np.inf          # at the last re-linearisation of a settled set
@@ -397,9 +398,10 @@ class ActiveSet:
         round_number : int
             The round of the solve, from 1.
         complementarity : callable
-            ``complementarity(rows, indices)``: the indices (among those given) of the rows
-            closed in the solution of the linear complementarity problem of ``rows[indices]``,
-            or None where it could not be solved (then the primal-dual choice stands).
+            ``complementarity(rows, indices, released)``: the indices (among those given) of
+            the rows closed in the solution of the linear complementarity problem of
+            ``rows[indices]``, or None where it could not be solved (then the primal-dual
+            choice stands); ``released`` (bool per index) is the guess its solve starts from.
 
         Returns
         -------
@@ -444,9 +446,16 @@ class ActiveSet:
         """The closed rows of the complementarity problem of the wanted and tried rows (``warm_exact``:
         all wanted so far), made independent, and their sorted codes; None where it is not solved."""
         tried = np.flatnonzero(isin_ints(codes, union_ints(self.tried, self.wanted) if self.warm_exact else self.tried))
-        closed = complementarity(candidates.rows, union_ints(want, tried))
+        indices = union_ints(want, tried)
+        # the problem's start: the rows the problem before released (rounds meet almost the
+        # same problem, and a start at its solution takes one sweep instead of the dual
+        # method's steps), before the first one the rows the last solve did not impose
+        released = (isin_ints(codes[indices], self.released) if self.released is not None
+                    else ~isin_ints(codes[indices], self._mult_codes))
+        closed = complementarity(candidates.rows, indices, released)
         if closed is None:
             return None
+        self.released = unique_ints(codes[np.setdiff1d(indices, closed)])
         # closed rows that depend on others hold with them; as equalities they would make
         # the system singular
         kept = self._independent(candidates.rows, closed)

@@ -337,7 +337,7 @@ class ContactSolver:
         if len(rows):
             prob.constraints.add_rows(self._columns(rows.C), -rows.g, label=LABEL)
 
-    def _complementarity(self, rows, candidates, tangent, result):
+    def _complementarity(self, rows, candidates, released, tangent, result):
         """The candidate rows closed in the exact solution of the linearised contact problem.
 
         With the tangent of the Newton solves the gaps respond linearly to the contact
@@ -349,7 +349,8 @@ class ContactSolver:
         copies (4 dofs), and dropping one as dependent would drop its inequality. Closed
         rows are those that press and those that touch without force: the latter place
         pieces that no force holds where the solution has them (else their modes are
-        frozen). Returns indices among ``candidates`` (of ``rows``), or None if the problem
+        frozen). ``released`` (bool per candidate) is the guess the problem's solve starts
+        from. Returns indices among ``candidates`` (of ``rows``), or None if the problem
         cannot be solved (recorded in ``result.notes``; the primal-dual update goes on).
         """
         t0 = time.perf_counter()
@@ -360,7 +361,7 @@ class ContactSolver:
         options = {k: v for k, v in self.options.items() if k != "load_steps"}
         try:
             _, closed, fallback = NewtonSolver(prob, tangent=tangent, **options).unilateral_multipliers(
-                np.arange(offset, offset + len(candidates)))
+                np.arange(offset, offset + len(candidates)), released)
         except (SingularSystem, QPError, np.linalg.LinAlgError, ValueError) as exc:
             # recorded: the set then comes from the primal-dual update, not the exact solution
             result.notes.append(f"complementarity problem of {len(candidates)} candidate rows not solved "

@@ -252,6 +252,10 @@ class EliminatedFactor(FactorBase):
         An NGSolve matrix of K's sparsity pattern, for NGSolve's factorisation (to_ngsolve).
     schur_by_dofs : bool
         :meth:`schur` through K^-1 on the rows' dofs (``linalg.sparse_schur.DofSchur``).
+    paired_products : bool
+        Otherwise, the products of the row-by-row :meth:`schur` by pairs of column blocks
+        (``linalg.triangular.paired_block_products``; thousands of rows in 3D, where 2D
+        keeps the one product its references were made with).
 
     Attributes
     ----------
@@ -268,7 +272,7 @@ class EliminatedFactor(FactorBase):
     """
 
     def __init__(self, K, fixed_dofs, pins=None, linear_solver="direct", inverse="auto",
-                 gmres_tol=1e-12, pattern=None, schur_by_dofs=False):
+                 gmres_tol=1e-12, pattern=None, schur_by_dofs=False, paired_products=False):
         if linear_solver not in LINEAR_SOLVERS:
             raise ValueError(f"linear_solver must be one of {LINEAR_SOLVERS}, got {linear_solver!r}")
         t0 = time.perf_counter()
@@ -286,6 +290,7 @@ class EliminatedFactor(FactorBase):
         self.gmres_tol = gmres_tol
         self._tmp = ng.BaseVector(self.ndof)     # NGSolve's solvers work on its vectors
         self._sparse, self._schur_by_dofs = None, schur_by_dofs    # the SparseSchur of schur
+        self._paired_products = paired_products
         self._triangles = None    # the factors' arrays for the C++ triangular solves (factor_arrays)
         self._lu = None
         self._ldl = None          # the supernodal L D L^T solver of the factors (SUPERNODAL_MIN_DOFS)
@@ -581,8 +586,11 @@ class EliminatedFactor(FactorBase):
         if self._sparse is None:
             index = -np.ones(self.ndof, dtype=np.int64)
             index[self.factor_free] = np.arange(self._lu.shape[0])          # dof -> row of K_ff
-            kind = DofSchur if self._schur_by_dofs else SparseSchur
-            self._sparse = kind(self._lu, self._factor_arrays(), self._supernodal(), index)
+            if self._schur_by_dofs:
+                self._sparse = DofSchur(self._lu, self._factor_arrays(), self._supernodal(), index)
+            else:
+                self._sparse = SparseSchur(self._lu, self._factor_arrays(), self._supernodal(), index,
+                                           paired=self._paired_products)
         try:
             S = self._sparse.complement(C)
         except (RuntimeError, ValueError) as err:

@@ -265,7 +265,7 @@ class BoundQP(NamedTuple):
     fallback: str = ""      #: why the updated free-block factor gave way to convex_qp's QR, if it did
 
 
-def bound_qp(H, c, A_eq, b_eq, bounded, tol=1e-12, max_sweeps=8, stop_early=True):
+def bound_qp(H, c, A_eq, b_eq, bounded, tol=1e-12, max_sweeps=8, stop_early=True, guess=None):
     """minimise 1/2 x^T H x - c^T x  subject to  A_eq x = b_eq,  x_i <= 0 for i in ``bounded``.
 
     The contact dual has this form (sign bounds on the multipliers, a few equalities for
@@ -304,6 +304,10 @@ def bound_qp(H, c, A_eq, b_eq, bounded, tol=1e-12, max_sweeps=8, stop_early=True
     stop_early : bool
         Stop the sweeps as soon as fewer bounds are violated than a third of the free
         variables; False: sweep until a solution or ``max_sweeps``.
+    guess : numpy.ndarray of bool, optional
+        Per bound (in the order of ``bounded``), whether the first sweep holds it: the
+        solution of a problem met before with almost the same data ends in one sweep
+        (a contact solve's rounds). Default: the bounds with c_i > 0.
 
     Returns
     -------
@@ -320,7 +324,9 @@ def bound_qp(H, c, A_eq, b_eq, bounded, tol=1e-12, max_sweeps=8, stop_early=True
     c = np.asarray(c, dtype=float)
     E, e = np.asarray(A_eq, dtype=float).reshape(-1, n), np.asarray(b_eq, dtype=float).ravel()
     bounded = np.asarray(bounded, dtype=int).ravel()
-    solved, starts, sweeps, factored = _primal_dual_sweeps(H, c, E, e, bounded, tol, max_sweeps, stop_early)
+    if guess is not None and np.shape(guess) != bounded.shape:
+        raise ValueError(f"bound_qp: guess has shape {np.shape(guess)}, bounded {bounded.shape}")
+    solved, starts, sweeps, factored = _primal_dual_sweeps(H, c, E, e, bounded, tol, max_sweeps, stop_early, guess)
     if solved is not None:
         return BoundQP(*solved, sweeps, False)
     fallback = ""
@@ -397,9 +403,10 @@ def _dual_steps_on_bounds(H, c, E, e, bounded, start, tol, factored=None):
     return x, u_eq, u[bounded], held[bounded].astype(bool)
 
 
-def _primal_dual_sweeps(H, c, E, e, bounded, tol, max_sweeps, stop_early):
-    """Primal-dual active-set sweeps for :func:`bound_qp`, from the bounds with c_i > 0
-    held (the sign of the unconstrained minimiser for a diagonal H).
+def _primal_dual_sweeps(H, c, E, e, bounded, tol, max_sweeps, stop_early, guess=None):
+    """Primal-dual active-set sweeps for :func:`bound_qp`, from the bounds ``guess`` holds,
+    or without one from the bounds with c_i > 0 held (the sign of the unconstrained
+    minimiser for a diagonal H).
 
     A guess whose equalities are dependent on its free variables (its held bounds take
     every row of a free piece) is mended by :func:`_spanning` and the sweeps go on. They
@@ -414,7 +421,11 @@ def _primal_dual_sweeps(H, c, E, e, bounded, tol, max_sweeps, stop_early):
     n = len(c)
     is_bound = np.zeros(n, dtype=bool)
     is_bound[bounded] = True
-    held = is_bound & (c > 0)
+    if guess is None:
+        held = is_bound & (c > 0)
+    else:
+        held = np.zeros(n, dtype=bool)
+        held[bounded[np.asarray(guess, dtype=bool)]] = True
     best, fewest, sweep, unmended, factored = held, np.inf, 0, None, None
     for sweep in range(1, max_sweeps + 1):
         x, u_eq, factor = _minimiser_on(H, c, E, e, ~held)

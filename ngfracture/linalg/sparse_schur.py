@@ -40,10 +40,15 @@ class SparseSchur:
         The supernodal solver of the same factors (reach solves through its panels).
     index : numpy.ndarray of int, shape (ndof,)
         The row of K_ff of every dof, -1 where a dof is not factorised.
+    paired : bool
+        Where U = D L^T, the symmetric products of new rows by pairs of column blocks
+        (:func:`linalg.triangular.paired_block_products`) instead of one over every row
+        they reach.
     """
 
-    def __init__(self, lu, arrays, supernodal, index):
+    def __init__(self, lu, arrays, supernodal, index, paired=False):
         self._lu, self._arrays, self._supernodal, self._index = lu, arrays, supernodal, index
+        self._paired = paired
         self._solved = {}         # row key -> its columns of Y and X, the last call's rows
         self._last = ([], None)   # the last call's row keys and S
 
@@ -78,11 +83,18 @@ class SparseSchur:
         place = {key: i for i, key in enumerate(last_keys)}
         known = [i for i, key in enumerate(keys) if key in place]
         if pivots is None or not known:
-            S = schur_product(columns, pivots, n)
+            S = self._product(columns)
         else:
             S = self._updated(columns, keys, known, place, last_S, pivots)
         self._last = (keys, S)
         return S
+
+    def _product(self, columns):
+        """S of the rows of these columns: :func:`schur_product`, or paired (``paired``)."""
+        n, pivots = self._lu.shape[0], self._arrays[2]
+        if self._paired and pivots is not None:
+            return paired_block_products([y for y, _ in columns], 1.0 / pivots, n)
+        return schur_product(columns, pivots, n)
 
     def _updated(self, columns, keys, known, place, last_S, pivots):
         """S from the last call's entries between known rows, the new rows' entries computed:
@@ -101,7 +113,7 @@ class SparseSchur:
         else:
             S[np.ix_(known, known)] = last_S[np.ix_(at, at)]
         if len(fresh):
-            S[np.ix_(fresh, fresh)] = schur_product([columns[i] for i in fresh], pivots, n)
+            S[np.ix_(fresh, fresh)] = self._product([columns[i] for i in fresh])
             weighted = [(y[0], y[1] * weights[y[0]]) for y, _ in (columns[i] for i in fresh)]
             block = column_products(weighted, [columns[i][0] for i in known], n)
             if prefix:

@@ -321,7 +321,7 @@ class NewtonSolver:
             status.steps = step
         return status
 
-    def unilateral_multipliers(self, unilateral):
+    def unilateral_multipliers(self, unilateral, released=None):
         """Multipliers of one linearised step in which some general rows are inequalities.
 
         The step of the first Newton iteration from the current state to the prescribed
@@ -338,6 +338,9 @@ class NewtonSolver:
         unilateral : numpy.ndarray of int
             Indices of the unilateral rows among the assembled general rows (with
             ``fix_free_modes``, the rows appended for free modes stay equalities).
+        released : numpy.ndarray of bool, optional
+            Per unilateral row, whether it is guessed released: the start of the solve
+            (``ConstrainedSolver.solve_unilateral``).
 
         Returns
         -------
@@ -372,7 +375,7 @@ class NewtonSolver:
         du_fixed[rows.fixed_dofs] = rows.fixed_values - u[rows.fixed_dofs]
         with prob.threads():
             _, lam, closed, fallback = kkt.solve_unilateral(self._out_of_balance(), du_fixed,
-                                                            rows.g - rows.C @ u, unilateral)
+                                                            rows.g - rows.C @ u, unilateral, released)
         return lam[:m], closed[:m], fallback
 
     def _out_of_balance(self):
