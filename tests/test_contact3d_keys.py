@@ -1,6 +1,6 @@
 """The fast paths of the 3D contact work give the results of the plain ones, exactly.
 
-Keys as int64 codes (``active_set3d.FaceKeys``, ``active_set.RowKeys``) against key tuples;
+Keys as int64 codes (``active_set3d.FaceKeys``, ``row_keys.RowKeys``) against key tuples;
 the gap rows' CSR arrays against the conversion from coordinates; the detection's pairs,
 tetrahedra and master faces against a brute-force search over all pairs (exact orient3d;
 the crossed face of the tetrahedron at a copy, or the nearest face by distance to every
@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from ngfracture.contact.active_set import Candidates, RowKeys
+from ngfracture.contact.active_set import Candidates
+from ngfracture.contact.row_keys import RowKeys
 from ngfracture.contact.active_set3d import ActiveSet3d, FaceKeys, fixed_rows_3d
 from ngfracture.contact.collision3d import PenetrationDetector3d, detect_penetrations_3d
 from ngfracture.contact.rows3d import face_gap_rows, node_to_face_rows

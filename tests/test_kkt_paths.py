@@ -21,7 +21,8 @@ import scipy.sparse.linalg as spla
 
 import ngfracture as nf
 from ngfracture.contact.solver import ContactSolver
-from ngfracture.linalg import factor as factor_module, sparse_schur as sparse_schur_module
+from ngfracture.linalg import factor as factor_module, kkt as kkt_module, sparse_schur as sparse_schur_module
+from ngfracture.linalg.factor import SingularSystem
 from ngfracture.linalg.kkt import ConstrainedSolver
 from ngfracture.linalg.sparse import to_scipy
 from ngfracture.mechanics.newton import NewtonSolver
@@ -102,12 +103,17 @@ def assert_equal_to_whole_kkt(du, lam, du_ref, lam_ref, tol):
     assert np.linalg.norm(x - x_ref) <= tol * np.linalg.norm(x_ref)
 
 
-@pytest.mark.parametrize("path, inverse, sparse_schur", [("augmented", "superlu", False), ("schur", "superlu", False),
-                                                         ("schur", "superlu", True), ("schur", "sparsecholesky", False)])
-def test_constrained_solve_equals_whole_kkt_solve(contact_state, path, inverse, sparse_schur, monkeypatch):
+@pytest.mark.parametrize("path, inverse, sparse_schur, coarse_cholesky",
+                         [("augmented", "superlu", False, False), ("schur", "superlu", False, False),
+                          ("schur", "superlu", True, False), ("schur", "sparsecholesky", False, False),
+                          ("schur", "superlu", False, True)])
+def test_constrained_solve_equals_whole_kkt_solve(contact_state, path, inverse, sparse_schur, coarse_cholesky,
+                                                  monkeypatch):
     """sparse_schur: the Schur complement from sparse triangular solves (the path of large
-    meshes, forced here on a small one), no kept columns."""
+    meshes, forced here on a small one), no kept columns. coarse_cholesky: the coarse
+    problem through the Cholesky factor of S (the path of thousands of rows, forced)."""
     monkeypatch.setattr(factor_module, "SPARSE_SCHUR_MIN_DOFS", 0 if sparse_schur else 10 ** 9)
+    monkeypatch.setattr(kkt_module, "COARSE_CHOLESKY_MIN_ROWS", 0 if coarse_cholesky else 10 ** 9)
     prob, rows, support, result = contact_state
     n_contact = len(result.multipliers)
     assert n_contact > 0 and np.any(result.multipliers < 0)     # pieces pressed together
@@ -250,3 +256,40 @@ def test_a_cracking_run_takes_the_same_path_with_the_sparse_schur_complement(mon
     assert abs(a.summary["crack_length"] - b.summary["crack_length"]) <= 1e-9 * a.summary["crack_length"]
     ua, ub = a.state.u, b.state.u
     assert np.linalg.norm(ua - ub) <= 1e-9 * np.linalg.norm(ua)
+
+
+@pytest.mark.parametrize("k", [0, 3])
+def test_the_coarse_problem_through_the_cholesky_factor_of_s_is_its_lu(k, monkeypatch):
+    """The equilibrated coarse problem [S -G; -G^T -A] solved through the Cholesky factor
+    of S with the modes' block eliminated equals its LU solve to 1e-12 (with and without
+    modes); rows that depend on each other fail the same pivot test; an S that is not
+    positive definite (a row on pinned dofs alone) or nearly singular takes the LU."""
+    rng = np.random.default_rng(17)
+    m = 60
+    B = rng.standard_normal((m, m + 20))
+    S, G = B @ B.T, rng.standard_normal((m, k))
+    A = np.eye(k) * 0.5
+    scale = kkt_module._equilibration(S, G)
+    rhs = rng.standard_normal(m + k)
+    monkeypatch.setattr(kkt_module, "COARSE_CHOLESKY_MIN_ROWS", 10 ** 9)
+    lu = kkt_module._coarse_factor(S, G, A, scale)
+    monkeypatch.setattr(kkt_module, "COARSE_CHOLESKY_MIN_ROWS", 0)
+    chol = kkt_module._coarse_factor(S, G, A, scale)
+    assert lu.cholesky is None and chol.cholesky is not None
+    x, reference = chol.solve(rhs), lu.solve(rhs)
+    assert np.linalg.norm(x - reference) <= 1e-12 * np.linalg.norm(reference)
+    dependent = np.vstack([B, B[:1]])
+    S2 = dependent @ dependent.T
+    G2 = np.vstack([G, G[:1]])
+    for threshold in (0, 10 ** 9):
+        monkeypatch.setattr(kkt_module, "COARSE_CHOLESKY_MIN_ROWS", threshold)
+        with pytest.raises(SingularSystem, match="coarse pivot ratio"):
+            kkt_module._coarse_factor(S2, G2, A, kkt_module._equilibration(S2, G2))
+    if k:
+        S3, G3 = S.copy(), G.copy()
+        S3[0, :] = S3[:, 0] = 0.0            # the row reaches no factorised dof
+        G3[0] = 1.0
+        monkeypatch.setattr(kkt_module, "COARSE_CHOLESKY_MIN_ROWS", 0)
+        assert kkt_module._coarse_factor(S3, G3, A, kkt_module._equilibration(S3, G3)).cholesky is None
+        S4 = S + 1e8 * np.outer(B[:, 0], B[:, 0])     # condition beyond the Cholesky route's
+        assert kkt_module._coarse_factor(S4, G, A, kkt_module._equilibration(S4, G)).cholesky is None

@@ -50,7 +50,6 @@ tuples is made from the codes only when read (the solver reads it once, at conve
 so a round costs no Python work per row.
 """
 import time
-from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -58,10 +57,11 @@ import numpy as np
 from .collision import detect_collisions
 from .intsets import isin_ints, union_ints, unique_ints
 from .redundancy import independent_rows
+from .row_keys import RowKeys
 from .rows import ContactConstraints, no_constraints, reachable, relinearise_node_to_segment, select_contacts
 from .seams import KINK_ANGLE, seam_constraints
 
-__all__ = ["Geometry", "Candidates", "RowKeys", "ActiveSet", "max_penetration", "refreshed"]
+__all__ = ["Geometry", "Candidates", "ActiveSet", "max_penetration", "refreshed"]
 
 
 @dataclass(frozen=True)
@@ -88,48 +88,6 @@ class Geometry:
     seams: object
     fixed: np.ndarray
     holds: object = None
-
-
-class RowKeys(Sequence):
-    """The keys of rows as int64 codes; the key tuples are made on first use.
-
-    Parameters
-    ----------
-    codes : numpy.ndarray of int
-        One code per row: equal codes for equal keys.
-    codec : object
-        Its ``decode(codes)`` gives the list of key tuples. Keys of one codec concatenate
-        (``+``) into keys of that codec.
-    """
-
-    def __init__(self, codes, codec):
-        self.codes = np.asarray(codes, dtype=np.int64)
-        self.codec = codec
-        self._tuples = None
-
-    def _list(self):
-        if self._tuples is None:
-            self._tuples = self.codec.decode(self.codes)
-        return self._tuples
-
-    def __len__(self):
-        return len(self.codes)
-
-    def __getitem__(self, i):
-        return self._list()[i]
-
-    def __iter__(self):
-        return iter(self._list())
-
-    def __add__(self, other):
-        if isinstance(other, RowKeys) and other.codec is self.codec:
-            return RowKeys(np.concatenate([self.codes, other.codes]), self.codec)
-        return self._list() + list(other)
-
-    def __eq__(self, other):
-        return isinstance(other, Sequence) and list(self) == list(other)
-
-    __hash__ = None
 
 
 @dataclass

@@ -81,7 +81,7 @@ the code checks); an edge row's key ("e", edge a, edge b) as the negative code
 (which found rows are new, which stay, which vertices a twin row covers) and the choice of
 the set (:class:`~ngfracture.contact.active_set.ActiveSet`) are array operations
 (``numpy.isin``, sorting), with the same results as with tuples; the tuples are made only
-where a caller reads them (:class:`~ngfracture.contact.active_set.RowKeys`).
+where a caller reads them (:class:`~ngfracture.contact.row_keys.RowKeys`).
 """
 import functools
 import time
@@ -89,7 +89,8 @@ import time
 import numpy as np
 import scipy.sparse as sp
 
-from .active_set import ActiveSet, Candidates, RowKeys, refreshed
+from .active_set import ActiveSet, Candidates, refreshed
+from .row_keys import RowKeys
 from .clipped3d import beyond_face, node_edge_rows, unseen_pairs
 from .copies3d import (behind_partner_rows, folded_rows_at_copies, found_rows_at_copies, rows_at_copies_of,
                        two_sided_rows)

@@ -15,7 +15,7 @@ with one made afresh, bit for bit (``tests/test_contact3d_setup.py``).
 import numpy as np
 
 from .. import _ngfracture as _ext
-from .active_set import RowKeys
+from .row_keys import RowKeys
 from .collision3d import PenetrationDetector3d
 from .copies3d import partner_incidences
 from .edge_crossings3d import EdgeCrossingDetector

@@ -18,7 +18,7 @@ import scipy.sparse.linalg as spla
 
 from .kept import KeptColumns, row_keys
 from .sparse import reproducible_threads, to_ngsolve, to_scipy
-from .sparse_schur import DofSchur, SparseSchur
+from .sparse_schur import schur_of
 from .triangular import factor_arrays, supernodal_solver
 
 #: the linear solvers of the Newton step: a sparse direct factorisation, or the paper's
@@ -253,9 +253,7 @@ class EliminatedFactor(FactorBase):
     schur_by_dofs : bool
         :meth:`schur` through K^-1 on the rows' dofs (``linalg.sparse_schur.DofSchur``).
     paired_products : bool
-        Otherwise, the products of the row-by-row :meth:`schur` by pairs of column blocks
-        (``linalg.triangular.paired_block_products``; thousands of rows in 3D, where 2D
-        keeps the one product its references were made with).
+        Else its products by pairs of column blocks (3D; ``sparse_schur.SparseSchur``).
 
     Attributes
     ----------
@@ -289,8 +287,7 @@ class EliminatedFactor(FactorBase):
         self.linear_solver = linear_solver
         self.gmres_tol = gmres_tol
         self._tmp = ng.BaseVector(self.ndof)     # NGSolve's solvers work on its vectors
-        self._sparse, self._schur_by_dofs = None, schur_by_dofs    # the SparseSchur of schur
-        self._paired_products = paired_products
+        self._sparse, self._schur_kind = None, "dofs" if schur_by_dofs else ("paired" if paired_products else "rows")
         self._triangles = None    # the factors' arrays for the C++ triangular solves (factor_arrays)
         self._lu = None
         self._ldl = None          # the supernodal L D L^T solver of the factors (SUPERNODAL_MIN_DOFS)
@@ -586,11 +583,7 @@ class EliminatedFactor(FactorBase):
         if self._sparse is None:
             index = -np.ones(self.ndof, dtype=np.int64)
             index[self.factor_free] = np.arange(self._lu.shape[0])          # dof -> row of K_ff
-            if self._schur_by_dofs:
-                self._sparse = DofSchur(self._lu, self._factor_arrays(), self._supernodal(), index)
-            else:
-                self._sparse = SparseSchur(self._lu, self._factor_arrays(), self._supernodal(), index,
-                                           paired=self._paired_products)
+            self._sparse = schur_of(self._schur_kind, self._lu, self._factor_arrays(), self._supernodal(), index)
         try:
             S = self._sparse.complement(C)
         except (RuntimeError, ValueError) as err:

@@ -269,7 +269,7 @@ class ConstrainedSolver:
         lam = np.zeros(self.m)
         if self.m:
             rhs = np.concatenate([self.C @ du - h, -(self._Rt @ q)])
-            sol = self._scale * sla.lu_solve(self._coarse, self._scale * rhs)
+            sol = self._scale * self._coarse.solve(self._scale * rhs)
             lam, alpha = sol[:self.m], sol[self.m:]
             du -= self._correction(lam)
             du += self._R @ alpha
@@ -352,10 +352,8 @@ class ConstrainedSolver:
         unilateral : numpy.ndarray of int or bool
             The rows that are inequalities.
         released : numpy.ndarray of bool, optional
-            Per unilateral row (in the order of ``unilateral`` given as indices, or per row
-            where it is a mask), whether it is guessed released: the QP starts from it
-            (``bound_qp``'s ``guess``; the answer is the same, reached in fewer steps from
-            a good guess). None: from the rows whose gap is open at the unconstrained step.
+            Per unilateral row, whether it is guessed released: the QP's start (``bound_qp``'s
+            ``guess``: the same answer, in fewer steps from a good guess).
 
         Returns
         -------
@@ -393,12 +391,10 @@ class ConstrainedSolver:
             H += 1e-10 * np.eye(self.m)
         e = gscale * (self._R.T @ q)
         bounded_rows = np.flatnonzero(bounded)
-        guess = None
-        if released is not None:
-            guess = np.zeros(self.m, dtype=bool)
+        guess = np.zeros(self.m, dtype=bool) if released is not None else None
+        if guess is not None:
             guess[unilateral] = released
-            guess = guess[bounded_rows]
-        answer = bound_qp(H, d * b + Gs @ e, Gs.T, e, bounded_rows, guess=guess)
+        answer = bound_qp(H, d * b + Gs @ e, Gs.T, e, bounded_rows, guess=None if guess is None else guess[bounded_rows])
         y, alpha = answer.x, answer.u_eq
         released = np.zeros(self.m, dtype=bool)
         released[bounded_rows[answer.held]] = True
@@ -430,17 +426,77 @@ def _equilibration(S, G):
     return np.concatenate([d, np.where(gn > 0, 1.0 / np.where(gn > 0, gn, 1.0), 1.0)])
 
 
+#: general rows from which the coarse problem is factorised through the Cholesky factor of S
+#: (thousands of 3D contact rows: half the work of an LU); below, one LU of the whole (the
+#: numbers the 2D references were made with)
+COARSE_CHOLESKY_MIN_ROWS = 1000
+#: ... where the pivots of S's Cholesky factor stay above this fraction of the largest: the
+#: elimination of the modes' block through a nearly singular S (rows whose stiffness the
+#: modes carry) loses what the LU's pivoting keeps
+COARSE_CHOLESKY_PIVOT_RATIO = 1e-6
+
+
 def _coarse_factor(S, G, A, scale):
-    """LU factorisation of the equilibrated coarse problem [S  -G; -G^T  -A].
+    """The equilibrated coarse problem M = [S  -G; -G^T  -A] factorised (:class:`_CoarseFactor`).
 
     Raises SingularSystem if a pivot is below 1e-12 of the largest: general rows (nearly)
     dependent, or leaving a rigid mode free."""
     coarse = np.block([[S, -G], [-G.T, -A]])
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", sla.LinAlgWarning)   # judged by the pivots below
-        lu = sla.lu_factor(scale[:, None] * coarse * scale[None, :])
-    pivots = np.abs(np.diag(lu[0]))
+    M = scale[:, None] * coarse * scale[None, :]
+    m = S.shape[0]
+    factor = _CoarseFactor.by_cholesky(M, m) if m >= COARSE_CHOLESKY_MIN_ROWS else None
+    if factor is None:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", sla.LinAlgWarning)   # judged by the pivots below
+            lu = sla.lu_factor(M)
+        factor = _CoarseFactor(lu, None, None, np.abs(np.diag(lu[0])))
+    pivots = factor.pivots
     if not np.all(np.isfinite(pivots)) or pivots.min() <= 1e-12 * pivots.max():
-        raise SingularSystem(f"the {S.shape[0]} general constraint rows are (nearly) linearly dependent "
+        raise SingularSystem(f"the {m} general constraint rows are (nearly) linearly dependent "
                              f"or leave rigid modes free: coarse pivot ratio {pivots.min() / pivots.max():.2e}")
-    return lu
+    return factor
+
+
+class _CoarseFactor:
+    """A factorisation of the equilibrated coarse problem M = [M_s  -M_g; -M_g^T  -M_a].
+
+    Either one LU of M (``lu``), or the Cholesky factor L of M_s with the block of the
+    modes eliminated: Y = L^-1 M_g and T = M_a + Y^T Y (k x k, by LU), then
+    y = -T^-1 (b + Y^T L^-1 a) and x = L^-T (L^-1 a + Y y) for the right-hand side (a, b).
+    ``pivots``: those of the LU, or diag(L)^2 and the pivots of T's LU (the pivots of
+    the same elimination), for the singularity test of :func:`_coarse_factor`.
+    """
+
+    def __init__(self, lu, cholesky, modes, pivots):
+        self.lu, self.cholesky, self.modes, self.pivots = lu, cholesky, modes, pivots
+
+    @classmethod
+    def by_cholesky(cls, M, m):
+        """The Cholesky route, or None where M_s is not positive definite (a row on pinned
+        dofs alone has a zero diagonal there) or nearly singular (``COARSE_CHOLESKY_PIVOT_RATIO``):
+        the LU of the whole pivots through it."""
+        try:
+            L = sla.cholesky(M[:m, :m], lower=True, check_finite=False)
+        except np.linalg.LinAlgError:
+            return None
+        d = np.diag(L) ** 2
+        if not d.min() >= COARSE_CHOLESKY_PIVOT_RATIO * d.max():
+            return None
+        Y = sla.solve_triangular(L, -M[:m, m:], lower=True, check_finite=False)
+        T = -M[m:, m:] + Y.T @ Y
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", sla.LinAlgWarning)   # judged by the pivots
+            lu_T = sla.lu_factor(T) if len(T) else (T, np.zeros(0, dtype=np.int32))
+        pivots = np.concatenate([d, np.abs(np.diag(lu_T[0]))])
+        return cls(None, L, (Y, lu_T), pivots)
+
+    def solve(self, rhs):
+        """M^-1 rhs for a vector of length m + k."""
+        if self.lu is not None:
+            return sla.lu_solve(self.lu, rhs)
+        L, (Y, lu_T) = self.cholesky, self.modes
+        m = L.shape[0]
+        z = sla.solve_triangular(L, rhs[:m], lower=True, check_finite=False)
+        y = -sla.lu_solve(lu_T, rhs[m:] + Y.T @ z) if len(Y.T) else np.zeros(0)
+        x = sla.solve_triangular(L, z + Y @ y, lower=True, trans="T", check_finite=False)
+        return np.concatenate([x, y])

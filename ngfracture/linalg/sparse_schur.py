@@ -78,7 +78,7 @@ class SparseSchur:
                           if new else []))
         self._solved = {key: self._solved[key] if key in self._solved else solved[key] for key in keys}
         columns = [self._solved[key] for key in keys]
-        n, pivots = self._lu.shape[0], self._arrays[2]
+        pivots = self._arrays[2]
         last_keys, last_S = self._last
         place = {key: i for i, key in enumerate(last_keys)}
         known = [i for i, key in enumerate(keys) if key in place]
@@ -216,4 +216,23 @@ class DofSchur:
         G[known:, known:] = 0.5 * (B[known:] + B[known:].T)
         return G
 
-__all__ = ["DofSchur", "SparseSchur"]
+def schur_of(kind, lu, arrays, supernodal, index):
+    """The Schur complement of one factorisation.
+
+    Parameters
+    ----------
+    kind : {"rows", "paired", "dofs"}
+        :class:`SparseSchur`, the same with paired block products, or :class:`DofSchur`.
+    lu, arrays, supernodal, index
+        As for :class:`SparseSchur`.
+
+    Returns
+    -------
+    SparseSchur or DofSchur
+    """
+    if kind == "dofs":
+        return DofSchur(lu, arrays, supernodal, index)
+    return SparseSchur(lu, arrays, supernodal, index, paired=kind == "paired")
+
+
+__all__ = ["DofSchur", "SparseSchur", "schur_of"]
