@@ -25,10 +25,11 @@ z = 0 of the default sphere's tangent (the dofs of a crack's lips, as the Schur
 complement by dofs keeps it, ``sparse_schur.DofSchur``): the reach solves of their unit
 rows, then the product Y^T D^-1 Y dense over every reached row
 (``triangular.weighted_products``) and by pairs of column blocks
-(``triangular.paired_block_products``) on one thread and on ``PRODUCT_THREADS``,
-best of three; seconds and their ratios to one factorisation + solve of the tangent
-(the unit), the largest difference of the products relative to G's largest entry, and
-whether the paired products on one and on more threads agree to the last bit.
+(``triangular.paired_block_products``), the reach solves and the paired products each on
+one thread and on ``PRODUCT_THREADS``, best of three; seconds and their ratios to one
+factorisation + solve of the tangent (the unit), the largest difference of the products
+relative to G's largest entry, and whether the paired products on one and on more
+threads agree to the last bit.
 
 Usage: python benchmarks/schur.py [--factors 1 2 4 8 16] [--sphere FINE ... [--maxh H]
        [--hole-rows N]] [--g-vertices N ...] [--json FILE [--force]]
@@ -164,15 +165,17 @@ def g_case(vertices, repeat=3):
             seconds = min(seconds, time.perf_counter() - t)
         out[f"{name}_s"], out[f"{name}_over_unit"] = seconds, seconds / unit
 
+    threads = triangular.PRODUCT_THREADS
     with single_threaded_blas():
-        best("reach", lambda: triangular.reach_solves(f._lu, arrays, index, units, f._supernodal()))
-        columns = [y for y, _ in G["reach"]]
+        for count in (1, threads):
+            triangular.PRODUCT_THREADS = count
+            best(f"reach_{count}", lambda: triangular.reach_solves(f._lu, arrays, index, units, f._supernodal()))
+        columns = [y for y, _ in G["reach_1"]]
         best("dense", lambda: triangular.weighted_products(columns, weights, n))
-        threads = triangular.PRODUCT_THREADS
         for count in (1, threads):
             triangular.PRODUCT_THREADS = count
             best(f"paired_{count}", lambda: triangular.paired_block_products(columns, weights, n))
-        triangular.PRODUCT_THREADS = threads
+    triangular.PRODUCT_THREADS = threads
     scale = np.abs(G["dense"]).max()
     out["paired_difference"] = float(np.abs(G["paired_1"] - G["dense"]).max() / scale)
     out["paired_threads_bitwise"] = bool(np.array_equal(G["paired_1"], G[f"paired_{threads}"]))

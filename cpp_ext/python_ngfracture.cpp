@@ -320,7 +320,7 @@ perm : numpy.ndarray of int64
            }
            return x;
          }, py::arg("b"), "X = A^-1 B for a vector (n,) or a block (n, k); a new Fortran-ordered array.")
-    .def("forward_sparse", [] (const SupernodalLDL & self, I64 bp, I32 bi, F64 bx)
+    .def("forward_sparse", [] (const SupernodalLDL & self, I64 bp, I32 bi, F64 bx, int threads)
          {
            if (bp.ndim() != 1 || bp.shape(0) < 1 || bi.shape(0) < bp.data()[bp.shape(0) - 1]
                || bx.shape(0) < bp.data()[bp.shape(0) - 1])
@@ -330,14 +330,14 @@ perm : numpy.ndarray of int64
            std::vector<double> yx;
            {
              py::gil_scoped_release release;
-             self.ForwardSparse(bp.shape(0) - 1, bp.data(), bi.data(), bx.data(), yp, yi, yx);
+             self.ForwardSparse(bp.shape(0) - 1, bp.data(), bi.data(), bx.data(), yp, yi, yx, std::max(1, threads));
            }
            return py::make_tuple(py::array_t<int64_t>(yp.size(), yp.data()),
                                  py::array_t<int32_t>(yi.size(), yi.data()),
                                  py::array_t<double>(yx.size(), yx.data()));
-         }, py::arg("bp"), py::arg("bi"), py::arg("bx"),
+         }, py::arg("bp"), py::arg("bi"), py::arg("bx"), py::arg("threads") = 1,
          R"doc(Y = L^-1 B for a sparse B (CSC, n rows, already permuted), through the supernodes
-its nonzeros reach only.
+its nonzeros reach only; its columns on up to ``threads`` threads, the same numbers.
 
 Returns
 -------

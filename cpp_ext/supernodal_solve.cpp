@@ -1,5 +1,7 @@
 // Triangular solves with a symmetric factorisation L D L^T kept in supernodes (see the header).
 #include "supernodal_solve.hpp"
+
+#include <thread>
 #include <algorithm>
 #include <cmath>
 #include <functional>
@@ -111,15 +113,45 @@ namespace ngfracture
 
   void SupernodalLDL::ForwardSparse (int64_t m, const int64_t * bp, const int32_t * bi, const double * bx,
                                      std::vector<int64_t> & yp, std::vector<int32_t> & yi,
-                                     std::vector<double> & yx) const
+                                     std::vector<double> & yx, int threads) const
+  {
+    for (int64_t q = 0; q < (m > 0 ? bp[m] : 0); q++)
+      if (bi[q] < 0 || bi[q] >= n_)
+        throw std::invalid_argument("SupernodalLDL.forward_sparse: right-hand side row out of range");
+    // the columns in contiguous ranges, one per thread: a column's numbers are the same
+    // whichever range holds it
+    int64_t count = std::max<int64_t>(1, std::min<int64_t>(threads, m / 64 + 1));
+    std::vector<std::vector<int64_t>> ps(count);
+    std::vector<std::vector<int32_t>> is(count);
+    std::vector<std::vector<double>> xs(count);
+    std::vector<std::thread> pool;
+    for (int64_t t = 1; t < count; t++)
+      pool.emplace_back([&, t] { ForwardRange(m * t / count, m * (t + 1) / count, bp, bi, bx, ps[t], is[t], xs[t]); });
+    ForwardRange(0, m / count, bp, bi, bx, ps[0], is[0], xs[0]);
+    for (auto & thread : pool)
+      thread.join();
+    yp.assign(1, 0);
+    yi.clear();
+    yx.clear();
+    for (int64_t t = 0; t < count; t++)
+      {
+        int64_t base = int64_t(yi.size());
+        for (size_t k = 1; k < ps[t].size(); k++)
+          yp.push_back(base + ps[t][k]);
+        yi.insert(yi.end(), is[t].begin(), is[t].end());
+        yx.insert(yx.end(), xs[t].begin(), xs[t].end());
+      }
+  }
+
+  void SupernodalLDL::ForwardRange (int64_t k0, int64_t k1, const int64_t * bp, const int32_t * bi,
+                                    const double * bx, std::vector<int64_t> & yp, std::vector<int32_t> & yi,
+                                    std::vector<double> & yx) const
   {
     int64_t n = n_;
     std::vector<double> z(n, 0.0), acc(n);
     std::vector<int64_t> mark(first_.size(), -1);     // the column that last reached a supernode
     std::vector<int32_t> next, done;                  // min-heap of supernodes to solve; solved
     yp.assign(1, 0);
-    yi.clear();
-    yx.clear();
     auto reach = [&] (int32_t s, int64_t k)
       {
         if (mark[s] == k) return;
@@ -127,12 +159,10 @@ namespace ngfracture
         next.push_back(s);
         std::push_heap(next.begin(), next.end(), std::greater<int32_t>());
       };
-    for (int64_t k = 0; k < m; k++)
+    for (int64_t k = k0; k < k1; k++)
       {
         for (int64_t q = bp[k]; q < bp[k+1]; q++)
           {
-            if (bi[q] < 0 || bi[q] >= n)
-              throw std::invalid_argument("SupernodalLDL.forward_sparse: right-hand side row out of range");
             z[bi[q]] += bx[q];
             reach(supernode_[bi[q]], k);
           }

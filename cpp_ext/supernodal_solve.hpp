@@ -23,15 +23,20 @@ namespace ngfracture
     // Y = L^-1 B for a sparse B (n x m CSC, rows already permuted): per column, only the
     // supernodes its nonzeros reach, in increasing order (the reach found supernode by
     // supernode, a heap of the next ones). Output CSC (yp, yi, yx), every row of every
-    // supernode reached, rows increasing within a column.
+    // supernode reached, rows increasing within a column. The columns go to up to
+    // ``threads`` threads in contiguous ranges; a column's numbers do not depend on it.
     void ForwardSparse (int64_t m, const int64_t * bp, const int32_t * bi, const double * bx,
-                        std::vector<int64_t> & yp, std::vector<int32_t> & yi, std::vector<double> & yx) const;
+                        std::vector<int64_t> & yp, std::vector<int32_t> & yi, std::vector<double> & yx,
+                        int threads = 1) const;
     int64_t Order () const { return n_; }
     int64_t Supernodes () const { return int64_t(first_.size()) - 1; }
     int64_t StoredEntries () const { return int64_t(values_.size()); }
 
   private:
     void SolveBlock (int64_t k, const double * B, double * X) const;
+    // ForwardSparse's columns k0 .. k1 - 1 (yp from 0)
+    void ForwardRange (int64_t k0, int64_t k1, const int64_t * bp, const int32_t * bi, const double * bx,
+                       std::vector<int64_t> & yp, std::vector<int32_t> & yi, std::vector<double> & yx) const;
     // L y = b on supernode s (z indexed by column): its diagonal block, then the rows
     // below it; acc: room for the rows below
     void ForwardSupernode (int64_t s, double * z, double * acc) const;

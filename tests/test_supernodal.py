@@ -171,7 +171,8 @@ def test_the_product_of_sparse_columns_is_the_dense_product(block_bytes, monkeyp
 def test_the_supernodal_sparse_forward_solve_is_the_entrywise_one():
     """Y = L^-1 B through the supernodes a sparse B reaches equals Gilbert-Peierls'
     (SparseLowerSolve) and the dense solve to rounding (1e-13 of Y's largest entry), with
-    the rows of whole supernodes, increasing; a row out of range is refused."""
+    the rows of whole supernodes, increasing, the same on any number of threads; a row
+    out of range is refused."""
     factor = plate_factor()
     factor.solve(np.ones(factor.ndof))
     ldl, (lower, _, _) = factor._ldl, factor._factor_arrays()
@@ -198,6 +199,14 @@ def test_the_supernodal_sparse_forward_solve_is_the_entrywise_one():
         assert set(np.flatnonzero(Y_gp[:, j])) <= set(rows.tolist())
     with pytest.raises(ValueError, match="out of range"):
         ldl.forward_sparse(np.array([0, 1], dtype=np.int64), np.array([n], dtype=np.int32), np.ones(1))
+    # many columns on several threads in contiguous ranges: the same arrays, bit for bit
+    many = 300
+    cols = np.concatenate([rng.choice(n, size=3, replace=False) for _ in range(many)])
+    B = sp.csc_matrix((rng.standard_normal(3 * many), (cols, np.repeat(np.arange(many), 3))), shape=(n, many))
+    bp, bi = B.indptr.astype(np.int64), B.indices.astype(np.int32)
+    one = ldl.forward_sparse(bp, bi, B.data, 1)
+    for threads in (2, 3, 8):
+        assert all(np.array_equal(a, b) for a, b in zip(ldl.forward_sparse(bp, bi, B.data, threads), one))
 
 
 @pytest.mark.parametrize("case", ["syrk", "negative weight", "small blocks"])

@@ -23,6 +23,15 @@ from scipy.linalg import blas
 from .. import _ngfracture as _ext
 from .sparse import single_threaded_blas
 
+#: columns per block of :func:`paired_block_products` (0.32 to 0.36 of the dense product's
+#: work at 128 to 512 on the sphere's 4800 dofs; blocks of 128 keep it near the least)
+PAIRED_BLOCK_COLUMNS = 128
+#: threads of the supernodal reach solves and of the dense products of the Schur complement
+#: (:func:`paired_block_products`, ``_ngfracture.RowsProduct``): every column, block or entry
+#: is computed the same way whichever thread takes it, so the result does not depend on how
+#: many there are
+PRODUCT_THREADS = 2
+
 
 def factor_arrays(lu):
     """SuperLU's factors Pr K_ff Pc = L U as the arrays of the C++ triangular solves.
@@ -117,7 +126,7 @@ def reach_solves(lu, arrays, index, C, supernodal=None):
         rhs = sp.csc_matrix((B.data[keep], (perm[rows[keep]], B.row[keep])), shape=(n, C.shape[0]))
         pointers, indices = rhs.indptr.astype(np.int64), rhs.indices.astype(np.int32)
         if unit and upper_t is None and supernodal is not None:
-            return supernodal.forward_sparse(pointers, indices, rhs.data)
+            return supernodal.forward_sparse(pointers, indices, rhs.data, PRODUCT_THREADS)
         return _ext.SparseLowerSolve(n, lp, li, lx, unit, pointers, indices, rhs.data)
 
     yp, yi, yx = solve(lower, lu.perm_r, True)
@@ -228,14 +237,6 @@ def weighted_products(y_columns, weights, n):
             S[i:i + width, j:j + width], S[j:j + width, i:i + width] = block, block.T
     return S
 
-
-#: columns per block of :func:`paired_block_products` (0.32 to 0.36 of the dense product's
-#: work at 128 to 512 on the sphere's 4800 dofs; blocks of 128 keep it near the least)
-PAIRED_BLOCK_COLUMNS = 128
-#: threads of the dense products of the Schur complement by dofs (:func:`paired_block_products`,
-#: ``_ngfracture.RowsProduct``): every block or entry is computed the same way whichever
-#: thread takes it, so the result does not depend on how many there are
-PRODUCT_THREADS = 2
 
 
 def paired_block_products(y_columns, weights, n):
