@@ -198,15 +198,14 @@ class DofSchur:
 
     def _grown(self, known, ndof):
         """G on ``self._dofs``, of which the first ``known`` are those of the G before."""
+        p = len(self._dofs)
+        units = sp.csr_matrix((np.ones(p), (np.arange(p), self._dofs)), shape=(p, ndof))
         if not self._symmetric:
-            p = len(self._dofs)
-            return self._units.complement(sp.csr_matrix((np.ones(p), (np.arange(p), self._dofs)), shape=(p, ndof)))
+            return self._units.complement(units)
         at = self._index[self._dofs]
         if self._G is None:
-            p, n = len(at), self._lu.shape[0]
-            units = sp.csr_matrix((np.ones(p), (np.arange(p), self._dofs)), shape=(p, ndof))
             solved = reach_solves(self._lu, self._arrays, self._index, units, self._supernodal)
-            return paired_block_products([y for y, _ in solved], 1.0 / self._arrays[2], n)
+            return paired_block_products([y for y, _ in solved], 1.0 / self._arrays[2], self._lu.shape[0])
         E = np.zeros((self._lu.shape[0], len(at) - known), order="F")
         E[at[known:], np.arange(len(at) - known)] = 1.0
         B = (self._supernodal.solve(E) if self._supernodal is not None else self._lu.solve(E))[at]
@@ -215,6 +214,7 @@ class DofSchur:
         G[:known, known:], G[known:, :known] = B[:known], B[:known].T
         G[known:, known:] = 0.5 * (B[known:] + B[known:].T)
         return G
+
 
 def schur_of(kind, lu, arrays, supernodal, index):
     """The Schur complement of one factorisation.

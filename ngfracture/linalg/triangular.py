@@ -238,7 +238,6 @@ def weighted_products(y_columns, weights, n):
     return S
 
 
-
 def paired_block_products(y_columns, weights, n):
     """Y^T diag(w) Y for columns that reach few rows each (w > 0 on them), exactly symmetric,
     in pairs of column blocks multiplied over the rows both blocks reach.
@@ -279,7 +278,7 @@ def paired_block_products(y_columns, weights, n):
         if pair[0] == pair[1]:
             upper = blas.dsyrk(1.0, W_i.T)
             return np.triu(upper) + np.triu(upper, 1).T
-        common, at_i, at_j = np.intersect1d(rows_i, rows_j, assume_unique=True, return_indices=True)
+        _, at_i, at_j = np.intersect1d(rows_i, rows_j, assume_unique=True, return_indices=True)
         return W_i[at_i].T @ W_j[at_j]
 
     S = np.zeros((m, m))
