@@ -118,9 +118,11 @@ namespace ngfracture
     for (int64_t q = 0; q < (m > 0 ? bp[m] : 0); q++)
       if (bi[q] < 0 || bi[q] >= n_)
         throw std::invalid_argument("SupernodalLDL.forward_sparse: right-hand side row out of range");
-    // the columns in contiguous ranges, one per thread: a column's numbers are the same
+    // the columns in contiguous ranges, one per thread and at least kColumnsPerThread
+    // each (fewer are cheaper than starting a thread): a column's numbers are the same
     // whichever range holds it
-    int64_t count = std::max<int64_t>(1, std::min<int64_t>(threads, m / 64 + 1));
+    constexpr int64_t kColumnsPerThread = 64;
+    int64_t count = std::max<int64_t>(1, std::min<int64_t>(threads, m / kColumnsPerThread + 1));
     std::vector<std::vector<int64_t>> ps(count);
     std::vector<std::vector<int32_t>> is(count);
     std::vector<std::vector<double>> xs(count);

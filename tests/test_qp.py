@@ -129,18 +129,24 @@ def test_primal_dual_sweeps_alone_solve_an_m_matrix_problem():
     assert np.array_equal(answer.held, convex_qp(H, c, np.zeros((0, n)), np.zeros(0), A_in, b_in)[3])
 
 
+def mixed_sign_qp(seed, n):
+    """A contact-sized QP with no M-matrix (dense mixed-sign coupling) and six equalities
+    for free modes: (H, c, A_eq, b_eq, bounded) and the generator, to draw more from it."""
+    rng = np.random.default_rng(seed)
+    B = rng.standard_normal((n, n)) / np.sqrt(n)
+    H, c = B @ B.T + 1e-2 * np.eye(n), rng.standard_normal(n)
+    A_eq, b_eq = rng.standard_normal((6, n)), rng.standard_normal(6)
+    return H, c, A_eq, b_eq, np.arange(6, n), rng
+
+
 @pytest.mark.parametrize("seed", range(2))
 def test_sweeps_that_do_not_settle_are_finished_by_the_dual_method(seed):
     """Contact-sized, no M-matrix (dense mixed-sign coupling), six equalities for free
     modes, two sweeps allowed (fewer than these problems need): the dual method finishes
     from the sweeps' best guess, and the answer is the cold dual method's Kuhn-Tucker point
     with its working set."""
-    rng = np.random.default_rng(300 + seed)
     n = 500
-    B = rng.standard_normal((n, n)) / np.sqrt(n)
-    H, c = B @ B.T + 1e-2 * np.eye(n), rng.standard_normal(n)
-    A_eq, b_eq = rng.standard_normal((6, n)), rng.standard_normal(6)
-    bounded = np.arange(6, n)
+    H, c, A_eq, b_eq, bounded, _ = mixed_sign_qp(300 + seed, n)
     answer = bound_qp(H, c, A_eq, b_eq, bounded, max_sweeps=2)
     assert answer.dual_steps and answer.sweeps == 2
     A_in, b_in = bounds_of(n, bounded)
@@ -182,12 +188,8 @@ def test_a_guess_at_the_answer_ends_in_one_sweep_and_any_guess_at_the_same_point
     same problem): from the answer's own working set one sweep and no dual step; from that
     set with some bounds flipped, and from holding nothing or everything, the same
     Kuhn-Tucker point (1e-10) and working set. A guess of another length is refused."""
-    rng = np.random.default_rng(400 + seed)
     n = 300
-    B = rng.standard_normal((n, n)) / np.sqrt(n)
-    H, c = B @ B.T + 1e-2 * np.eye(n), rng.standard_normal(n)
-    A_eq, b_eq = rng.standard_normal((6, n)), rng.standard_normal(6)
-    bounded = np.arange(6, n)
+    H, c, A_eq, b_eq, bounded, rng = mixed_sign_qp(400 + seed, n)
     A_in, b_in = bounds_of(n, bounded)
     cold = bound_qp(H, c, A_eq, b_eq, bounded)
     warm = bound_qp(H, c, A_eq, b_eq, bounded, guess=cold.held)

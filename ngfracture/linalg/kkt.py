@@ -391,10 +391,8 @@ class ConstrainedSolver:
             H += 1e-10 * np.eye(self.m)
         e = gscale * (self._R.T @ q)
         bounded_rows = np.flatnonzero(bounded)
-        guess = np.zeros(self.m, dtype=bool) if released is not None else None
-        if guess is not None:
-            guess[unilateral] = released
-        answer = bound_qp(H, d * b + Gs @ e, Gs.T, e, bounded_rows, guess=None if guess is None else guess[bounded_rows])
+        answer = bound_qp(H, d * b + Gs @ e, Gs.T, e, bounded_rows,
+                          guess=_released_on(bounded_rows, unilateral, released, self.m))
         y, alpha = answer.x, answer.u_eq
         released = np.zeros(self.m, dtype=bool)
         released[bounded_rows[answer.held]] = True
@@ -403,6 +401,16 @@ class ConstrainedSolver:
         du -= self._correction(lam)
         du += self._R @ (gscale * alpha)
         return du, lam, ~released, answer.fallback
+
+
+def _released_on(bounded_rows, unilateral, released, m):
+    """``released`` (per unilateral row, in the order of ``unilateral``) on the bounded rows
+    of :meth:`ConstrainedSolver.solve_unilateral`, or None without one."""
+    if released is None:
+        return None
+    on_rows = np.zeros(m, dtype=bool)
+    on_rows[unilateral] = released
+    return on_rows[bounded_rows]
 
 
 def _chosen_path(path, factor, m, dependent_rows):

@@ -230,8 +230,7 @@ def weighted_products(y_columns, weights, n):
     S = np.zeros((m, m))
     for i in range(0, m, width):
         W = _dense_block(y, place, len(rows), i, i + width) * scale
-        upper = blas.dsyrk(1.0, W.T)      # W.T is Fortran-ordered: no copy
-        S[i:i + width, i:i + width] = np.triu(upper) + np.triu(upper, 1).T
+        S[i:i + width, i:i + width] = _gram(W)
         for j in range(i + width, m, width):
             block = W.T @ (_dense_block(y, place, len(rows), j, j + width) * scale)
             S[i:i + width, j:j + width], S[j:j + width, i:i + width] = block, block.T
@@ -276,8 +275,7 @@ def paired_block_products(y_columns, weights, n):
     def product(pair):
         (rows_i, W_i), (rows_j, W_j) = blocks[pair[0]], blocks[pair[1]]
         if pair[0] == pair[1]:
-            upper = blas.dsyrk(1.0, W_i.T)
-            return np.triu(upper) + np.triu(upper, 1).T
+            return _gram(W_i)
         _, at_i, at_j = np.intersect1d(rows_i, rows_j, assume_unique=True, return_indices=True)
         return W_i[at_i].T @ W_j[at_j]
 
@@ -289,6 +287,13 @@ def paired_block_products(y_columns, weights, n):
             S[np.ix_(a, b)] = block
             S[np.ix_(b, a)] = block.T
     return S
+
+
+def _gram(W):
+    """W^T W of a C-ordered W by the symmetric rank-k product (BLAS syrk on W.T, which is
+    Fortran-ordered: no copy), its lower triangle the upper's mirror: exactly symmetric."""
+    upper = blas.dsyrk(1.0, W.T)
+    return np.triu(upper) + np.triu(upper, 1).T
 
 
 def _scaled_block(columns, weights):
