@@ -52,7 +52,7 @@ from ..linalg.qp import QPError
 from ..mechanics.newton import NewtonSolver, SolveStatus, check_solve_options
 from ..mechanics.tangent import SavedTangent
 
-__all__ = ["ContactResult", "ContactSolver", "space_columns", "space_columns_3d", "LABEL"]
+__all__ = ["ContactResult", "ContactSolver", "space_columns", "space_columns_3d", "LABEL", "PENETRATION_FRACTION"]
 
 #: edges crossing by less than this fraction of ``tol`` (or ``penetration_tol``, the larger) get
 #: no edge-to-edge row (3D; docs/contact.md, "Edge-to-edge rows in 3D")
@@ -62,6 +62,14 @@ EDGE_TOL = 1e-3
 #: wedge, by less than this fraction of ``tol`` (or ``penetration_tol``, the larger) gets no
 #: row of its own (3D; docs/contact.md, "Rows at copies found by their planes")
 COPY_TOL = 1e-4
+
+#: the default ``penetration_tol`` as a fraction of ``tol``, on triangles and on tetrahedra. In
+#: 3D a point where several crack lips meet keeps penetrations of about 1e-12 that no
+#: re-linearisation removes: a row at a copy holds its pair on one of two coincident faces,
+#: and once the lips slide by d and the faces turn apart by an angle a the other face's
+#: condition differs by |d| a; each update switches to the other face (docs/contact.md,
+#: "Penetration accepted at the end")
+PENETRATION_FRACTION = {2: 1e-10, 3: 1e-7}
 
 #: label of the problem's constraint rows that the contact solve owns
 LABEL = "contact"
@@ -164,7 +172,8 @@ class ContactSolver:
         Precision threshold of the detection (a length): pairs closer than tol count,
         and slave nodes within tol of a master segment can get a constraint.
     penetration_tol : float, optional
-        Penetration depth accepted at the end (a length); None: 1e-10 * tol.
+        Penetration depth accepted at the end (a length); None: ``PENETRATION_FRACTION``
+        times tol (1e-10 on triangles, 1e-7 on tetrahedra).
     max_rounds : int
         Detect-and-solve rounds before giving up with reason "active_set".
     rank_tol : float
@@ -246,7 +255,8 @@ class ContactSolver:
                         "held on the rigid modes contact leaves free"] if fix is False else [])
         self.problem = problem
         self.tol = float(tol)
-        self.penetration_tol = 1e-10 * max(self.tol, 1e-300) if penetration_tol is None else penetration_tol
+        self.penetration_tol = (PENETRATION_FRACTION[problem.dim] * max(self.tol, 1e-300) if penetration_tol is None
+                                else penetration_tol)
         self.max_rounds = max_rounds
         self.rank_tol = rank_tol
         self.max_updates = max_updates

@@ -232,7 +232,8 @@ class StepLog:
     substeps : int
         Newton load steps of the accepted increment solve.
     method : str
-        Newton variant of the accepted attempt ("modified" or "full").
+        Newton variant of the accepted attempt ("modified", "full" or "rescue", see
+        :mod:`ngfracture.run.retries`).
     notes : list of str
         Departures from the plain path (a kept tangent that failed, ...).
     kept_tangent : bool

@@ -11,17 +11,24 @@ Every attempt starts from the saved state. After a failed solve:
 4. no smaller dx within ``dx_min``: the step gives up.
 
 On a tetrahedral mesh with contact, a failure at fixed load with modified Newton first
-takes dx * cut with modified Newton, once per step, and then goes on as above. A
-full-Newton contact solve there factorises at every iteration and builds the Schur
-complement of all contact rows from each factor: on the default sphere (about 1350 rows)
-a relaxation took 271 s of CPU with full Newton against 20 s with modified Newton, and
-the contact set that failed to settle settled at the smaller step.
+takes dx * cut with modified Newton, once per step, and then goes on as above, with
+"rescue" for full Newton: modified Newton for every solve, and full Newton only for a
+solve that fails with it (``LoadStep.equilibrium``). A full-Newton contact solve there
+factorises at every iteration and builds the Schur complement of all contact rows from
+each factor: on the default sphere (about 1350 rows) a relaxation took 271 s of CPU with
+full Newton against 20 s with modified Newton, and the contact set that failed to settle
+settled at the smaller step. Where dx cannot be cut, an attempt all in full Newton
+repeats every solve of the step at that cost: step 66 of the default sphere took 2.5 to
+3 s a relaxation with modified Newton and 30 to 40 s with full Newton, every one but the
+failing one on the same rounds (docs/solid.md, "The sphere scenes").
 
 A tangent kept from the step before that fails is not a retry of this kind: the step
 makes the same attempt with a tangent of its own (``LoadStep.step``).
 """
 
-__all__ = ["next_retry"]
+from .records import Equilibrium, StepFailed, merged_notes
+
+__all__ = ["next_retry", "rescued"]
 
 
 def next_retry(log, phase, dx, control, cut_first):
@@ -51,7 +58,7 @@ def next_retry(log, phase, dx, control, cut_first):
         log.substeps, log.cut_modified = 1, True
         return dx * control.cut
     if log.method == "modified":
-        log.method = "full"           # the same attempt with fresh tangents
+        log.method = "rescue" if cut_first else "full"     # the same attempt with fresh tangents
         return dx
     if phase == "increment":
         log.substeps *= 2
@@ -60,3 +67,38 @@ def next_retry(log, phase, dx, control, cut_first):
         log.substeps = 1
         return dx * control.cut
     return None
+
+
+def rescued(solve, prob, phase):
+    """The equilibrium of a solve of a "rescue" attempt: modified Newton, and where that
+    fails, full Newton from the same start (noted).
+
+    Parameters
+    ----------
+    solve : callable
+        ``solve(method)`` with method "modified" or "full": the Equilibrium of ``prob``,
+        or StepFailed.
+    prob : ElasticProblem
+        The problem ``solve`` solves; its displacement and load factor are restored before
+        the full-Newton solve.
+    phase : {"increment", "relaxation"}
+        For the note.
+
+    Returns
+    -------
+    Equilibrium
+
+    Raises
+    ------
+    StepFailed
+        The full-Newton solve failed too.
+    """
+    u, load = prob.u.vec.FV().NumPy().copy(), prob.load_factor.Get()
+    try:
+        return solve("modified")
+    except StepFailed as err:
+        prob.u.vec.FV().NumPy()[:] = u
+        prob.load_factor.Set(load)
+        eq = solve("full")
+        note = f"a {phase} solve that failed with modified Newton ({err.reason}) was solved with full Newton"
+        return Equilibrium(eq.contact_keys, eq.tangent, eq.iterations, merged_notes(eq.notes, [note]))

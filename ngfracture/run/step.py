@@ -11,10 +11,10 @@
        row without a crack, dx = min(dx * grow, dx_max).
 
 Each stage returns a record (:mod:`ngfracture.run.records`); a failed solve raises
-``StepFailed``. A failure sends the step back to the saved state: an increment solve that
-started from the tangent kept from the step before is made again with a tangent of its
-own; the other retries follow :mod:`ngfracture.run.retries` (full Newton, more Newton load
-steps, dx * cut); after ``max_retries`` failures the step gives up.
+``StepFailed`` and sends the step back to the saved state: an increment solve that started
+from the tangent kept from the step before is made again with a tangent of its own; the
+other retries follow :mod:`ngfracture.run.retries` (full Newton, more Newton load steps,
+dx * cut) until ``max_retries``.
 
 Where the paper is vague:
 
@@ -49,7 +49,7 @@ from .state import State, crack_extent, round_trip
 from . import tangents
 from .growth import critical_event, relax
 from .refinement import refine_equilibrium, refine_initial
-from .retries import next_retry
+from .retries import next_retry, rescued
 
 __all__ = ["LoadStep", "UNHELD_NOTE"]
 
@@ -145,7 +145,8 @@ class LoadStep:
         ----------
         prob : ElasticProblem
         phase : {"increment", "relaxation"}
-        method : {"modified", "full"}
+        method : {"modified", "full", "rescue"}
+            "rescue": :func:`ngfracture.run.retries.rescued`.
         timings : Timings
         substeps : int
         warm : iterable of tuple
@@ -164,6 +165,9 @@ class LoadStep:
         StepFailed
             The solve did not converge.
         """
+        if method == "rescue":
+            return rescued(lambda newton: self.equilibrium(prob, phase, newton, timings, substeps, warm, lineage,
+                                                           start if newton == "modified" else None), prob, phase)
         c = self.control
         options = dict(method=method, tol=c.tol, maxit=c.maxit, inverse=c.inverse, load_steps=substeps)
         if self.needs_contact(prob.mesh):
