@@ -68,7 +68,7 @@ COPY_TOL = 1e-4
 #: re-linearisation removes: a row at a copy holds its pair on one of two coincident faces,
 #: and once the lips slide by d and the faces turn apart by an angle a the other face's
 #: condition differs by |d| a; each update switches to the other face (docs/contact.md,
-#: "Penetration accepted at the end")
+#: "Contact in 3D runs")
 PENETRATION_FRACTION = {2: 1e-10, 3: 1e-7}
 
 #: label of the problem's constraint rows that the contact solve owns

@@ -70,7 +70,7 @@ def critical_event(stepper, state, dx, method, timings, substeps=1, keep=True):
     stepper : LoadStep
     state : State
     dx : float
-    method : {"modified", "full"}
+    method : {"modified", "full", "rescue"}
     timings : Timings
     substeps : int
     keep : bool
@@ -123,7 +123,7 @@ def critical_load(stepper, state, x_try, prob, eq, method, timings):
     prob : ElasticProblem
         The increment's equilibrium at x_try.
     eq : Equilibrium
-    method : {"modified", "full"}
+    method : {"modified", "full", "rescue"}
     timings : Timings
 
     Returns
@@ -190,7 +190,7 @@ def relax(stepper, prob, crack, eq, x, area, method, timings):
     x : float
     area : float
         The reference area of the split mesh (the area invariant's).
-    method : {"modified", "full"}
+    method : {"modified", "full", "rescue"}
     timings : Timings
 
     Returns

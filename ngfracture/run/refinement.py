@@ -103,7 +103,7 @@ def refine_equilibrium(stepper, prob, eq, x, strength, area, method, timings):
     strength : numpy.ndarray or None
     area : float
         The reference area of prob's mesh (the area invariant's reference).
-    method : {"modified", "full"}
+    method : {"modified", "full", "rescue"}
     timings : Timings
 
     Returns

@@ -13,14 +13,14 @@ Every attempt starts from the saved state. After a failed solve:
 On a tetrahedral mesh with contact, a failure at fixed load with modified Newton first
 takes dx * cut with modified Newton, once per step, and then goes on as above, with
 "rescue" for full Newton: modified Newton for every solve, and full Newton only for a
-solve that fails with it (``LoadStep.equilibrium``). A full-Newton contact solve there
+solve that fails with it (:func:`rescued`, called by ``LoadStep.equilibrium``). A full-Newton contact solve there
 factorises at every iteration and builds the Schur complement of all contact rows from
 each factor: on the default sphere (about 1350 rows) a relaxation took 271 s of CPU with
 full Newton against 20 s with modified Newton, and the contact set that failed to settle
 settled at the smaller step. Where dx cannot be cut, an attempt all in full Newton
 repeats every solve of the step at that cost: step 66 of the default sphere took 2.5 to
 3 s a relaxation with modified Newton and 30 to 40 s with full Newton, every one but the
-failing one on the same rounds (docs/solid.md, "The sphere scenes").
+failing one on the same rounds (docs/design.md, "Retries").
 
 A tangent kept from the step before that fails is not a retry of this kind: the step
 makes the same attempt with a tangent of its own (``LoadStep.step``).

@@ -268,7 +268,7 @@ class LoadStep:
         ----------
         state : State
         dx : float
-        method : {"modified", "full"}
+        method : {"modified", "full", "rescue"}
         timings : Timings
         substeps : int
             Newton load steps of the increment solve.
@@ -321,7 +321,7 @@ class LoadStep:
         ----------
         state : State
         x : float
-        method : {"modified", "full"}
+        method : {"modified", "full", "rescue"}
         timings : Timings
         substeps : int
         keep : bool
