@@ -93,17 +93,37 @@ namespace ngfracture
       {
         free_ = free;
         int f = Size();
-        for (int i = 0; i < f; i++)
-          for (int j = 0; j <= i; j++)
-            Lij(i, j) = L0[size_t(i) * f + j];
-        std::vector<double> col(f);
+        constexpr int tile = 64;          // the transposing copy by tiles that stay in cache
+        for (int i0 = 0; i0 < f; i0 += tile)
+          for (int j0 = 0; j0 <= i0; j0 += tile)
+            for (int j = j0; j < std::min(j0 + tile, f); j++)
+              for (int i = std::max(i0, j); i < std::min(i0 + tile, f); i++)
+                Lij(i, j) = L0[size_t(i) * f + j];
         for (int q = 0; q < p_; q++)
-        {
           for (int r = 0; r < f; r++)
-            col[r] = qp_.E[size_t(q) * n_ + free_[r]];
-          Forward(col.data(), 0);
-          std::copy(col.begin(), col.end(), &Wiq(0, q));
-        }
+            Wiq(r, q) = qp_.E[size_t(q) * n_ + free_[r]];
+        ForwardColumns();
+      }
+
+      // L Y = B in place for W's p columns: Forward on each, panel by panel of L's columns,
+      // so that L streams from memory once instead of once per column (each entry takes
+      // the same operations in the same order as in Forward)
+      void ForwardColumns ()
+      {
+        int f = Size();
+        constexpr int panel = 32;
+        for (int j0 = 0; j0 < f; j0 += panel)
+          for (int q = 0; q < p_; q++)
+          {
+            double * w = &Wiq(0, q);
+            for (int j = j0; j < std::min(j0 + panel, f); j++)
+            {
+              const double * col = &L_[size_t(j) * n_];
+              double wj = w[j] /= col[j];
+              for (int i = j + 1; i < f; i++)
+                w[i] -= col[i] * wj;
+            }
+          }
       }
 
       // L y = b in place, b zero before ``from``
@@ -292,6 +312,56 @@ namespace ngfracture
       std::vector<double> L_, W_, Q_, R_;
     };
 
+    // The bounds' lengths in the metric of H, |L^-1 e_i| = sqrt((H^-1)_ii): given for the
+    // start's held variables; for a free one at position r of the start, |L0^-1 e_r|^2 plus
+    // qp.extra[i], computed when first needed ((f - r)^2 / 2 flops; the method considers a few
+    // bounds of thousands)
+    class BoundLengths
+    {
+    public:
+      BoundLengths (const BoundQpData & qp, const int8_t * held0, const double * L0)
+        : qp_(qp), L0_(L0), length_(qp.norm, qp.norm + qp.n), at_(qp.n, -1)
+      {
+        for (int i = 0; i < qp.n; i++)
+          if (!held0[i])
+            at_[i] = f0_++;
+      }
+
+      // a lower bound of the length, with the diagonal entry of L0^-1 alone (shrunk so that
+      // rounding keeps it below the length computed)
+      double Floor (int i) const
+      {
+        if (length_[i] > 0.0 || at_[i] < 0)
+          return length_[i];
+        double d = L0_[size_t(at_[i]) * f0_ + at_[i]];
+        return (1.0 - 1e-12) * std::sqrt(1.0 / (d * d) + qp_.extra[i]);
+      }
+
+      double Of (int i)
+      {
+        if (length_[i] > 0.0 || at_[i] < 0)
+          return std::max(length_[i], 1e-300);
+        int r = at_[i], m = f0_ - r;
+        std::vector<double> y(m);         // L0^-1 e_r, from row r on
+        double sum = 0.0;
+        for (int t = 0; t < m; t++)
+        {
+          const double * row = L0_ + size_t(r + t) * f0_ + r;
+          y[t] = ((t == 0 ? 1.0 : 0.0) - Dot(row, y.data(), t)) / row[t];
+          sum += y[t] * y[t];
+        }
+        length_[i] = std::max(std::sqrt(sum + qp_.extra[i]), 1e-300);
+        return length_[i];
+      }
+
+    private:
+      const BoundQpData & qp_;
+      const double * L0_;
+      std::vector<double> length_;
+      std::vector<int> at_;
+      int f0_ = 0;
+    };
+
     // The state of the method: x, the equalities' multipliers, the held bounds in the order
     // they entered with their multipliers.
     struct DualState
@@ -394,15 +464,16 @@ namespace ngfracture
 
     // the free bound missed most in the metric of H, if by more than the level (relative
     // to the data and the iterate's size |x|_H); -1 for none
-    int NextBound (const BoundQpData & qp, const DualState & s, double size)
+    int NextBound (const BoundQpData & qp, const DualState & s, double size, BoundLengths & lengths)
     {
       double level = qp.level * std::max({ qp.data, size, 1e-300 });
       int best = -1;
       double most = level;
       for (int i = 0; i < qp.n; i++)
-        if (qp.bounded[i] && !s.held[i] && s.x[i] / qp.norm[i] > most)
+        if (qp.bounded[i] && !s.held[i] && s.x[i] > 0.0 && s.x[i] / lengths.Floor(i) > most
+            && s.x[i] / lengths.Of(i) > most)
         {
-          most = s.x[i] / qp.norm[i];
+          most = s.x[i] / lengths.Of(i);
           best = i;
         }
       return best;
@@ -423,8 +494,8 @@ namespace ngfracture
     }
 
     // dual steps until bound j holds, freeing the held bounds whose multipliers reach zero
-    BoundDualStatus Enter (const BoundQpData & qp, int j, FreeFactor & F, SlotMatrix & slots, DualState & s,
-                           int & dropped, std::string & reason)
+    BoundDualStatus Enter (const BoundQpData & qp, int j, double length, FreeFactor & F, SlotMatrix & slots,
+                           DualState & s, int & dropped, std::string & reason)
     {
       double force = 0.0;                 // the multiplier of j while it is pushed down
       std::vector<double> y(qp.n), by_slot(qp.n), dmu(qp.p), du(s.active.size());
@@ -455,7 +526,7 @@ namespace ngfracture
             }
           }
         }
-        double t_full = ww > std::pow(1e-14 * qp.norm[j], 2) ? s.x[j] / ww : inf;
+        double t_full = ww > std::pow(1e-14 * length, 2) ? s.x[j] / ww : inf;
         double t = std::min(t_dual, t_full);
         if (!std::isfinite(t))
         {
@@ -507,11 +578,12 @@ namespace ngfracture
     if (StartPair(qp, held0, L0, F, s, answer.reason))
     {
       SlotMatrix slots(qp, s.held);
+      BoundLengths lengths(qp, held0, L0);
       answer.reason = "no solution in " + std::to_string(qp.max_steps) + " steps";
       double size = SizeInH(qp, s);
       for (int step = 0; step < qp.max_steps; step++)
       {
-        int j = NextBound(qp, s, size);
+        int j = NextBound(qp, s, size, lengths);
         if (j < 0)
         {
           answer.status = BoundDualStatus::solved;
@@ -519,7 +591,7 @@ namespace ngfracture
           break;
         }
         answer.entered++;
-        BoundDualStatus entered = Enter(qp, j, F, slots, s, answer.dropped, answer.reason);
+        BoundDualStatus entered = Enter(qp, j, lengths.Of(j), F, slots, s, answer.dropped, answer.reason);
         if (entered != BoundDualStatus::solved)
         {
           answer.status = entered;

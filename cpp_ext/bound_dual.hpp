@@ -25,7 +25,10 @@ namespace ngfracture
     const double * E = nullptr;        // p x n, row-major
     const double * e = nullptr;        // p
     const int8_t * bounded = nullptr;  // n: x_i <= 0 applies
-    const double * norm = nullptr;     // n: |L^-1 e_i| (H = L L^T), a bound's length in the metric of H
+    const double * norm = nullptr;     // n: |L^-1 e_i| (H = L L^T), a bound's length in the metric of H,
+                                       // of the held variables of the start; 0 for the free ones
+    const double * extra = nullptr;    // n: for a free variable of the start at position r,
+                                       // |L^-1 e_i|^2 - |L0^-1 e_r|^2 (the held ones' share)
     double level = 0.0;                // tol: a bound is missed when x_i / norm_i > tol max(data, |x|_H)
     double data = 0.0;                 // the data's size in the metric of H
     double growth_limit = 1e8;         // |x|_H may exceed data by this factor at most
@@ -45,7 +48,8 @@ namespace ngfracture
 
   // The method from the S-pair of ``held0`` (held bounds with negative multipliers at the
   // minimiser on the others are freed, all at once, until none is left). L0: the lower
-  // Cholesky factor of H over the variables not in held0, in increasing order, row-major.
+  // Cholesky factor of H over the variables not in held0, in increasing order, row-major;
+  // a free variable's length in the metric of H is computed from it when a step needs it.
   BoundDualAnswer BoundDualActiveSet (const BoundQpData & qp, const int8_t * held0, const double * L0);
 }
 #endif

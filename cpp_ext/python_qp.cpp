@@ -22,7 +22,7 @@ namespace
 void ExportQp (py::module & m)
 {
   m.def("BoundDualActiveSet",
-        [] (DArr H, DArr c, DArr E, DArr e, BArr bounded, DArr norm, BArr held, DArr L0, double tol,
+        [] (DArr H, DArr c, DArr E, DArr e, BArr bounded, DArr norm, DArr extra, BArr held, DArr L0, double tol,
             double data, double growth_limit, int max_steps)
         {
           py::ssize_t n = c.ndim() == 1 ? c.shape(0) : -1;
@@ -30,7 +30,8 @@ void ExportQp (py::module & m)
           Check(E.ndim() == 2 && E.shape(1) == n && e.ndim() == 1 && e.shape(0) == E.shape(0),
                 "E must be p x n, e of length p");
           Check(bounded.ndim() == 1 && bounded.shape(0) == n && norm.ndim() == 1 && norm.shape(0) == n
-                && held.ndim() == 1 && held.shape(0) == n, "bounded, norm and held must have length n");
+                && extra.ndim() == 1 && extra.shape(0) == n && held.ndim() == 1 && held.shape(0) == n,
+                "bounded, norm, extra and held must have length n");
           py::ssize_t f = 0;
           for (py::ssize_t i = 0; i < n; i++)
           {
@@ -42,7 +43,7 @@ void ExportQp (py::module & m)
           qp.n = int(n);
           qp.p = int(E.shape(0));
           qp.H = H.data(); qp.c = c.data(); qp.E = E.data(); qp.e = e.data();
-          qp.bounded = bounded.data(); qp.norm = norm.data();
+          qp.bounded = bounded.data(); qp.norm = norm.data(); qp.extra = extra.data();
           qp.level = tol; qp.data = data; qp.growth_limit = growth_limit; qp.max_steps = max_steps;
           BoundDualAnswer a;
           {
@@ -53,7 +54,7 @@ void ExportQp (py::module & m)
                                 a.dropped, int(a.status), a.reason);
         },
         py::arg("H"), py::arg("c"), py::arg("E"), py::arg("e"), py::arg("bounded"), py::arg("norm"),
-        py::arg("held"), py::arg("L0"), py::arg("tol"), py::arg("data"), py::arg("growth_limit"),
+        py::arg("extra"), py::arg("held"), py::arg("L0"), py::arg("tol"), py::arg("data"), py::arg("growth_limit"),
         py::arg("max_steps"),
         R"doc(Goldfarb-Idnani dual steps for min 1/2 x^T H x - c^T x, E x = e, x_i <= 0 (bounded i).
 
@@ -63,7 +64,10 @@ H, c, E, e : numpy.ndarray
     (n, n) symmetric positive definite, (n,), (p, n), (p,).
 bounded : numpy.ndarray of int8 (n,)
 norm : numpy.ndarray (n,)
-    |L^-1 e_i| for H = L L^T: a bound's length in the metric of H.
+    |L^-1 e_i| for H = L L^T, a bound's length in the metric of H, of the held variables
+    of the start; 0 for the free ones, whose lengths are computed from L0 where needed.
+extra : numpy.ndarray (n,)
+    For a free variable of the start at position r: |L^-1 e_i|^2 - |L0^-1 e_r|^2.
 held : numpy.ndarray of int8 (n,)
     The start's held bounds (a subset of ``bounded``).
 L0 : numpy.ndarray (f, f)

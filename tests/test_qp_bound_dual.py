@@ -22,15 +22,36 @@ def bound_dual(H, c, E, e, bounded, held):
     """BoundDualActiveSet from the start ``held`` (bool per variable), its data as bound_qp
     prepares them."""
     n = len(c)
-    inverse = np.linalg.inv(np.linalg.cholesky(H))
-    norm = np.linalg.norm(inverse, axis=0)
-    data = np.max(np.abs(e) / np.linalg.norm(inverse @ E.T, axis=0), initial=np.linalg.norm(inverse @ c))
     is_bound = np.zeros(n, dtype=np.int8)
     is_bound[bounded] = 1
     free = np.flatnonzero(~held)
     L0 = np.linalg.cholesky(H[np.ix_(free, free)])
-    return ext.BoundDualActiveSet(H, c, E, e, is_bound, norm, held.astype(np.int8), L0, 1e-12, data,
+    norm, extra, data = qp_module._start_metric(H, c, E, e, held, L0)
+    return ext.BoundDualActiveSet(H, c, E, e, is_bound, norm, extra, held.astype(np.int8), L0, 1e-12, data,
                                   GROWTH_LIMIT, 10 * n + 100)
+
+
+@pytest.mark.parametrize("held_fraction", [0.0, 0.1, 0.9, 1.0])
+def test_the_start_metric_is_that_of_the_inverse_of_H(held_fraction):
+    """The bounds' lengths |L^-1 e_i| = sqrt((H^-1)_ii) and the data's size sqrt(c^T H^-1 c)
+    (and |e_q| / sqrt(E_q H^-1 E_q^T)), made from the start's factor of H_FF and the Schur
+    complement of its held variables, are those of the dense inverse of H to rounding
+    (n eps cond(H)); the free variables' first term |L0^-1 e_r|^2, which the C++ steps
+    compute, is taken here from the inverse of L0."""
+    n, p = 200, 6
+    H, c, E, e, rng = contact_like(42, n, p)
+    held = rng.random(n) < held_fraction
+    free = np.flatnonzero(~held)
+    L0 = np.linalg.cholesky(H[np.ix_(free, free)]) if len(free) else np.zeros((0, 0))
+    norm, extra, data = qp_module._start_metric(H, c, E, e, held, L0)
+    lengths = norm.copy()
+    lengths[free] = np.sqrt(np.sum(np.linalg.inv(L0) ** 2, axis=0) + extra[free]) if len(free) else 0.0
+    inverse = np.linalg.inv(H)
+    rounding = n * np.finfo(float).eps * np.linalg.cond(H)
+    assert np.all(norm[free] == 0.0) and np.all(extra[held] == 0.0)
+    assert np.abs(lengths / np.sqrt(np.diag(inverse)) - 1).max() <= rounding
+    expected = max(np.sqrt(c @ inverse @ c), np.max(np.abs(e) / np.sqrt(np.diag(E @ inverse @ E.T))))
+    assert abs(data / expected - 1) <= rounding
 
 
 @pytest.mark.parametrize("seed,p", [(0, 0), (1, 6), (2, 6), (3, 9)])
@@ -134,10 +155,12 @@ def test_the_binding_names_a_wrong_shape():
     n = 4
     H = np.eye(n)
     args = dict(H=H, c=np.zeros(n), E=np.zeros((1, n)), e=np.zeros(1), bounded=np.ones(n, np.int8),
-                norm=np.ones(n), held=np.zeros(n, np.int8), L0=np.eye(n), tol=1e-12, data=1.0,
+                norm=np.ones(n), extra=np.zeros(n), held=np.zeros(n, np.int8), L0=np.eye(n), tol=1e-12, data=1.0,
                 growth_limit=1e8, max_steps=100)
     with pytest.raises(ValueError, match="L0 must be f x f"):
         ext.BoundDualActiveSet(**{**args, "L0": np.eye(n - 1)})
+    with pytest.raises(ValueError, match="extra and held must have length n"):
+        ext.BoundDualActiveSet(**{**args, "extra": np.zeros(n - 1)})
     with pytest.raises(ValueError, match="held variable is not bounded"):
         ext.BoundDualActiveSet(**{**args, "bounded": np.zeros(n, np.int8), "held": np.ones(n, np.int8),
                                   "L0": np.zeros((0, 0))})
@@ -178,9 +201,18 @@ def test_the_dual_method_starts_from_the_last_sweeps_factor(seed, p, monkeypatch
             return solved, starts, count, factored if reuse else None
 
         monkeypatch.setattr(qp_module, "_primal_dual_sweeps", sweeps_keeping)
-        cholesky = qp_module.sla.cholesky
+        cholesky, metric, in_metric = qp_module.sla.cholesky, qp_module._start_metric, []
+
+        def start_metric(*args):         # its Cholesky factor is of the held variables' block
+            in_metric.append(1)
+            try:
+                return metric(*args)
+            finally:
+                in_metric.pop()
+
+        monkeypatch.setattr(qp_module, "_start_metric", start_metric)
         monkeypatch.setattr(qp_module.sla, "cholesky",
-                            lambda a, **k: fresh.append(a.shape[0]) or cholesky(a, **k))
+                            lambda a, **k: (None if in_metric else fresh.append(a.shape[0])) or cholesky(a, **k))
         answer = bound_qp(H, c, E, e, bounded)
         monkeypatch.undo()
         return answer, [size for size in fresh if size < len(c)]

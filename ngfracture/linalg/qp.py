@@ -371,15 +371,6 @@ def _dual_steps_on_bounds(H, c, E, e, bounded, start, tol, factored=None):
         an answer that is not finite).
     """
     n = len(c)
-    L = sla.cholesky(H, lower=True)
-    inverse, info = lapack.dtrtri(L, lower=1)
-    if info != 0:
-        raise np.linalg.LinAlgError("bound_qp: the Cholesky factor of H is singular")
-    norm = np.maximum(np.sqrt(np.einsum("ij,ij->j", inverse, inverse)), 1e-300)  # |L^-1 e_j|
-    data = np.linalg.norm(inverse @ c)
-    if len(e):
-        data = max(data, np.max(np.abs(e) / np.maximum(np.linalg.norm(inverse @ E.T, axis=0), 1e-300)))
-    del L, inverse                       # n x n each: not kept beside the C++ copies of H
     is_bound = np.zeros(n, dtype=np.int8)
     is_bound[bounded] = 1
     held = np.zeros(n, dtype=bool)
@@ -391,9 +382,10 @@ def _dual_steps_on_bounds(H, c, E, e, bounded, start, tol, factored=None):
     else:
         free = np.flatnonzero(~held)
         L0 = sla.cholesky(H[np.ix_(free, free)], lower=True) if len(free) else np.zeros((0, 0))
+    norm, extra, data = _start_metric(H, c, E, e, held, L0)
     held = held.astype(np.int8)
     x, u_eq, u, held, _, _, status, reason = _ext.BoundDualActiveSet(
-        H, c, E, e, is_bound, norm, held, L0, tol, data, GROWTH_LIMIT, 10 * (n + len(e) + len(bounded)) + 100)
+        H, c, E, e, is_bound, norm, extra, held, L0, tol, data, GROWTH_LIMIT, 10 * (n + len(e) + len(bounded)) + 100)
     if status == 1:
         raise Infeasible(f"bound_qp: {reason}")
     if status != 0:
@@ -401,6 +393,59 @@ def _dual_steps_on_bounds(H, c, E, e, bounded, start, tol, factored=None):
     if not (np.all(np.isfinite(x)) and np.all(np.isfinite(u_eq)) and np.all(np.isfinite(u))):
         raise QPError("bound_qp: the dual steps ended on a value that is not finite")
     return x, u_eq, u[bounded], held[bounded].astype(bool)
+
+
+def _start_metric(H, c, E, e, held, L0):
+    """The metric of the dual steps from the start's factor L0 of H_FF (F: not ``held``).
+
+    A bound's length |L^-1 e_i| in the metric of H = L L^T is sqrt((H^-1)_ii), and the
+    data's size |L^-1 c| is sqrt(c^T H^-1 c) (the equalities' offsets alike). By the Schur
+    complement S_A = H_AA - H_AF H_FF^-1 H_FA = M M^T of the held variables A (a few
+    against thousands of free ones in a contact solve's rounds):
+
+        (H^-1)_ii = |L0^-1 e_i|^2 + |M^-1 (H_AF H_FF^-1)_{:, i}|^2    (i in F),
+        (H^-1)_ii = |M^-1 e_i|^2                                     (i in A),
+        b^T H^-1 b = |L0^-1 b_F|^2 + |M^-1 (b_A - H_AF H_FF^-1 b_F)|^2,
+
+    which takes triangular solves with a columns instead of a factorisation of all of H and
+    the inverse of its factor (2 n^3 / 3 flops; 0.5 s at 3000 rows). The first term of a free
+    variable's length costs (f - r)^2 / 2 for its position r in F: the C++ dual steps
+    compute it for the few bounds they consider (``BoundDualActiveSet``).
+
+    Returns (norm, extra, data): norm the lengths of the held variables (0 for the free
+    ones, computed in C++), extra the second term of the free ones' squares (0 for the held).
+
+    Raises
+    ------
+    numpy.linalg.LinAlgError
+        If H is not positive definite (S_A is not).
+    """
+    n = len(c)
+    free, hold = np.flatnonzero(~held), np.flatnonzero(held)
+    norm, extra = np.zeros(n), np.zeros(n)
+    B = np.column_stack([c, E.T])                     # the data: c and the equalities' rows
+    B_F = sla.solve_triangular(L0, B[free], lower=True, check_finite=False) if len(free) else B[free]
+    sizes = np.einsum("ij,ij->j", B_F, B_F)
+    if len(hold):
+        Y = (sla.solve_triangular(L0, H[np.ix_(free, hold)], lower=True, check_finite=False)
+             if len(free) else np.zeros((0, len(hold))))                          # L0^-1 H_FA
+        M = sla.cholesky(H[np.ix_(hold, hold)] - Y.T @ Y, lower=True, check_finite=False)
+        M_inv, info = lapack.dtrtri(M, lower=1)
+        if info != 0:
+            raise np.linalg.LinAlgError("bound_qp: the Schur complement of the held variables is singular")
+        norm[hold] = np.sqrt(np.einsum("ij,ij->j", M_inv, M_inv))
+        if len(free):
+            X = sla.solve_triangular(L0, Y, lower=True, trans="T", check_finite=False)    # H_FF^-1 H_FA
+            Z = X @ M_inv.T
+            extra[free] = np.einsum("ij,ij->i", Z, Z)
+            A_B = M_inv @ (B[hold] - Y.T @ B_F)
+        else:
+            A_B = M_inv @ B[hold]
+        sizes = sizes + np.einsum("ij,ij->j", A_B, A_B)
+    data = np.sqrt(sizes[0])
+    if len(e):
+        data = max(data, np.max(np.abs(e) / np.maximum(np.sqrt(sizes[1:]), 1e-300)))
+    return norm, extra, data
 
 
 def _primal_dual_sweeps(H, c, E, e, bounded, tol, max_sweeps, stop_early, guess=None):
