@@ -158,7 +158,8 @@ class ConstrainedSolver:
             self._R, A = factor.corrected_modes(self._R)
             self._Rt = self._R.T
             self._Z, S, self._first = self._schur_complement(first)
-            S = 0.5 * (S + S.T)
+            if not np.array_equal(S, S.T):    # exactly symmetric where U = D L^T: no copies of m^2
+                S = 0.5 * (S + S.T)
             G = (self.C @ self._R).toarray()
             self._S, self._G = S, G       # kept for solve_unilateral
             self._scale = _equilibration(S, G)
@@ -388,7 +389,7 @@ class ConstrainedSolver:
         Gs = d[:, None] * self._G * gscale[None, :]
         H = d[:, None] * self._S * d[None, :] + Gs @ Gs.T
         if self._coarse is None:
-            H += 1e-10 * np.eye(self.m)
+            H[np.diag_indices(self.m)] += 1e-10
         e = gscale * (self._R.T @ q)
         bounded_rows = np.flatnonzero(bounded)
         answer = bound_qp(H, d * b + Gs @ e, Gs.T, e, bounded_rows,
@@ -449,11 +450,11 @@ def _coarse_factor(S, G, A, scale):
 
     Raises SingularSystem if a pivot is below 1e-12 of the largest: general rows (nearly)
     dependent, or leaving a rigid mode free."""
-    coarse = np.block([[S, -G], [-G.T, -A]])
-    M = scale[:, None] * coarse * scale[None, :]
     m = S.shape[0]
-    factor = _CoarseFactor.by_cholesky(M, m) if m >= COARSE_CHOLESKY_MIN_ROWS else None
+    factor = _CoarseFactor.by_cholesky(S, G, A, scale) if m >= COARSE_CHOLESKY_MIN_ROWS else None
     if factor is None:
+        coarse = np.block([[S, -G], [-G.T, -A]])
+        M = scale[:, None] * coarse * scale[None, :]
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", sla.LinAlgWarning)   # judged by the pivots below
             lu = sla.lu_factor(M)
@@ -479,19 +480,22 @@ class _CoarseFactor:
         self.lu, self.cholesky, self.modes, self.pivots = lu, cholesky, modes, pivots
 
     @classmethod
-    def by_cholesky(cls, M, m):
-        """The Cholesky route, or None where M_s is not positive definite (a row on pinned
-        dofs alone has a zero diagonal there) or nearly singular (``COARSE_CHOLESKY_PIVOT_RATIO``):
-        the LU of the whole pivots through it."""
+    def by_cholesky(cls, S, G, A, scale):
+        """The Cholesky route for the coarse problem of :func:`_coarse_factor`, its blocks
+        equilibrated one by one (the entries of M, without M), or None where M_s is not
+        positive definite (a row on pinned dofs alone has a zero diagonal there) or nearly
+        singular (``COARSE_CHOLESKY_PIVOT_RATIO``): the LU of the whole pivots through it."""
+        m = S.shape[0]
+        s, g = scale[:m], scale[m:]
         try:
-            L = sla.cholesky(M[:m, :m], lower=True, check_finite=False)
+            L = sla.cholesky(s[:, None] * S * s[None, :], lower=True, check_finite=False)
         except np.linalg.LinAlgError:
             return None
         d = np.diag(L) ** 2
         if not d.min() >= COARSE_CHOLESKY_PIVOT_RATIO * d.max():
             return None
-        Y = sla.solve_triangular(L, -M[:m, m:], lower=True, check_finite=False)
-        T = -M[m:, m:] + Y.T @ Y
+        Y = sla.solve_triangular(L, s[:, None] * G * g[None, :], lower=True, check_finite=False)   # -M_g
+        T = g[:, None] * A * g[None, :] + Y.T @ Y                                                # -M_a + Y^T Y
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", sla.LinAlgWarning)   # judged by the pivots
             lu_T = sla.lu_factor(T) if len(T) else (T, np.zeros(0, dtype=np.int32))
