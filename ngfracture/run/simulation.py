@@ -26,6 +26,7 @@ from ..mechanics.problem import ElasticProblem
 from . import checkpoint
 from .control import StepControl
 from .files import RunFiles, check_folder, read_resumable
+from .heap import kept_heap
 from .scene import Scene
 from ..geometry.solid import crack_area
 from .state import crack_length
@@ -215,8 +216,9 @@ class Simulation:
                 "timings": {**self.timings, "wall": wall, "linear_solver": self.timings.factorisation_record()}}
 
     @single_threaded_blas()
+    @kept_heap()
     def run(self, on_step=None):
-        """Run to the end.
+        """Run to the end (freed memory kept for the run's next allocations, run/heap.py).
 
         Parameters
         ----------
