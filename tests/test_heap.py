@@ -1,5 +1,6 @@
-"""The heap of a run (ngfracture/run/heap.py): inside kept_heap a freed block of 64 MB
-serves the next one without a page fault; after it, a new block is fresh memory again."""
+"""The heap of a run (ngfracture/run/heap.py): inside kept_heap freed blocks of 64 MB stay
+in the process and serve the next ones without a page fault; on leaving, the free memory
+goes back to the system."""
 import resource
 
 import numpy as np
@@ -9,7 +10,14 @@ from ngfracture.run import heap
 
 pytestmark = pytest.mark.skipif(heap._glibc() is None, reason="mallopt is glibc's")
 
-SIZE = 8 * 2 ** 20       # doubles: 64 MB, above glibc's mmap threshold
+SIZE = 8 * 2 ** 20       # doubles: 64 MB, above glibc's largest mmap threshold (32 MB)
+BLOCK = SIZE * 8
+
+
+def resident():
+    """The resident set of this process, bytes."""
+    with open("/proc/self/statm") as f:
+        return int(f.read().split()[1]) * resource.getpagesize()
 
 
 def faults_of_a_fresh_block():
@@ -22,23 +30,29 @@ def faults_of_a_fresh_block():
     return faults
 
 
-def test_a_freed_block_serves_the_next_inside_and_is_returned_after():
-    """Inside: the memory of the freed block is reused, no page is faulted in (a handful
-    for the interpreter's own objects). After: glibc maps a new block, at least one fault
-    per 2 MB huge page of it."""
+def test_freed_blocks_stay_inside_and_go_back_after():
+    """Inside: four freed blocks stay resident, and a block after a freed one faults in no
+    page (a handful for the interpreter's own objects). After: the resident set is back
+    within half a block of where it was."""
+    before = resident()
     with heap.kept_heap() as kept:
         assert kept
-        faults_of_a_fresh_block()
+        blocks = [np.ones(SIZE) for _ in range(4)]
+        del blocks
+        kept_size = resident()
         inside = faults_of_a_fresh_block()
-    after = faults_of_a_fresh_block()
+    after = resident()
     assert inside <= 8
-    assert after >= SIZE * 8 // (2 * 2 ** 20)
+    assert kept_size - before >= 3.5 * BLOCK
+    assert after - before <= BLOCK / 2
 
 
 def test_nested_runs_keep_the_heap_until_the_last_leaves():
+    before = resident()
     with heap.kept_heap():
         with heap.kept_heap():
             pass
-        faults_of_a_fresh_block()
-        assert faults_of_a_fresh_block() <= 8
-    assert heap._runs == 0
+        blocks = [np.ones(SIZE) for _ in range(4)]
+        del blocks
+        assert resident() - before >= 3.5 * BLOCK
+    assert heap._runs == 0 and resident() - before <= BLOCK / 2
