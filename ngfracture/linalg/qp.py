@@ -407,7 +407,7 @@ def _start_metric(H, c, E, e, held, L0):
         (H^-1)_ii = |M^-1 e_i|^2                                     (i in A),
         b^T H^-1 b = |L0^-1 b_F|^2 + |M^-1 (b_A - H_AF H_FF^-1 b_F)|^2,
 
-    which takes triangular solves with a columns instead of a factorisation of all of H and
+    which takes triangular solves with |A| columns instead of a factorisation of all of H and
     the inverse of its factor (2 n^3 / 3 flops; 0.5 s at 3000 rows). The first term of a free
     variable's length costs (f - r)^2 / 2 for its position r in F: the C++ dual steps
     compute it for the few bounds they consider (``BoundDualActiveSet``).
