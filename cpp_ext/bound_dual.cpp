@@ -516,12 +516,17 @@ namespace ngfracture
       int best = -1;
       double most = level;
       for (int i = 0; i < qp.n; i++)
-        if (qp.bounded[i] && !s.held[i] && s.x[i] > 0.0 && s.x[i] / lengths.Floor(i) > most
-            && s.x[i] / lengths.Of(i) > most)
+      {
+        // the lower bound of the length first: most bounds are missed by too little
+        if (!qp.bounded[i] || s.held[i] || !(s.x[i] > 0.0) || !(s.x[i] / lengths.Floor(i) > most))
+          continue;
+        double miss = s.x[i] / lengths.Of(i);
+        if (miss > most)
         {
-          most = s.x[i] / lengths.Of(i);
+          most = miss;
           best = i;
         }
+      }
       return best;
     }
 

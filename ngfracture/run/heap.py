@@ -14,6 +14,7 @@ last bit, the largest resident set 2.2 -> 3.4 GB. Other C libraries than glibc: 
 import contextlib
 import ctypes
 import ctypes.util
+import functools
 import platform
 import threading
 
@@ -30,8 +31,9 @@ _runs = 0        # runs inside kept_heap in this process (nested or on threads)
 _lock = threading.Lock()
 
 
+@functools.lru_cache(maxsize=None)
 def _glibc():
-    """The C library if it is glibc with mallopt, else None."""
+    """The C library if it is glibc with mallopt, else None (looked up once per process)."""
     if platform.system() != "Linux" or platform.libc_ver()[0] != "glibc":
         return None
     try:
