@@ -24,12 +24,12 @@ rows of a cracked hole add to the stick rows.
 z = 0 of the default sphere's tangent (the dofs of a crack's lips, as the Schur
 complement by dofs keeps it, ``sparse_schur.DofSchur``): the reach solves of their unit
 rows, then the product Y^T D^-1 Y dense over every reached row
-(``triangular.weighted_products``) and by pairs of column blocks
-(``triangular.paired_block_products``), the reach solves and the paired products each on
+(``triangular.weighted_products``) and by groups of rows
+(``triangular.grouped_row_products``), the reach solves and the grouped products each on
 one thread and on ``PRODUCT_THREADS``, best of three; seconds and their ratios to one
 factorisation + solve of the tangent (the unit), the largest difference of the products
-relative to G's largest entry, and whether the paired products on one and on more
-threads agree to the last bit.
+relative to G's largest entry, and whether the grouped products on one and on more
+threads agree to the last bit. ``--g-vertices 0`` takes every free vertex.
 
 Usage: python benchmarks/schur.py [--factors 1 2 4 8 16] [--sphere FINE ... [--maxh H]
        [--hole-rows N]] [--g-vertices N ...] [--json FILE [--force]]
@@ -147,7 +147,7 @@ def g_case(vertices, repeat=3):
     nv = f.ndof // 3
     X = np.array([v.point for v in scene.mesh.vertices])
     free = np.flatnonzero(f.factor_free[:nv])
-    near = free[np.argsort(np.abs(X[free, 2]), kind="stable")[:vertices]]
+    near = free[np.argsort(np.abs(X[free, 2]), kind="stable")[:vertices or None]]
     dofs = np.concatenate([near, near + nv, near + 2 * nv])
     units = sp.csr_matrix((np.ones(len(dofs)), (np.arange(len(dofs)), dofs)), shape=(len(dofs), f.ndof))
     index = -np.ones(f.ndof, dtype=np.int64)
@@ -174,12 +174,12 @@ def g_case(vertices, repeat=3):
         best("dense", lambda: triangular.weighted_products(columns, weights, n))
         for count in (1, threads):
             triangular.PRODUCT_THREADS = count
-            best(f"paired_{count}", lambda: triangular.paired_block_products(columns, weights, n))
+            best(f"grouped_{count}", lambda: triangular.grouped_row_products(columns, weights, n))
     triangular.PRODUCT_THREADS = threads
     scale = np.abs(G["dense"]).max()
-    out["paired_difference"] = float(np.abs(G["paired_1"] - G["dense"]).max() / scale)
-    out["paired_threads_bitwise"] = bool(np.array_equal(G["paired_1"], G[f"paired_{threads}"]))
-    out["dense_over_paired"] = out["dense_s"] / out[f"paired_{threads}_s"]
+    out["grouped_difference"] = float(np.abs(G["grouped_1"] - G["dense"]).max() / scale)
+    out["grouped_threads_bitwise"] = bool(np.array_equal(G["grouped_1"], G[f"grouped_{threads}"]))
+    out["dense_over_grouped"] = out["dense_s"] / out[f"grouped_{threads}_s"]
     print(out, flush=True)
     return out
 

@@ -274,6 +274,30 @@ Returns
 numpy.ndarray, shape (m, m))doc");
 }
 
+static void ExportAddLowerBlock (py::module & m)
+{
+  using I64 = py::array_t<int64_t, py::array::c_style | py::array::forcecast>;
+  using F64C = py::array_t<double, py::array::c_style>;     // S is changed in place: never a copy (noconvert)
+  using F64F = py::array_t<double, py::array::f_style | py::array::forcecast>;
+  m.def("AddLowerBlock", [] (F64C S, I64 at, F64F B)
+        {
+          if (S.ndim() != 2 || S.shape(0) != S.shape(1) || !S.writeable())
+            throw py::value_error("ngfracture.AddLowerBlock: S must be a square, writeable, C-ordered float64 array");
+          int64_t n = S.shape(0), k = at.shape(0);
+          if (at.ndim() != 1 || B.ndim() != 2 || B.shape(0) != k || B.shape(1) != k)
+            throw py::value_error("ngfracture.AddLowerBlock: B must be k x k (Fortran-ordered) for k places");
+          for (int64_t i = 0; i < k; i++)
+            if (at.data()[i] < 0 || at.data()[i] >= n || (i && at.data()[i] <= at.data()[i - 1]))
+              throw py::value_error("ngfracture.AddLowerBlock: the places must increase within S");
+          {
+            py::gil_scoped_release release;
+            AddLowerBlock(n, S.mutable_data(), k, at.data(), B.data());
+          }
+        }, py::arg("S").noconvert(), py::arg("at"), py::arg("B"),
+        R"doc(S[at[i], at[j]] += B[j, i] for i <= j: the lower triangle of a symmetric block
+(Fortran-ordered, as BLAS syrk leaves it) into the upper triangle of S, in place.)doc");
+}
+
 static void ExportSupernodalLDL (py::module & m)
 {
   using I64 = py::array_t<int64_t, py::array::c_style | py::array::forcecast>;
@@ -357,6 +381,7 @@ PYBIND11_MODULE(_ngfracture, m)
   ExportSparseTriangular(m);
   ExportSupernodalLDL(m);
   ExportRowsProduct(m);
+  ExportAddLowerBlock(m);
   ExportCrack(m);
   ExportCollision(m);
   ExportCollision3d(m);

@@ -56,4 +56,16 @@ namespace ngfracture
           for (int64_t j = std::max(j0, i + 1); j < std::min(m, j0 + tile); j++)
             S[i * m + j] = S[j * m + i] = 0.5 * (S[i * m + j] + S[j * m + i]);
   }
+
+  void AddLowerBlock (int64_t n, double * S, int64_t k, const int64_t * at, const double * B)
+  {
+    // column i of B (contiguous) is row at[i] of S, its columns at[j] increasing
+    for (int64_t i = 0; i < k; i++)
+      {
+        double * row = S + at[i] * n;
+        const double * column = B + i * k;
+        for (int64_t j = i; j < k; j++)
+          row[at[j]] += column[j];
+      }
+  }
 }

@@ -15,5 +15,11 @@ namespace ngfracture
   // row-major.
   void RowsProduct (int64_t m, int64_t p, const int64_t * cp, const int32_t * ci, const double * cx,
                     const double * G, double * S, int threads);
+
+  // S[at[i], at[j]] += B[j, i] for i <= j < k: the lower triangle of a symmetric k x k block
+  // (column-major, as BLAS syrk leaves it) added into the upper triangle of S (n x n,
+  // row-major) at the increasing places `at`. Each entry of S gets one addition, so the
+  // sum over blocks added in a fixed order is the same whatever else runs.
+  void AddLowerBlock (int64_t n, double * S, int64_t k, const int64_t * at, const double * B);
 }
 #endif

@@ -23,7 +23,7 @@ def random_rows(factor, k, rng):
                          shape=(k, factor.ndof))
 
 
-def plate_factor(schur_by_dofs=False, paired_products=False):
+def plate_factor(schur_by_dofs=False, grouped_products=False):
     """The default plate's tangent at its first increment, factorised as the simulation does."""
     scene = scenes.plate()
     prob = ElasticProblem(scene.mesh, scene.material)
@@ -31,7 +31,7 @@ def plate_factor(schur_by_dofs=False, paired_products=False):
     rows = prob.assemble_constraints()
     support = prob.support(rows)
     factor = factor_module.EliminatedFactor(prob.tangent(), rows.fixed_dofs, support.pins,
-                                            schur_by_dofs=schur_by_dofs, paired_products=paired_products)
+                                            schur_by_dofs=schur_by_dofs, grouped_products=grouped_products)
     factor.factorise()
     return factor
 
@@ -238,18 +238,20 @@ def test_the_weighted_product_of_sparse_columns_is_symmetric_and_the_dense_one(c
 
 
 @pytest.mark.parametrize("threads", [1, 2, 3])
-def test_the_paired_block_product_is_the_dense_one_whatever_the_blocks_and_threads(threads, monkeypatch):
-    """Y^T diag(w) Y by pairs of column blocks over the rows both reach (G of the Schur
-    complement by dofs) equals the dense product to rounding (1e-14 of the largest term), is
-    exactly symmetric, and is the same to the last bit on any number of threads; a column
-    that reaches nothing has zero entries, and a weight that is not positive takes the
-    general product."""
+def test_the_grouped_row_product_is_the_dense_one_whatever_the_groups_and_threads(threads, monkeypatch):
+    """Y^T diag(w) Y by a dense block of the rows most columns reach and groups of the others
+    (G of the Schur complement by dofs) equals the dense product to rounding (1e-14 of the
+    largest term), is exactly symmetric, and is the same to the last bit on any number of
+    threads; a column that reaches nothing has zero entries, and a weight that is not
+    positive takes the general product. The columns are paths to a common root, as in a
+    factor: a few top rows that all reach, and rows below reached by runs of columns."""
     rng = np.random.default_rng(13)
-    n, m = 60, 23
+    n, m = 80, 41
     ys = []
     for j in range(m):
-        start = int(rng.integers(0, n))
-        rows = np.unique(np.concatenate([[start], rng.integers(start, n, 8)])) if j != 5 else np.zeros(0, int)
+        start = int(rng.integers(0, n - 10))
+        below = np.unique(np.concatenate([[start], rng.integers(start, n - 10, 8)]))
+        rows = np.concatenate([below, np.arange(n - 10, n)]) if j != 5 else np.zeros(0, int)
         ys.append((rows, rng.standard_normal(len(rows))))
     w = rng.uniform(0.5, 2.0, n)
     Y = np.zeros((n, m))
@@ -257,17 +259,44 @@ def test_the_paired_block_product_is_the_dense_one_whatever_the_blocks_and_threa
         Y[r, j] = v
     expected = Y.T @ (w[:, None] * Y)
     scale = (np.abs(Y).T @ (w[:, None] * np.abs(Y))).max()
-    monkeypatch.setattr(triangular, "PAIRED_BLOCK_COLUMNS", 4)
+    monkeypatch.setattr(triangular, "TOP_BLOCK_COLUMNS", 8)
+    monkeypatch.setattr(triangular, "GROUP_ROWS", 3)
     monkeypatch.setattr(triangular, "PRODUCT_THREADS", 1)
-    one = triangular.paired_block_products(ys, w, n)
+    one = triangular.grouped_row_products(ys, w, n)
     monkeypatch.setattr(triangular, "PRODUCT_THREADS", threads)
-    S = triangular.paired_block_products(ys, w, n)
+    S = triangular.grouped_row_products(ys, w, n)
     assert np.array_equal(S, one) and np.array_equal(S, S.T)
     assert np.abs(S - expected).max() <= 1e-14 * scale
     assert np.all(S[5] == 0.0)
+    reaching = np.count_nonzero(Y, axis=1)
+    groups = triangular._row_groups(reaching, triangular.TOP_ROW_SHARE * m)
+    assert np.all(reaching[n - 10:] >= triangular.TOP_ROW_SHARE * m)      # the top block is used
+    assert len(groups) >= 2 and max(b - a for a, b in groups) <= 3
+    assert sum(b - a for a, b in groups) == np.count_nonzero((reaching > 0) & (reaching < triangular.TOP_ROW_SHARE * m))
     w[ys[0][0][0]] = -1.0
     expected = Y.T @ (w[:, None] * Y)
-    assert np.abs(triangular.paired_block_products(ys, w, n) - expected).max() <= 1e-14 * scale
+    assert np.abs(triangular.grouped_row_products(ys, w, n) - expected).max() <= 1e-14 * scale
+
+
+def test_a_block_is_added_into_the_upper_triangle_in_place_and_bad_places_are_refused():
+    """``AddLowerBlock`` adds a symmetric block's lower triangle at increasing places into
+    the upper triangle of S, in S itself; places that do not increase, or an S it would
+    have to copy (Fortran-ordered, float32), are refused before anything changes."""
+    S = np.zeros((6, 6))
+    B = np.asfortranarray(np.arange(16.0).reshape(4, 4))
+    at = np.array([0, 2, 3, 5])
+    ext.AddLowerBlock(S, at, B)
+    expected = np.zeros((6, 6))
+    for i in range(4):
+        for j in range(i, 4):
+            expected[at[i], at[j]] = B[j, i]
+    assert np.array_equal(S, expected)
+    with pytest.raises(ValueError, match="places must increase"):
+        ext.AddLowerBlock(S, np.array([0, 3, 2, 5]), B)
+    for other in (np.zeros((6, 6)).T, np.zeros((6, 6), dtype=np.float32)):
+        with pytest.raises(TypeError):
+            ext.AddLowerBlock(other, at, B)
+    assert np.array_equal(S, expected)
 
 
 def test_the_rows_product_is_c_g_ct_exactly_symmetric_on_any_number_of_threads():
@@ -318,19 +347,19 @@ def test_the_schur_complement_of_rows_met_before_keeps_their_entries(monkeypatch
     assert np.abs(S2 - reference).max() <= 1e-12 * np.abs(reference).max()
 
 
-def test_the_row_by_row_schur_complement_by_paired_products_is_the_plain_one(monkeypatch):
-    """With ``paired_products`` (3D) the row-by-row S takes its new rows' products by pairs
+def test_the_row_by_row_schur_complement_by_grouped_products_is_the_plain_one(monkeypatch):
+    """With ``grouped_products`` (3D) the row-by-row S takes its new rows' products by pairs
     of column blocks: the same S as the one product to rounding (1e-14 of its largest
     entry) and as full solves (1e-12), exactly symmetric, on a first call and on a call
     that keeps some rows of it and adds others."""
     monkeypatch.setattr(factor_module, "SPARSE_SCHUR_MIN_DOFS", 0)
-    monkeypatch.setattr(triangular, "PAIRED_BLOCK_COLUMNS", 8)
-    plain, paired = plate_factor(), plate_factor(paired_products=True)
+    monkeypatch.setattr(triangular, "TOP_BLOCK_COLUMNS", 8)
+    plain, grouped = plate_factor(), plate_factor(grouped_products=True)
     rng = np.random.default_rng(16)
     first = random_rows(plain, 40, rng)
     second = sp.vstack([first[::3], random_rows(plain, 25, rng)]).tocsr()
     for C in (first, second):
-        S, reference = paired.schur(C), plain.schur(C)
+        S, reference = grouped.schur(C), plain.schur(C)
         assert np.array_equal(S, S.T)
         assert np.abs(S - reference).max() <= 1e-14 * np.abs(reference).max()
         solved = C @ plain.solve(C.T.toarray())

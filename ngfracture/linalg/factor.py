@@ -252,8 +252,8 @@ class EliminatedFactor(FactorBase):
         An NGSolve matrix of K's sparsity pattern, for NGSolve's factorisation (to_ngsolve).
     schur_by_dofs : bool
         :meth:`schur` through K^-1 on the rows' dofs (``linalg.sparse_schur.DofSchur``).
-    paired_products : bool
-        Else its products by pairs of column blocks (3D; ``sparse_schur.SparseSchur``).
+    grouped_products : bool
+        Else its products by groups of the factor's rows (3D; ``sparse_schur.SparseSchur``).
 
     Attributes
     ----------
@@ -270,7 +270,7 @@ class EliminatedFactor(FactorBase):
     """
 
     def __init__(self, K, fixed_dofs, pins=None, linear_solver="direct", inverse="auto",
-                 gmres_tol=1e-12, pattern=None, schur_by_dofs=False, paired_products=False):
+                 gmres_tol=1e-12, pattern=None, schur_by_dofs=False, grouped_products=False):
         if linear_solver not in LINEAR_SOLVERS:
             raise ValueError(f"linear_solver must be one of {LINEAR_SOLVERS}, got {linear_solver!r}")
         t0 = time.perf_counter()
@@ -287,7 +287,7 @@ class EliminatedFactor(FactorBase):
         self.linear_solver = linear_solver
         self.gmres_tol = gmres_tol
         self._tmp = ng.BaseVector(self.ndof)     # NGSolve's solvers work on its vectors
-        self._sparse, self._schur_kind = None, "dofs" if schur_by_dofs else ("paired" if paired_products else "rows")
+        self._sparse, self._schur_kind = None, "dofs" if schur_by_dofs else ("grouped" if grouped_products else "rows")
         self._triangles = None    # the factors' arrays for the C++ triangular solves (factor_arrays)
         self._lu = None
         self._ldl = None          # the supernodal L D L^T solver of the factors (SUPERNODAL_MIN_DOFS)

@@ -241,7 +241,7 @@ def make_factor(K, fixed_dofs, pins, linear_solver="direct", inverse="auto", dim
         # factorisation serves the rounds; for one system from the rows (they touch about three
         # times as many dofs as they are: by dofs 2.7 times the CPU of by rows on the sphere)
         factor = EliminatedFactor(K, fixed_dofs, pins, linear_solver, inverse, pattern=pattern,
-                                  schur_by_dofs=dim == 3 and not one_system, paired_products=dim == 3)
+                                  schur_by_dofs=dim == 3 and not one_system, grouped_products=dim == 3)
     factor.choice = record
     return factor
 

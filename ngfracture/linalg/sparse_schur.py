@@ -24,7 +24,7 @@ import scipy.sparse as sp
 from .. import _ngfracture as _ext
 from .kept import row_keys
 from . import triangular
-from .triangular import column_products, paired_block_products, reach_solves, schur_product
+from .triangular import column_products, grouped_row_products, reach_solves, schur_product
 
 
 class SparseSchur:
@@ -40,15 +40,15 @@ class SparseSchur:
         The supernodal solver of the same factors (reach solves through its panels).
     index : numpy.ndarray of int, shape (ndof,)
         The row of K_ff of every dof, -1 where a dof is not factorised.
-    paired : bool
-        Where U = D L^T, the symmetric products of new rows by pairs of column blocks
-        (:func:`linalg.triangular.paired_block_products`) instead of one over every row
-        they reach.
+    grouped : bool
+        Where U = D L^T, the symmetric products of new rows by groups of the rows of the
+        factor they reach (:func:`linalg.triangular.grouped_row_products`) instead of one
+        over every row they reach.
     """
 
-    def __init__(self, lu, arrays, supernodal, index, paired=False):
+    def __init__(self, lu, arrays, supernodal, index, grouped=False):
         self._lu, self._arrays, self._supernodal, self._index = lu, arrays, supernodal, index
-        self._paired = paired
+        self._grouped = grouped
         self._solved = {}         # row key -> its columns of Y and X, the last call's rows
         self._last = ([], None)   # the last call's row keys and S
 
@@ -90,10 +90,10 @@ class SparseSchur:
         return S
 
     def _product(self, columns):
-        """S of the rows of these columns: :func:`schur_product`, or paired (``paired``)."""
+        """S of the rows of these columns: :func:`schur_product`, or by groups of rows (``grouped``)."""
         n, pivots = self._lu.shape[0], self._arrays[2]
-        if self._paired and pivots is not None:
-            return paired_block_products([y for y, _ in columns], 1.0 / pivots, n)
+        if self._grouped and pivots is not None:
+            return grouped_row_products([y for y, _ in columns], 1.0 / pivots, n)
         return schur_product(columns, pivots, n)
 
     def _updated(self, columns, keys, known, place, last_S, pivots):
@@ -131,8 +131,8 @@ class DofSchur:
     For rows whose values change from call to call on the same dofs (see the module
     docstring): G is kept and grown by the dofs a call adds; a call then costs a sparse
     product and no triangular solve. Where every pivot was diagonal (U = D L^T), G is made
-    from the reach solves of the dofs' unit rows by the paired block products
-    (:func:`linalg.triangular.paired_block_products`) and grown by one solve of K_ff per new
+    from the reach solves of the dofs' unit rows by the products over groups of rows
+    (:func:`linalg.triangular.grouped_row_products`) and grown by one solve of K_ff per new
     dof (a few dofs against thousands: their columns of K_ff^-1 directly, instead of their
     products against every column met before); else it is the :class:`SparseSchur` of the
     unit rows.
@@ -205,7 +205,7 @@ class DofSchur:
         at = self._index[self._dofs]
         if self._G is None:
             solved = reach_solves(self._lu, self._arrays, self._index, units, self._supernodal)
-            return paired_block_products([y for y, _ in solved], 1.0 / self._arrays[2], self._lu.shape[0])
+            return grouped_row_products([y for y, _ in solved], 1.0 / self._arrays[2], self._lu.shape[0])
         E = np.zeros((self._lu.shape[0], len(at) - known), order="F")
         E[at[known:], np.arange(len(at) - known)] = 1.0
         B = (self._supernodal.solve(E) if self._supernodal is not None else self._lu.solve(E))[at]
@@ -221,8 +221,8 @@ def schur_of(kind, lu, arrays, supernodal, index):
 
     Parameters
     ----------
-    kind : {"rows", "paired", "dofs"}
-        :class:`SparseSchur`, the same with paired block products, or :class:`DofSchur`.
+    kind : {"rows", "grouped", "dofs"}
+        :class:`SparseSchur`, the same with the products by groups of rows, or :class:`DofSchur`.
     lu, arrays, supernodal, index
         As for :class:`SparseSchur`.
 
@@ -232,7 +232,7 @@ def schur_of(kind, lu, arrays, supernodal, index):
     """
     if kind == "dofs":
         return DofSchur(lu, arrays, supernodal, index)
-    return SparseSchur(lu, arrays, supernodal, index, paired=kind == "paired")
+    return SparseSchur(lu, arrays, supernodal, index, grouped=kind == "grouped")
 
 
 __all__ = ["DofSchur", "SparseSchur", "schur_of"]

@@ -23,11 +23,19 @@ from scipy.linalg import blas
 from .. import _ngfracture as _ext
 from .sparse import single_threaded_blas
 
-#: columns per block of :func:`paired_block_products` (0.32 to 0.36 of the dense product's
-#: work at 128 to 512 on the sphere's 4800 dofs; blocks of 128 keep it near the least)
-PAIRED_BLOCK_COLUMNS = 128
+#: rows reached by at least this share of the columns form the dense top block of
+#: :func:`grouped_row_products` (the separators near the root of the elimination tree) ...
+TOP_ROW_SHARE = 0.5
+#: ... multiplied by pairs of blocks of this many columns (the tasks of the threads)
+TOP_BLOCK_COLUMNS = 1024
+#: below the top, consecutive rows form a group while each is reached by at most this factor
+#: more columns than the first (the work then within 1 % of the sum over rows of the square
+#: of their columns, on the default sphere's G of 7099 dofs) ...
+GROUP_GROWTH = 1.1
+#: ... and at most this many rows
+GROUP_ROWS = 256
 #: threads of the supernodal reach solves and of the dense products of the Schur complement
-#: (:func:`paired_block_products`, ``_ngfracture.RowsProduct``): every column, block or entry
+#: (:func:`grouped_row_products`, ``_ngfracture.RowsProduct``): every column, block or entry
 #: is computed the same way whichever thread takes it, so the result does not depend on how
 #: many there are
 PRODUCT_THREADS = 2
@@ -237,18 +245,21 @@ def weighted_products(y_columns, weights, n):
     return S
 
 
-def paired_block_products(y_columns, weights, n):
+def grouped_row_products(y_columns, weights, n):
     """Y^T diag(w) Y for columns that reach few rows each (w > 0 on them), exactly symmetric,
-    in pairs of column blocks multiplied over the rows both blocks reach.
+    as a sum over groups of rows, each group one dense product over the columns it reaches.
 
     The columns of L^-1 at unit vectors reach the paths of the elimination tree from their
-    first row to the root: columns that start at neighbouring rows of the factor share most
-    of their rows, distant ones few. Sorted by their first row and cut into blocks of
-    ``PAIRED_BLOCK_COLUMNS``, a pair of blocks is one dense product over the rows both
-    reach, a third of the work of :func:`weighted_products`' product over every row any
-    column reaches (the sphere's 4800 dofs; docs/solvers.md, "Sparse Schur complement").
-    The pairs run on ``PRODUCT_THREADS`` threads, one BLAS thread each, every pair
-    computed the same way whichever thread takes it.
+    first row to the root. The rows near the root (the top separators), reached by at least
+    ``TOP_ROW_SHARE`` of the columns, carry most of the work: they are one dense block,
+    multiplied by pairs of ``TOP_BLOCK_COLUMNS`` columns (syrk on the diagonal). Every
+    other row is reached by few columns, and consecutive rows of a supernode by nearly the
+    same ones: such rows form a group (each reaching at most ``GROUP_GROWTH`` times the
+    columns of the first, at most ``GROUP_ROWS`` rows), whose product over the columns it
+    reaches is added into them. The work is the sum over rows of the square of the columns
+    reaching them, to within a few per cent (docs/solvers.md, "Sparse Schur complement").
+    The products run on ``PRODUCT_THREADS`` threads, one BLAS thread each, and are added in
+    a fixed order, so the result is the same to the last bit on any number of threads.
 
     Parameters
     ----------
@@ -263,30 +274,64 @@ def paired_block_products(y_columns, weights, n):
     numpy.ndarray, shape (len(y_columns), len(y_columns))
     """
     m = len(y_columns)
-    stacked = _stacked(y_columns)
-    if np.any(weights[stacked[0]] <= 0):
+    rows, values, column, _ = _stacked(y_columns)
+    if np.any(weights[rows] <= 0):
         return weighted_products(y_columns, weights, n)
-    first = np.array([r[0] if len(r) else n for r, _ in y_columns], dtype=np.int64)
-    order = np.argsort(first, kind="stable")
-    blocks = [_scaled_block([y_columns[k] for k in order[s:s + PAIRED_BLOCK_COLUMNS]], weights)
-              for s in range(0, m, PAIRED_BLOCK_COLUMNS)]
-    pairs = [(i, j) for i in range(len(blocks)) for j in range(i, len(blocks))]
+    Y = sp.csr_matrix((values * np.sqrt(weights[rows]), (rows, column)), shape=(n, m))
+    Y.sort_indices()
+    reaching = np.diff(Y.indptr)
+    top = np.flatnonzero(reaching >= TOP_ROW_SHARE * m)
+    W = np.asfortranarray(Y[top].toarray())
+    cuts = list(range(0, m, TOP_BLOCK_COLUMNS)) + [m]
+    pairs = [(i, j) for i in range(len(cuts) - 1) for j in range(i, len(cuts) - 1)]
 
-    def product(pair):
-        (rows_i, W_i), (rows_j, W_j) = blocks[pair[0]], blocks[pair[1]]
-        if pair[0] == pair[1]:
-            return _gram(W_i)
-        _, at_i, at_j = np.intersect1d(rows_i, rows_j, assume_unique=True, return_indices=True)
-        return W_i[at_i].T @ W_j[at_j]
+    def top_product(pair):
+        a, b = W[:, cuts[pair[0]]:cuts[pair[0] + 1]], W[:, cuts[pair[1]]:cuts[pair[1] + 1]]
+        return blas.dsyrk(1.0, a, trans=1, lower=1).T if pair[0] == pair[1] else a.T @ b
+
+    def group_product(group):
+        start, stop = Y.indptr[group[0]], Y.indptr[group[1]]
+        reached = np.unique(Y.indices[start:stop])
+        V = np.zeros((group[1] - group[0], len(reached)), order="F")
+        V[np.repeat(np.arange(len(V)), reaching[group[0]:group[1]]),
+          np.searchsorted(reached, Y.indices[start:stop])] = Y.data[start:stop]
+        return reached, blas.dsyrk(1.0, V, trans=1, lower=1)
 
     S = np.zeros((m, m))
     with single_threaded_blas(), ThreadPoolExecutor(PRODUCT_THREADS) as pool:
-        for (i, j), block in zip(pairs, pool.map(product, pairs)):
-            a = order[i * PAIRED_BLOCK_COLUMNS:(i + 1) * PAIRED_BLOCK_COLUMNS]
-            b = order[j * PAIRED_BLOCK_COLUMNS:(j + 1) * PAIRED_BLOCK_COLUMNS]
-            S[np.ix_(a, b)] = block
-            S[np.ix_(b, a)] = block.T
+        for (i, j), block in zip(pairs, pool.map(top_product, pairs)):
+            S[cuts[i]:cuts[i + 1], cuts[j]:cuts[j + 1]] = block
+        for reached, block in pool.map(group_product, _row_groups(reaching, TOP_ROW_SHARE * m)):
+            _ext.AddLowerBlock(S, reached.astype(np.int64), block)
+    _mirror_upper(S)
     return S
+
+
+def _row_groups(reaching, top):
+    """(first, stop) of the groups of :func:`grouped_row_products`: runs of consecutive rows
+    reached by fewer than ``top`` columns, each row by as many as the first or more, at most
+    ``GROUP_GROWTH`` times as many, and at most ``GROUP_ROWS`` rows."""
+    below = (reaching > 0) & (reaching < top)
+    counts = reaching.tolist()
+    groups = []
+    for r in np.flatnonzero(below).tolist():
+        if groups:
+            first, stop = groups[-1]
+            if r == stop and r - first < GROUP_ROWS and counts[first] <= counts[r] <= GROUP_GROWTH * counts[first]:
+                groups[-1] = (first, r + 1)
+                continue
+        groups.append((r, r + 1))
+    return groups
+
+
+def _mirror_upper(S, width=512):
+    """Copy S's upper triangle onto its lower one, in blocks of ``width`` rows: exactly symmetric."""
+    m = S.shape[0]
+    for a in range(0, m, width):
+        b = min(a + width, m)
+        D = S[a:b, a:b]
+        S[a:b, a:b] = np.triu(D) + np.triu(D, 1).T
+        S[b:, a:b] = S[a:b, b:].T
 
 
 def _gram(W):
@@ -294,18 +339,6 @@ def _gram(W):
     Fortran-ordered: no copy), its lower triangle the upper's mirror: exactly symmetric."""
     upper = blas.dsyrk(1.0, W.T)
     return np.triu(upper) + np.triu(upper, 1).T
-
-
-def _scaled_block(columns, weights):
-    """(rows, W): the rows the columns reach, increasing, and the columns on them as a dense
-    C-ordered array (its rows gathered fast; W.T Fortran-ordered for syrk), scaled by
-    sqrt(weights) row by row."""
-    stacked = _stacked(columns)
-    rows = np.unique(stacked[0])
-    place = np.full(int(rows[-1]) + 1 if len(rows) else 0, -1, dtype=np.int64)
-    place[rows] = np.arange(len(rows))
-    W = _dense_block(stacked, place, len(rows), 0, len(columns)) * np.sqrt(weights[rows])[:, None]
-    return rows, W
 
 
 def _stacked(columns):
