@@ -238,7 +238,7 @@ def test_the_weighted_product_of_sparse_columns_is_symmetric_and_the_dense_one(c
 
 
 @pytest.mark.parametrize("threads", [1, 2, 3])
-def test_the_grouped_row_product_is_the_dense_one_whatever_the_groups_and_threads(threads, monkeypatch):
+def test_the_grouped_row_product_is_the_dense_one_whatever_the_groups_and_threads(threads, monkeypatch, capfd):
     """Y^T diag(w) Y by a dense block of the rows most columns reach and groups of the others
     (G of the Schur complement by dofs) equals the dense product to rounding (1e-14 of the
     largest term), is exactly symmetric, and is the same to the last bit on any number of
@@ -273,9 +273,14 @@ def test_the_grouped_row_product_is_the_dense_one_whatever_the_groups_and_thread
     assert np.all(reaching[n - 10:] >= triangular.TOP_ROW_SHARE * m)      # the top block is used
     assert len(groups) >= 2 and max(b - a for a, b in groups) <= 3
     assert sum(b - a for a, b in groups) == np.count_nonzero((reaching > 0) & (reaching < triangular.TOP_ROW_SHARE * m))
+    few = [(r[r < n - 10], v[r < n - 10]) for r, v in ys]       # no row that half the columns reach
+    Y[n - 10:] = 0.0
+    assert np.count_nonzero(Y, axis=1).max() < triangular.TOP_ROW_SHARE * m
+    assert np.abs(triangular.grouped_row_products(few, w, n) - Y.T @ (w[:, None] * Y)).max() <= 1e-14 * scale
     w[ys[0][0][0]] = -1.0
     expected = Y.T @ (w[:, None] * Y)
-    assert np.abs(triangular.grouped_row_products(ys, w, n) - expected).max() <= 1e-14 * scale
+    assert np.abs(triangular.grouped_row_products(few, w, n) - expected).max() <= 1e-14 * scale
+    assert "DSYRK" not in "".join(capfd.readouterr())             # no BLAS call on an empty block
 
 
 def test_a_block_is_added_into_the_upper_triangle_in_place_and_bad_places_are_refused():

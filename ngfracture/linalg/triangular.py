@@ -283,7 +283,7 @@ def grouped_row_products(y_columns, weights, n):
     top = np.flatnonzero(reaching >= TOP_ROW_SHARE * m)
     W = np.asfortranarray(Y[top].toarray())
     cuts = list(range(0, m, TOP_BLOCK_COLUMNS)) + [m]
-    pairs = [(i, j) for i in range(len(cuts) - 1) for j in range(i, len(cuts) - 1)]
+    pairs = [(i, j) for i in range(len(cuts) - 1) for j in range(i, len(cuts) - 1)] if len(top) else []
 
     def top_product(pair):
         a, b = W[:, cuts[pair[0]]:cuts[pair[0] + 1]], W[:, cuts[pair[1]]:cuts[pair[1] + 1]]
