@@ -237,14 +237,15 @@ def test_the_weighted_product_of_sparse_columns_is_symmetric_and_the_dense_one(c
     assert np.all(S[2] == 0.0)
 
 
-@pytest.mark.parametrize("threads", [1, 2, 3])
-def test_the_grouped_row_product_is_the_dense_one_whatever_the_groups_and_threads(threads, monkeypatch, capfd):
+@pytest.mark.parametrize("top_columns", [8, 1024])
+def test_the_grouped_row_product_is_the_dense_one_whatever_the_groups(top_columns, monkeypatch, capfd):
     """Y^T diag(w) Y by a dense block of the rows most columns reach and groups of the others
     (G of the Schur complement by dofs) equals the dense product to rounding (1e-14 of the
-    largest term), is exactly symmetric, and is the same to the last bit on any number of
-    threads; a column that reaches nothing has zero entries, and a weight that is not
-    positive takes the general product. The columns are paths to a common root, as in a
-    factor: a few top rows that all reach, and rows below reached by runs of columns."""
+    largest term) and is exactly symmetric, with the top block in one product or in many;
+    a column that reaches nothing has zero entries, a product without a top block makes no
+    BLAS call on it, and a weight that is not positive takes the general product. The
+    columns are paths to a common root, as in a factor: a few top rows that all reach, and
+    rows below reached by runs of columns."""
     rng = np.random.default_rng(13)
     n, m = 80, 41
     ys = []
@@ -259,13 +260,10 @@ def test_the_grouped_row_product_is_the_dense_one_whatever_the_groups_and_thread
         Y[r, j] = v
     expected = Y.T @ (w[:, None] * Y)
     scale = (np.abs(Y).T @ (w[:, None] * np.abs(Y))).max()
-    monkeypatch.setattr(triangular, "TOP_BLOCK_COLUMNS", 8)
+    monkeypatch.setattr(triangular, "TOP_BLOCK_COLUMNS", top_columns)
     monkeypatch.setattr(triangular, "GROUP_ROWS", 3)
-    monkeypatch.setattr(triangular, "PRODUCT_THREADS", 1)
-    one = triangular.grouped_row_products(ys, w, n)
-    monkeypatch.setattr(triangular, "PRODUCT_THREADS", threads)
     S = triangular.grouped_row_products(ys, w, n)
-    assert np.array_equal(S, one) and np.array_equal(S, S.T)
+    assert np.array_equal(S, S.T)
     assert np.abs(S - expected).max() <= 1e-14 * scale
     assert np.all(S[5] == 0.0)
     reaching = np.count_nonzero(Y, axis=1)
