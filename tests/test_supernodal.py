@@ -241,7 +241,8 @@ def test_the_weighted_product_of_sparse_columns_is_symmetric_and_the_dense_one(c
 def test_the_grouped_row_product_is_the_dense_one_whatever_the_groups(top_columns, monkeypatch, capfd):
     """Y^T diag(w) Y by a dense block of the rows most columns reach and groups of the others
     (G of the Schur complement by dofs) equals the dense product to rounding (1e-14 of the
-    largest term) and is exactly symmetric, with the top block in one product or in many;
+    largest term) and is exactly symmetric, with the top block in one product or in many,
+    in a new array or in the one given;
     a column that reaches nothing has zero entries, a product without a top block makes no
     BLAS call on it, and a weight that is not positive takes the general product. The
     columns are paths to a common root, as in a factor: a few top rows that all reach, and
@@ -263,6 +264,9 @@ def test_the_grouped_row_product_is_the_dense_one_whatever_the_groups(top_column
     monkeypatch.setattr(triangular, "TOP_BLOCK_COLUMNS", top_columns)
     monkeypatch.setattr(triangular, "GROUP_ROWS", 3)
     S = triangular.grouped_row_products(ys, w, n)
+    room = np.full(m * m + 7, np.nan)
+    into = triangular.grouped_row_products(ys, w, n, out=room[:m * m].reshape(m, m))
+    assert np.shares_memory(into, room) and np.array_equal(into, S)      # written where asked
     assert np.array_equal(S, S.T)
     assert np.abs(S - expected).max() <= 1e-14 * scale
     assert np.all(S[5] == 0.0)
@@ -394,6 +398,34 @@ def test_the_schur_complement_by_dofs_solves_no_row_whose_dofs_were_met(monkeypa
     dofs_more = len(np.setdiff1d(more.indices, first.indices))
     assert solves == [dofs_first]
     assert len(factor._sparse._dofs) == dofs_first + dofs_more
+
+
+def test_g_grows_in_its_room_with_the_numbers_of_a_fresh_array(monkeypatch):
+    """G grown call after call by new dofs lives at the start of an array with room to grow
+    and moves within it (the rows overlapping their new places included): bit for bit the
+    G of a DofSchur that takes a fresh array at every growth, exactly symmetric, and K^-1
+    on the dofs from full solves to rounding (1e-12); the room is made once while it lasts."""
+    monkeypatch.setattr(factor_module, "SPARSE_SCHUR_MIN_DOFS", 0)
+    rng = np.random.default_rng(11)
+    roomy, tight = plate_factor(schur_by_dofs=True), plate_factor(schur_by_dofs=True)
+    calls = [random_rows(roomy, 6, rng)] + [random_rows(roomy, 1, rng) for _ in range(4)]
+    rooms, sizes = set(), set()
+    for k, C in enumerate(calls):
+        monkeypatch.setattr(sparse_schur_module, "GROWTH_ROOM", 400)
+        roomy.schur(sp.vstack(calls[:k + 1]).tocsr())
+        monkeypatch.setattr(sparse_schur_module, "GROWTH_ROOM", 0)
+        if tight._sparse is not None:
+            tight._sparse._room = None                       # a fresh array at every growth
+        tight.schur(sp.vstack(calls[:k + 1]).tocsr())
+        G, dofs = roomy._sparse._G, roomy._sparse._dofs
+        assert np.array_equal(G, tight._sparse._G) and np.array_equal(G, G.T)
+        E = sp.csr_matrix((np.ones(len(dofs)), (np.arange(len(dofs)), dofs)), shape=(len(dofs), roomy.ndof))
+        reference = E @ roomy.solve(E.T.toarray())
+        assert np.abs(G - reference).max() <= 1e-12 * np.abs(reference).max()
+        sizes.add(len(dofs))
+        if roomy._sparse._room is not None:
+            rooms.add(id(roomy._sparse._room))
+    assert len(rooms) == 1 and len(sizes) >= 4          # grown three times or more in one room
 
 
 def test_the_schur_complement_by_dofs_of_rows_met_in_the_last_product_is_its_own_numbers(monkeypatch):

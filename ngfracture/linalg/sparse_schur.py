@@ -149,6 +149,7 @@ class DofSchur:
         self._index, self._symmetric = index, arrays[2] is not None     # U = D L^T: G symmetric
         self._dofs, self._order, self._G = np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), None
         self._made = ({}, None)   # the last product's rows (key -> position) and S
+        self._room = None         # the array G lives at the start of once it has grown, with room to grow
 
     def complement(self, C):
         """S for the rows C (entries at dofs that are not factorised are ignored).
@@ -205,15 +206,44 @@ class DofSchur:
         at = self._index[self._dofs]
         if self._G is None:
             solved = reach_solves(self._lu, self._arrays, self._index, units, self._supernodal)
-            return grouped_row_products([y for y, _ in solved], 1.0 / self._arrays[2], self._lu.shape[0])
+            return grouped_row_products([y for y, _ in solved], 1.0 / self._arrays[2], self._lu.shape[0],
+                                        out=self._new_room(p))
         E = np.zeros((self._lu.shape[0], len(at) - known), order="F")
         E[at[known:], np.arange(len(at) - known)] = 1.0
         B = (self._supernodal.solve(E) if self._supernodal is not None else self._lu.solve(E))[at]
-        G = np.empty((len(at), len(at)))
-        G[:known, :known] = self._G
+        G = self._moved(known, len(at))
         G[:known, known:], G[known:, :known] = B[:known], B[:known].T
         G[known:, known:] = 0.5 * (B[known:] + B[known:].T)
         return G
+
+    def _moved(self, known, p):
+        """A p x p array (C-ordered) whose first ``known`` rows and columns are G's.
+
+        G grows by a few dofs at a time. A fresh p x p array at every growth is fresh memory,
+        faulted in page by page as G is copied into it (1.3 s for the late default sphere's 400 MB
+        against 0.05 s for the copy), so G lives at the start of an array with room for
+        ``GROWTH_ROOM`` more rows (or a sixteenth more) and moves within it, row by row from
+        the last: a row's new place lies past the old places of all rows before it."""
+        if self._room is None or self._room.size < p * p:
+            G = self._new_room(p)
+            G[:known, :known] = self._G
+            return G
+        flat = self._room
+        for i in range(known - 1, 0, -1):
+            row = flat[i * known:(i + 1) * known]
+            # a row that overlaps its own new place is copied first (no copy may run over its source)
+            flat[i * p:i * p + known] = row.copy() if i * p < (i + 1) * known else row
+        return flat[:p * p].reshape(p, p)
+
+    def _new_room(self, p):
+        """A new array with room for G to grow in, and its first p x p entries as a C-ordered view."""
+        size = p + max(GROWTH_ROOM, p // 16)
+        self._room = np.empty(size * size)
+        return self._room[:p * p].reshape(p, p)
+
+
+#: rows of room for G to grow in (:meth:`DofSchur._moved`), at least
+GROWTH_ROOM = 256
 
 
 def schur_of(kind, lu, arrays, supernodal, index):

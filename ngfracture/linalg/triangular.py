@@ -244,7 +244,7 @@ def weighted_products(y_columns, weights, n):
     return S
 
 
-def grouped_row_products(y_columns, weights, n):
+def grouped_row_products(y_columns, weights, n, out=None):
     """Y^T diag(w) Y for columns that reach few rows each (w > 0 on them), exactly symmetric,
     as a sum over groups of rows, each group one dense product over the columns it reaches.
 
@@ -270,15 +270,21 @@ def grouped_row_products(y_columns, weights, n):
     weights : numpy.ndarray, shape (n,)
         Where one is not positive on a row a column reaches: :func:`weighted_products`.
     n : int
+    out : numpy.ndarray, shape (len(y_columns), len(y_columns)), optional
+        C-ordered array to write the result into (G in the room it grows in,
+        ``sparse_schur.DofSchur``); a new one without it.
 
     Returns
     -------
     numpy.ndarray, shape (len(y_columns), len(y_columns))
+        ``out`` where given.
     """
     m = len(y_columns)
     rows, values, column, _ = _stacked(y_columns)
+    S = np.zeros((m, m)) if out is None else out
     if np.any(weights[rows] <= 0):
-        return weighted_products(y_columns, weights, n)
+        S[...] = weighted_products(y_columns, weights, n)
+        return S
     Y = sp.csr_matrix((values * np.sqrt(weights[rows]), (rows, column)), shape=(n, m))
     Y.sort_indices()
     reaching = np.diff(Y.indptr)
@@ -299,7 +305,7 @@ def grouped_row_products(y_columns, weights, n):
           np.searchsorted(reached, Y.indices[start:stop])] = Y.data[start:stop]
         return reached.astype(np.int64), blas.dsyrk(1.0, V, trans=1, lower=1)
 
-    S = np.zeros((m, m))
+    S[...] = 0.0
     with single_threaded_blas():
         for i, j in pairs:
             S[cuts[i]:cuts[i + 1], cuts[j]:cuts[j + 1]] = top_product((i, j))
