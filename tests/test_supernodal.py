@@ -242,11 +242,10 @@ def test_the_grouped_row_product_is_the_dense_one_whatever_the_groups(top_column
     """Y^T diag(w) Y by a dense block of the rows most columns reach and groups of the others
     (G of the Schur complement by dofs) equals the dense product to rounding (1e-14 of the
     largest term) and is exactly symmetric, with the top block in one product or in many,
-    in a new array or in the one given;
-    a column that reaches nothing has zero entries, a product without a top block makes no
-    BLAS call on it, and a weight that is not positive takes the general product. The
-    columns are paths to a common root, as in a factor: a few top rows that all reach, and
-    rows below reached by runs of columns."""
+    in a new array or in the one given; a column that reaches nothing has zero entries, a
+    product without a top block makes no BLAS call on it, and a weight that is not positive
+    takes the general product. The columns are paths to a common root, as in a factor: a
+    few top rows that all reach, and rows below reached by runs of columns."""
     rng = np.random.default_rng(13)
     n, m = 80, 41
     ys = []
@@ -355,10 +354,10 @@ def test_the_schur_complement_of_rows_met_before_keeps_their_entries(monkeypatch
 
 
 def test_the_row_by_row_schur_complement_by_grouped_products_is_the_plain_one(monkeypatch):
-    """With ``grouped_products`` (3D) the row-by-row S takes its new rows' products by pairs
-    of column blocks: the same S as the one product to rounding (1e-14 of its largest
-    entry) and as full solves (1e-12), exactly symmetric, on a first call and on a call
-    that keeps some rows of it and adds others."""
+    """With ``grouped_products`` (3D) the row-by-row S takes its new rows' products by
+    groups of the factor's rows: the same S as the one product to rounding (1e-14 of its
+    largest entry) and as full solves (1e-12), exactly symmetric, on a first call and on a
+    call that keeps some rows of it and adds others."""
     monkeypatch.setattr(factor_module, "SPARSE_SCHUR_MIN_DOFS", 0)
     monkeypatch.setattr(triangular, "TOP_BLOCK_COLUMNS", 8)
     plain, grouped = plate_factor(), plate_factor(grouped_products=True)
