@@ -149,7 +149,7 @@ class DofSchur:
         self._index, self._symmetric = index, arrays[2] is not None     # U = D L^T: G symmetric
         self._dofs, self._order, self._G = np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), None
         self._made = ({}, None)   # the last product's rows (key -> position) and S
-        self._room = None         # the array G lives at the start of once it has grown, with room to grow
+        self._room = None         # the array G lives at the start of, with room to grow (_moved)
 
     def complement(self, C):
         """S for the rows C (entries at dofs that are not factorised are ignored).
