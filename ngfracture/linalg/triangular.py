@@ -281,7 +281,7 @@ def grouped_row_products(y_columns, weights, n, out=None):
     """
     m = len(y_columns)
     rows, values, column, _ = _stacked(y_columns)
-    S = np.zeros((m, m)) if out is None else out
+    S = np.empty((m, m)) if out is None else out
     if np.any(weights[rows] <= 0):
         S[...] = weighted_products(y_columns, weights, n)
         return S
