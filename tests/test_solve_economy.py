@@ -15,7 +15,7 @@ import pytest
 
 import ngfracture as nf
 from ngfracture.contact.solver import ContactSolver
-from ngfracture.mechanics.newton import NewtonSolver
+from ngfracture.mechanics.newton import NewtonSolver, rewinder
 
 from conftest import square_mesh
 from test_contact_solve import pressed_blocks
@@ -33,6 +33,21 @@ def exact(stretch=0.1):
     prob = stretched(stretch)
     assert prob.solve(method="full", tol=1e-14).converged
     return prob.u.vec.FV().NumPy().copy()
+
+
+def test_a_rewound_problem_solves_again_to_the_same_bits():
+    """A retry starts where the failed solve started: the displacement and the load factor."""
+    prob = stretched()
+    prob.load_factor.Set(0.25)
+    start = prob.u.vec.FV().NumPy().copy()
+    rewind = rewinder(prob)
+    assert prob.solve(method="full", tol=1e-12).converged
+    first = prob.u.vec.FV().NumPy().copy()
+    assert prob.load_factor.Get() == 1.0 and np.abs(first - start).max() > 1e-3
+    rewind()
+    assert prob.load_factor.Get() == 0.25 and np.array_equal(prob.u.vec.FV().NumPy(), start)
+    assert prob.solve(method="full", tol=1e-12).converged
+    assert np.array_equal(prob.u.vec.FV().NumPy(), first)
 
 
 @pytest.mark.parametrize("tol", [1e-4, 1e-6, 1e-8])

@@ -49,7 +49,7 @@ from .seams import KINK_ANGLE, find_seams
 from ..linalg.factor import SingularSystem
 from ..linalg.sparse import single_threaded_blas
 from ..linalg.qp import QPError
-from ..mechanics.newton import NewtonSolver, SolveStatus, check_solve_options
+from ..mechanics.newton import NewtonSolver, SolveStatus, check_solve_options, rewinder
 from ..mechanics.tangent import SavedTangent
 
 __all__ = ["ContactResult", "ContactSolver", "space_columns", "space_columns_3d", "LABEL", "PENETRATION_FRACTION"]
@@ -436,14 +436,13 @@ class ContactSolver:
         warm = set() if uncracked else set(warm)
         if not warm:
             return self._solve(warm, uncracked, lineage, start)
-        u, load = prob.u.vec.FV().NumPy().copy(), prob.load_factor.Get()
+        rewind = rewinder(prob)
         result = self._solve(warm, uncracked, lineage, start)
         if result.converged:
             return result
         # rows of the pass before can hold a shattered piece in a nearly singular way
         # (docs/contact.md); the plain path decides then
-        prob.u.vec.FV().NumPy()[:] = u
-        prob.load_factor.Set(load)
+        rewind()
         plain = self._solve(set(), uncracked, lineage, start)
         plain.notes.append(f"the warm start from {len(warm)} contact rows failed ({result.reason}); "
                            "solved from the prediction without rows")

@@ -156,6 +156,27 @@ class SolveStatus:
         return self
 
 
+def rewinder(prob):
+    """A function that puts the displacement and load factor of ``prob`` back as they are
+    now: a solve that failed is tried again from the same start.
+
+    Parameters
+    ----------
+    prob : ElasticProblem
+
+    Returns
+    -------
+    callable
+        ``rewind()``, without arguments.
+    """
+    u, load = prob.u.vec.FV().NumPy().copy(), prob.load_factor.Get()
+
+    def rewind():
+        prob.u.vec.FV().NumPy()[:] = u
+        prob.load_factor.Set(load)
+    return rewind
+
+
 class _Timer:
     def __init__(self, timings, phase):
         self.timings, self.phase = timings, phase

@@ -26,6 +26,7 @@ A tangent kept from the step before that fails is not a retry of this kind: the 
 makes the same attempt with a tangent of its own (``LoadStep.step``).
 """
 
+from ..mechanics.newton import rewinder
 from .records import Equilibrium, StepFailed, merged_notes
 
 __all__ = ["next_retry", "rescued"]
@@ -93,12 +94,11 @@ def rescued(solve, prob, phase):
     StepFailed
         The full-Newton solve failed too.
     """
-    u, load = prob.u.vec.FV().NumPy().copy(), prob.load_factor.Get()
+    rewind = rewinder(prob)
     try:
         return solve("modified")
     except StepFailed as err:
-        prob.u.vec.FV().NumPy()[:] = u
-        prob.load_factor.Set(load)
+        rewind()
         eq = solve("full")
         note = f"a {phase} solve that failed with modified Newton ({err.reason}) was solved with full Newton"
         return Equilibrium(eq.contact_keys, eq.tangent, eq.iterations, merged_notes(eq.notes, [note]))
