@@ -233,6 +233,7 @@ def test_first_only_splits_the_first_vertex_that_splits():
     def cut(r):          # the processed vertices that cut edges
         return set(r.record["vertex"][np.diff(r.record["edge_offsets"]) > 0].tolist())
     assert cut(res) == {inner} and np.array_equal(res.record["principal"], [3.0, 2.0])
+    assert res.refusals == {"2 2a": 1}      # the overstrained vertex the rules refused
     every = fracture.split_by_tensor(m, tensors, 1.0)
     assert set(every.record["vertex"]) == {edge, inner, other} and cut(every) == {inner, other}
     # nothing splittable: the whole order processed, nothing split, the same mesh

@@ -240,3 +240,30 @@ def test_run_free(tmp_path):
 def solid_arrays(scene):
     from ngfracture.geometry.solid import solid_to_arrays
     return solid_to_arrays(scene.mesh)
+
+
+def test_vertices_no_rule_cuts_are_noted_with_their_count_and_overstrain():
+    """A relaxation ends at the first pass that splits nothing. Overstrained vertices that
+    pass leaves (a cut that would close a pocket between crack sheets, docs/solid.md,
+    "Refusals") stay overstrained: the step's note says how many and how far, and that
+    count is the accepted state's own (the spread pass processes every overstrained vertex
+    when it splits none). On the coarse confined sphere the first such steps come at about
+    1.6 x_c (docs/solid.md, "The coarse runs and the contact rules they need")."""
+    from ngfracture.fracture.solid_criterion import principal_3d
+    from ngfracture.run.simulation import Simulation, StepControl
+    scene = sphere3d(**COARSE)
+    criterion, seen = scene.criterion(), []
+
+    def on_step(accepted):
+        prob = accepted.problem
+        values = principal_3d(criterion.overstrain(prob.mesh, prob.u, accepted.state.strength, arrays=prob.arrays))[0]
+        notes = [n for n in accepted.record["notes"] if "overstrained" in n]
+        seen.append((int(np.sum(values > 1.0)), float(values.max()), notes))
+
+    Simulation(scene, StepControl(max_steps=9), pictures="none").run(on_step=on_step)
+    assert any(count for count, _, _ in seen)
+    for count, largest, notes in seen:
+        assert len(notes) == (count > 0), (count, notes)
+        if count:
+            number = count if count > 1 else "1 vertex stays"
+            assert notes[0].startswith(f"{number} ") and f"(up to {largest:.4g})" in notes[0], (count, largest, notes)

@@ -160,6 +160,7 @@ def test_new_crack_at_a_free_surface_vertex():
     # pulled normal to the surface, a surface vertex splits nothing (rule 2a)
     r = s3.split_vertices_3d(a, [v], [X])
     assert r.nsplit == 0 and {"none", "aligned"} <= names(r.record["flags"][0])
+    assert r.refusals == {"aligned": 1} and s3.split_vertices_3d(a, [v], [Z]).refusals == {}
 
 
 def test_fronts_meet_the_free_surface():

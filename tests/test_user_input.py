@@ -60,6 +60,37 @@ def test_a_bad_load_is_refused_before_the_folder_is_touched(case, message, coars
     assert snapshot(earlier_results) == before            # nothing deleted, nothing written
 
 
+def tied_plate(coarse_plate, kinds):
+    """The coarse plate with general rows: "tie" (two free dofs equal), "again" (that row
+    repeated), "fixed" (a row on a dof the plate's Dirichlet conditions fix)."""
+    def apply_load(prob, x):
+        coarse_plate.apply_load(prob, x)
+        n = prob.fes.ndof
+        fixed = prob.assemble_constraints().fixed_dofs
+        free = np.setdiff1d(np.arange(n), fixed)
+        for kind in kinds:
+            row = np.zeros((1, n))
+            if kind == "fixed":
+                row[0, fixed[0]] = 1.0
+            else:
+                row[0, free[0]], row[0, free[5]] = 1.0, -1.0
+            prob.constraints.add_rows(row, [0.0], label=kind)
+    return with_load(coarse_plate, apply_load)
+
+
+def test_dependent_constraint_rows_are_refused_before_the_folder_is_touched(coarse_plate, earlier_results):
+    """Measured before: rows repeating others passed the check, and every attempt of the
+    first step then failed as singular, cutting dx seven times."""
+    before = snapshot(earlier_results)
+    with pytest.raises(ValueError) as exc:
+        Simulation(tied_plate(coarse_plate, ["tie", "again", "fixed"]), out=earlier_results, force=True)
+    message = str(exc.value)
+    assert "Scene 'plate'" in message and "2 of its 3 general constraint rows (again: 1, fixed: 1; rows 1, 2)" in message
+    assert snapshot(earlier_results) == before
+    # one tie is independent of the Dirichlet rows: accepted
+    Simulation(tied_plate(coarse_plate, ["tie"]))
+
+
 def test_a_bad_material_region_is_refused_before_the_folder_is_touched(coarse_plate, earlier_results):
     from ngfracture.mechanics.materials import LinearElastic
     scene = with_load(coarse_plate, coarse_plate.apply_load, material={"glass": LinearElastic(1.0, 0.3)})

@@ -60,6 +60,7 @@ Rules as implemented (paper section 3; decisions where the paper is silent)
 """
 import math
 import time
+from collections import Counter
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -195,6 +196,18 @@ class SplitResult:
     def nsplit(self):
         """Number of vertices created."""
         return len(self.parent) - int(self.record["nv_old"])
+
+    @property
+    def refusals(self):
+        """The processed vertices that cut no edge, counted by their rules ("2 2a", "none").
+
+        Returns
+        -------
+        dict
+            Rule names (:func:`rule_names`, joined by spaces) to counts, sorted by name.
+        """
+        cut = np.diff(self.record["edge_offsets"]) > 0
+        return dict(sorted(Counter(" ".join(rule_names(r)) for r in self.record["rule"][~cut]).items()))
 
 
 def split_vertices(mesh, vertices, directions, crack_name="crack", skip_neighbours=False, rules=PAPER_RULES):

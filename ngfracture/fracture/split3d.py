@@ -61,6 +61,7 @@ A front edge is an edge held by two crack faces whose third vertices are distinc
 one point (the two lips meet there): :func:`front_edges_3d`.
 """
 import math
+from collections import Counter
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -71,10 +72,12 @@ from .solid_criterion import principal_3d
 
 __all__ = ["SPLIT3D_FLAGS", "SPLIT_MODES", "Split3dResult", "split_vertices_3d",
            "split_by_tensor_3d", "front_edges_3d",
-           "pinched_vertices_3d", "flag_names_3d"]
+           "pinched_vertices_3d", "flag_names_3d", "REFUSALS_3D"]
 
 #: bit flags of the record's "flags" entries, by name (cpp_ext/crack_split3d.hpp)
 SPLIT3D_FLAGS = dict(_ext.SPLIT3D_FLAGS)
+#: the flags that say why a vertex split nothing (docs/solid.md, "Refusals")
+REFUSALS_3D = ("empty", "enclosed", "dangling", "aligned", "pocket")
 
 
 def flag_names_3d(flags):
@@ -118,6 +121,20 @@ class Split3dResult:
     def nsplit(self):
         """Number of vertices created."""
         return len(self.parent) - int(self.record["nv_old"])
+
+    @property
+    def refusals(self):
+        """The processed vertices that changed nothing (flag ``none``), counted by the rule
+        that refused them (``REFUSALS_3D``; "none" where no rule is named).
+
+        Returns
+        -------
+        dict
+            Rule names to counts, sorted by name.
+        """
+        refused = (self.record["flags"] & SPLIT3D_FLAGS["none"]) != 0
+        names = (" ".join(n for n in flag_names_3d(f) if n in REFUSALS_3D) or "none" for f in self.record["flags"][refused])
+        return dict(sorted(Counter(names).items()))
 
 
 def _crack_bc(arrays, crack_name):

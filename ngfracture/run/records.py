@@ -99,6 +99,9 @@ class CrackPass:
         Reference positions (k, 2) of the vertices that split.
     overstrain : float
         The largest overstrain of the equilibrium it judged (a vertex splits above 1).
+    refused : dict
+        Of a pass that split nothing: its overstrained vertices counted by the splitting
+        rule that refused them (the engines' ``refusals``); empty when none was refused.
     """
     problem: object
     n_split: int
@@ -106,6 +109,22 @@ class CrackPass:
     lineage: object
     positions: np.ndarray
     overstrain: float
+    refused: dict = field(default_factory=dict)
+
+    def refusal_note(self):
+        """The note of a pass that left overstrained vertices unsplit (None if it did not):
+        their cracks stop on the splitting rules, not on the criterion.
+
+        Returns
+        -------
+        str or None
+        """
+        if not self.refused:
+            return None
+        rules = ", ".join(f"{name}: {count}" for name, count in self.refused.items())
+        n = sum(self.refused.values())
+        return (f"{n} {'vertex stays' if n == 1 else 'vertices stay'} overstrained (up to {self.overstrain:.4g}) "
+                f"where no splitting rule cuts them ({rules}): cracks stop there on the rules, not on the criterion")
 
 
 @dataclass

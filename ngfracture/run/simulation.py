@@ -17,7 +17,10 @@ import warnings
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
+import numpy as np
+
 from ..contact.overlap import fragment_overlap_area
+from ..contact.redundancy import independent_rows
 from ..fracture.criterion import ONE_RING_NOTE
 from ..fracture.crack_graph import crack_graph
 from ..fracture.fragments import FragmentStatistics
@@ -158,19 +161,22 @@ class Simulation:
         """Build the problem at x = 0, at the first increment and at the final load: the scene's materials,
         regions and the boundaries its ``apply_load`` names are checked before any work. Returns
         whether the problem at the first increment has loads other than prescribed displacements."""
-        dead_loads = False
+        dead_loads, dependent = False, ""
         for x in (0.0, float(self.scene.dx), float(self.scene.load_max)):
             try:
                 with warnings.catch_warnings():
                     warnings.simplefilter("ignore")   # mesh quality: the run's own problems warn
                     prob = ElasticProblem(self.scene.mesh, self.scene.material, order=1)
                 self.scene.apply_load(prob, x)
-                prob.assemble_constraints()
+                rows = prob.assemble_constraints()
                 if x == float(self.scene.dx):
-                    dead_loads = bool(prob.loads)
+                    dead_loads, dependent = bool(prob.loads), dependent_rows(prob, rows)
             except Exception as exc:
                 raise ValueError(f"Scene {self.scene.name!r}: the problem at load x = {x:g} cannot be "
                                  f"built: {type(exc).__name__}: {exc}") from exc
+            if dependent:
+                raise ValueError(f"Scene {self.scene.name!r}: at load x = {x:g}, {dependent}: every solve "
+                                 f"would be singular; leave them out of apply_load")
         return dead_loads
 
     def _identity(self):
@@ -347,6 +353,37 @@ class Simulation:
             "timings": {**{k: round(v, 6) for k, v in self.timings.items()}, "wall": round(wall, 6),
                         "linear_solver": self.timings.factorisation_record()},
         }
+
+
+def dependent_rows(prob, rows):
+    """Which general constraint rows of a problem depend linearly on the others or on its
+    single-dof rows, in words ("" where none does).
+
+    Parameters
+    ----------
+    prob : ElasticProblem
+    rows : ConstraintRows
+        ``prob.assemble_constraints()``.
+
+    Returns
+    -------
+    str
+        E.g. "12 of its 120 general constraint rows (stick: 12; rows 3, 7, ...) depend on the
+        others or on the Dirichlet conditions".
+    """
+    m = rows.C.shape[0]
+    if m == 0:
+        return ""
+    # rtol far below the redundancy removal's: only rows that no solve could impose
+    dropped = np.setdiff1d(np.arange(m), independent_rows(rows.C, rows.fixed_dofs, rtol=1e-10))
+    if dropped.size == 0:
+        return ""
+    blocks = prob.constraints.rows
+    labels = np.repeat([label for _, _, label in blocks], [C.shape[0] for C, _, _ in blocks])[dropped]
+    counts = ", ".join(f"{name}: {int(np.sum(labels == name))}" for name in dict.fromkeys(labels))
+    listed = ", ".join(str(i) for i in dropped[:8]) + (", ..." if dropped.size > 8 else "")
+    return (f"{dropped.size} of its {m} general constraint rows ({counts}; rows {listed}) depend on the "
+            f"others or on the Dirichlet conditions")
 
 
 def _linear_at_large_strain(scene):
