@@ -242,6 +242,10 @@ def _run_run(args):
     print(f"{scene.name}: {s['n_steps']} steps, {s['n_split_vertices']} split vertices, {crack}, "
           f"{s['n_fragments']} fragments, {s['timings']['wall']:.1f} s; "
           f"{result.reason}: {result.message}", file=closing)
+    if s.get("notes"):     # departures from the plain path (docs/command_line.md): say that there are some
+        last = s["notes"][-1]
+        print(f"{len(s['notes'])} notes in summary.json (\"notes\"), the last of step {last['step']}: "
+              f"{last['note']}", file=closing)
     if s.get("pictures", {}).get("final_error"):
         print(f"final.png was not drawn: {s['pictures']['final_error']}", file=sys.stderr)
     files = ["results.pvd", "cracks.pvd", "summary.json"] + sorted(

@@ -195,6 +195,19 @@ def test_failed_run_exits_1_with_the_last_good_state(tmp_path, capsys, monkeypat
     assert (out / "checkpoint_000002.npz").exists()
 
 
+def test_a_run_with_notes_says_so_in_its_closing_lines(tmp_path, capsys):
+    """A departure from the plain path is in summary.json; the closing lines say how many
+    there are and repeat the last (the coarse sphere's eighth step leaves vertices no
+    splitting rule cuts: docs/solid.md, "Refused vertices in runs")."""
+    out = tmp_path / "o"
+    assert main(["run", "sphere3d", "--set", "maxh=0.4", "--set", "fine=0.15", "--steps", "8", "--quiet",
+                 "--pictures", "none", "--out", str(out)]) == 0
+    notes = json.loads((out / "summary.json").read_text())["notes"]
+    assert notes and "stay overstrained" in notes[-1]["note"]
+    line = f'{len(notes)} notes in summary.json ("notes"), the last of step {notes[-1]["step"]}: {notes[-1]["note"]}'
+    assert line in capsys.readouterr().out.splitlines()
+
+
 if __name__ == "__main__":
     raise SystemExit(pytest.main([__file__, "-q"]))
 
