@@ -243,8 +243,9 @@ def relax(stepper, prob, crack, eq, x, area, method, timings):
             break         # one event per load step: the next step finds the next critical load
         crack = stepper.crack_pass(prob, x, strength, eq.tangent, timings)
         splits += crack.n_split
-    if crack.problem is None and crack.refusal_note():
-        notes = merged_notes(notes, [crack.refusal_note()])
+    refused = crack.refusal_note() if crack.problem is None else None
+    if refused:
+        notes = merged_notes(notes, [refused])
     # after a lost support the last factorisation is of another mesh: nothing to keep
     return Relaxation(prob, strength, eq.contact_keys, None if lost else eq.tangent, splits, work, positions,
                       iterations, notes, broken, lost, area)
