@@ -95,8 +95,8 @@ def _add_run(subparsers):
                         "'ngfracture scenes' lists the built-in scenes' parameters)")
     p.add_argument("--maxh", type=_positive_float, default=None,
                    help="mesh size, short for --set maxh=H (default: the scene's)")
-    p.add_argument("--steps", type=_int_at_least(1), default=200,
-                   help="at most this many accepted load steps (default 200)")
+    p.add_argument("--steps", type=_int_at_least(1), default=None,
+                   help="at most this many accepted load steps (default: the scene's, else 200)")
     p.add_argument("--load-max", type=_positive_float, default=None,
                    help="final value of the load parameter x (default: the scene's). plate: "
                         "x is the total extension of the unit plate (length; the mean strain); "
@@ -215,7 +215,9 @@ def _run_run(args):
     assignments = list(args.assignments) + ([f"maxh={args.maxh!r}"] if args.maxh is not None else [])
     params = parse_assignments(assignments, make_scene)
     settings = {name: getattr(args, name) for name, _, _ in CONTROL_OPTIONS if getattr(args, name) is not None}
-    control = StepControl(max_steps=args.steps, **settings)
+    if args.steps is not None:        # else the scene's own max_steps, if it has one
+        settings["max_steps"] = args.steps
+    control = StepControl(**settings)
     out = args.out if args.out is not None else _default_out(args.scene)
     check_folder(out, force=args.force, resume=args.resume,     # before meshing
                  option_names=("--force", "--resume"))
@@ -404,7 +406,8 @@ def _add_ensemble(subparsers):
                        help="address of a running dask scheduler, e.g. tcp://host:8786")
     where.add_argument("--workers", type=_int_at_least(1), default=2,
                        help="worker processes of the local cluster (default 2)")
-    p.add_argument("--steps", type=_int_at_least(1), default=200, help="at most this many steps per sample")
+    p.add_argument("--steps", type=_int_at_least(1), default=None,
+                   help="at most this many steps per sample (default: the scene's, else 200)")
     p.add_argument("--contact", choices=["auto", "never"], default="auto", help="as for run")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=_run_ensemble)
@@ -428,7 +431,8 @@ def _run_ensemble(args):
     out = args.out if args.out is not None else os.path.join("out", f"{name}_ensemble")
     ensemble = Ensemble(SceneFactory(args.scene, overrides),           # checks the scene, writes nothing
                         list(range(args.seed, args.seed + args.samples)), out=out,
-                        control={"max_steps": args.steps}, contact=args.contact, workers=args.workers,
+                        control={} if args.steps is None else {"max_steps": args.steps},
+                        contact=args.contact, workers=args.workers,
                         progress=not args.quiet)
     client = None
     if args.scheduler is not None:

@@ -195,6 +195,23 @@ def test_failed_run_exits_1_with_the_last_good_state(tmp_path, capsys, monkeypat
     assert (out / "checkpoint_000002.npz").exists()
 
 
+def test_the_scenes_own_max_steps_holds_unless_steps_is_given(tmp_path, monkeypatch):
+    """Measured before: --steps defaulted to 200 and overrode a scene's max_steps (the beam's
+    1000)."""
+    def plate_of_three_steps(maxh=0.034):
+        """The plate, three steps at most."""
+        scene = scenes.plate(maxh=maxh, radius=None)
+        scene.control = {**scene.control, "max_steps": 3}
+        return scene
+
+    monkeypatch.setitem(scenes.SCENES, "plate", plate_of_three_steps)
+    for extra, steps in (([], 3), (["--steps", "2"], 2)):
+        out = tmp_path / str(steps)
+        assert main(["run", "plate", *SMALL, "--out", str(out), *extra]) == 0
+        s = json.loads((out / "summary.json").read_text())
+        assert s["reason"] == "max_steps" and s["n_steps"] == steps and s["control"]["max_steps"] == steps
+
+
 def test_a_run_with_notes_says_so_in_its_closing_lines(tmp_path, capsys):
     """A departure from the plain path is in summary.json; the closing lines say how many
     there are and repeat the last (the coarse sphere's eighth step leaves vertices no
