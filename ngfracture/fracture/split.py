@@ -198,6 +198,11 @@ class SplitResult:
         return len(self.parent) - int(self.record["nv_old"])
 
     @property
+    def refused(self):
+        """The processed vertices that cut no edge (rules 2a, none), ascending."""
+        return np.sort(self.record["vertex"][np.diff(self.record["edge_offsets"]) == 0]).astype(np.int64)
+
+    @property
     def refusals(self):
         """The processed vertices that cut no edge, counted by their rules ("2 2a", "none").
 

@@ -123,6 +123,11 @@ class Split3dResult:
         return len(self.parent) - int(self.record["nv_old"])
 
     @property
+    def refused(self):
+        """The processed vertices that changed nothing (flag ``none``), ascending."""
+        return np.sort(self.record["vertex"][(self.record["flags"] & SPLIT3D_FLAGS["none"]) != 0]).astype(np.int64)
+
+    @property
     def refusals(self):
         """The processed vertices that changed nothing (flag ``none``), counted by the rule
         that refused them (``REFUSALS_3D``; "none" where no rule is named).

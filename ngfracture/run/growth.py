@@ -14,6 +14,8 @@ equilibrium (:data:`NO_EQUILIBRIUM`) is taken as that: the crack runs on unstabl
 run ends broken at that load with the cracked state.
 """
 
+import numpy as np
+
 from ..fracture.strain import principal
 from ..mechanics.resultants import load_vector, unsupported_pieces, work_of_forces
 from .records import Relaxation, StepFailed, merged_notes
@@ -33,7 +35,7 @@ CRITICAL_MARGIN = 1e-3
 CRITICAL_ITERATIONS = 40
 
 
-def max_overstrain(stepper, mesh, u, strength, arrays, timings):
+def max_overstrain(stepper, mesh, u, strength, arrays, timings, skip=None):
     """The largest overstrain of a displacement's vertices (a vertex cracks above 1).
 
     Parameters
@@ -46,6 +48,8 @@ def max_overstrain(stepper, mesh, u, strength, arrays, timings):
     arrays : MeshArrays
         The mesh as arrays.
     timings : Timings
+    skip : numpy.ndarray, optional
+        Vertices left out (those no splitting rule cuts).
 
     Returns
     -------
@@ -53,7 +57,10 @@ def max_overstrain(stepper, mesh, u, strength, arrays, timings):
     """
     with timings.timed("strain"):
         tensors = stepper.criterion.overstrain(mesh, u, strength, arrays=arrays)
-        return float(principal(tensors)[0].max(initial=0.0))
+        values = principal(tensors)[0]
+        if skip is not None:
+            values[skip] = 0.0
+        return float(values.max(initial=0.0))
 
 
 def critical_event(stepper, state, dx, method, timings, substeps=1, keep=True):
@@ -62,8 +69,11 @@ def critical_event(stepper, state, dx, method, timings, substeps=1, keep=True):
     Where the accepted state is itself overstrained (the crack it grew is critical at a lower
     load), the event's load is sought below the state's; else the increment x + dx is
     solved and, where it overstrains a vertex, the load is brought back to the critical
-    one. Where the critical vertex splits nothing (no rule cuts it), the step takes its
-    whole increment and splits what the fixed-load pass splits there.
+    one. Where the critical vertex splits nothing (no rule cuts it: the end of a clamped
+    edge, a pocket between crack sheets), the event is sought again without it, at the
+    critical load of the vertices that remain (noted); where the pass splits nothing and
+    refuses no new vertex, the step takes its whole increment and splits what the
+    fixed-load pass splits there.
 
     Parameters
     ----------
@@ -87,26 +97,37 @@ def critical_event(stepper, state, dx, method, timings, substeps=1, keep=True):
     iterations : int
     notes : list of str
     """
-    U = state.u.reshape(2, -1)[:, :state.mesh.nv].T
-    m_state = max_overstrain(stepper, state.mesh, U, state.strength, state.arrays, timings) if state.step else 0.0
-    x_try = state.x if m_state >= 1.0 else state.x + dx
-    prob, eq, start = stepper.increment(state, x_try, method, timings, substeps, keep)
-    x, pc, ec, more = critical_load(stepper, state, x_try, prob, eq, method, timings)
-    iterations = eq.iterations + more
-    if pc is prob:            # x_try overstrains nothing: a quiet increment
-        return x_try, prob, eq, None, start, iterations, eq.notes
-    crack = stepper.crack_pass(pc, x, state.strength, ec.tangent, timings)
-    if crack.n_split:
-        return x, pc, ec, crack, start, iterations, ec.notes
+    U = state.u.reshape(state.mesh.dim, -1)[:, :state.mesh.nv].T
+    skip, notes, iterations, x_try = np.zeros(0, dtype=np.int64), [], 0, None
+    while True:
+        m_state = max_overstrain(stepper, state.mesh, U, state.strength, state.arrays, timings, skip) if state.step else 0.0
+        if x_try != (state.x if m_state >= 1.0 else state.x + dx):
+            # the state's kept tangent serves the first increment solve only (as in the fallback)
+            first, x_try = x_try is None, state.x if m_state >= 1.0 else state.x + dx
+            prob, eq, start = stepper.increment(state, x_try, method, timings, substeps, keep and first)
+            iterations += eq.iterations
+        x, pc, ec, more = critical_load(stepper, state, x_try, prob, eq, method, timings, skip)
+        iterations += more
+        if pc is prob:            # x_try overstrains nothing (but vertices no rule cuts): a quiet
+            return x_try, prob, eq, None, start, iterations, eq.notes   # increment, whose pass notes them
+        crack = stepper.crack_pass(pc, x, state.strength, ec.tangent, timings)
+        if crack.n_split:
+            return x, pc, ec, crack, start, iterations, merged_notes(ec.notes, notes)
+        refused = np.setdiff1d(crack.refused_vertices, skip)
+        if refused.size == 0:
+            break
+        # the critical vertex splits by no rule (a clamped corner, a pocket): the event is
+        # the next vertex's, at its own critical load
+        skip, notes = np.union1d(skip, refused), merged_notes(notes, [crack.refusal_note()])
     note = (f"the vertex critical at x = {x:.6g} splits by no rule: the step took its whole increment "
             f"(growth at fixed load)")
     if x_try != state.x + dx:
         prob, eq, _ = stepper.increment(state, state.x + dx, method, timings, substeps, keep=False)
         iterations += eq.iterations
-    return state.x + dx, prob, eq, None, start, iterations, merged_notes(eq.notes, [note])
+    return state.x + dx, prob, eq, None, start, iterations, merged_notes(eq.notes, notes + [note])
 
 
-def critical_load(stepper, state, x_try, prob, eq, method, timings):
+def critical_load(stepper, state, x_try, prob, eq, method, timings, skip=None):
     """Growth resolved in load: the load at which the most overstrained vertex is just critical.
 
     Where the increment's equilibrium at ``x_try`` overstrains a vertex, the load is
@@ -125,6 +146,8 @@ def critical_load(stepper, state, x_try, prob, eq, method, timings):
     eq : Equilibrium
     method : {"modified", "full", "rescue"}
     timings : Timings
+    skip : numpy.ndarray, optional
+        Vertices whose overstrain does not count (no splitting rule cuts them).
 
     Returns
     -------
@@ -136,7 +159,7 @@ def critical_load(stepper, state, x_try, prob, eq, method, timings):
     StepFailed
         "critical_load": no load within CRITICAL_ITERATIONS makes the crack just critical.
     """
-    m = max_overstrain(stepper, prob.mesh, prob.u, state.strength, prob.arrays, timings)
+    m = max_overstrain(stepper, prob.mesh, prob.u, state.strength, prob.arrays, timings, skip)
     if m <= 1.0:
         return x_try, prob, eq, 0
     target = 1.0 + CRITICAL_MARGIN
@@ -150,7 +173,7 @@ def critical_load(stepper, state, x_try, prob, eq, method, timings):
         prob = stepper.problem(state.mesh, x, timings, state.u)
         eq = stepper.equilibrium(prob, "increment", method, timings, warm=state.contact_keys)
         iterations += eq.iterations
-        m = max_overstrain(stepper, prob.mesh, prob.u, state.strength, prob.arrays, timings)
+        m = max_overstrain(stepper, prob.mesh, prob.u, state.strength, prob.arrays, timings, skip)
         if 1.0 <= m <= 1.0 + 2 * CRITICAL_MARGIN:
             return x, prob, eq, iterations
         if m > 1.0:

@@ -102,6 +102,8 @@ class CrackPass:
     refused : dict
         Of a pass that split nothing: its overstrained vertices counted by the splitting
         rule that refused them (the engines' ``refusals``); empty when none was refused.
+    refused_vertices : numpy.ndarray
+        Those vertices (the engines' ``refused``), ascending.
     """
     problem: object
     n_split: int
@@ -110,6 +112,7 @@ class CrackPass:
     positions: np.ndarray
     overstrain: float
     refused: dict = field(default_factory=dict)
+    refused_vertices: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
 
     def refusal_note(self):
         """The note of a pass that left overstrained vertices unsplit (None if it did not):

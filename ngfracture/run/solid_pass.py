@@ -53,7 +53,7 @@ def solid_crack_pass(stepper, prob, x, strength, tensors, largest, tangent, timi
     res = split_by_tensor_3d(prob.arrays, tensors, 1.0, mode=stepper.control.split)
     timings.add("split", time.perf_counter() - t0)
     if res.nsplit == 0:
-        return CrackPass(None, 0, strength, None, np.zeros((0, 3)), largest, res.refusals)
+        return CrackPass(None, 0, strength, None, np.zeros((0, 3)), largest, res.refusals, res.refused)
     made = np.diff(res.record["new_offsets"]) > 0
     positions = prob.arrays.points[res.record["vertex"][made]]
     # P1: the displacement is a vertex field (component-major), copied through the split

@@ -249,7 +249,7 @@ class LoadStep:
         timings.add("split", time.perf_counter() - t0 - rebuild)
         timings.add("rebuild", rebuild)
         if res.nsplit == 0:
-            return CrackPass(None, 0, strength, None, np.zeros((0, 2)), largest, res.refusals)
+            return CrackPass(None, 0, strength, None, np.zeros((0, 2)), largest, res.refusals, res.refused)
         positions = res.record["position"][np.diff(res.record["new_offsets"]) > 0]
         # P1: the displacement is a vertex field (component-major), copied through the split
         u = transfer_vertex_field(prob.u.vec.FV().NumPy().reshape(2, -1).T, res).T.reshape(-1)
