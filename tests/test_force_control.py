@@ -103,3 +103,31 @@ def test_past_the_peak_the_force_follows_the_lefm_load_of_the_grown_crack(senb):
     assert min(x[peak + 1:]) < x[peak]
     rows = list(csv.reader((out / "force_displacement.csv").open()))
     assert "load_Fy" in rows[0] and len(rows) == 1 + result.summary["n_steps"]
+
+
+def test_a_bar_on_tetrahedra_under_an_end_traction_breaks_at_its_critical_load():
+    """Force control in 3D: the notched bar of ``bar3d`` pulled by a traction on its right end
+    cracks at the load where its most overstrained vertex is just critical (the overstrain
+    grows in proportion to the load to 1e-4: St Venant-Kirchhoff at strains of 1e-4), and
+    under the dead load the crack runs on through the ligament: the run ends broken at that
+    load. Before, the critical load's search read the displacement as a 2D one and every
+    step after the first failed."""
+    from ngfracture.run.growth import CRITICAL_MARGIN
+    from ngfracture.scenes.solids import corner_vertices, hold_gliding_ends
+    bar = nf.scenes.bar3d(maxh=0.4, radius=0.2, thickness=0.25)
+    corners = corner_vertices(bar.mesh, [[0.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+
+    def pull(prob, x):
+        prob.add_dirichlet("left", 0.0, component="x")
+        prob.add_traction("right", (x, 0.0, 0.0))
+        hold_gliding_ends(prob, corners)
+
+    scene = nf.Scene(name="bar3d_traction", mesh=bar.mesh, material=bar.material, critical=bar.critical,
+                     apply_load=pull, load_max=1e7, dx=2.5e5, contact_tol=bar.contact_tol, stop_when_unloaded=True,
+                     radius=bar.radius, control=bar.control)
+    result = nf.Simulation(scene, pictures="none").run()
+    first, cracked = result.summary["history"][:2]
+    assert first["split_vertices"] == 0 and cracked["split_vertices"] > 0
+    critical_load = first["x"] / first["overstrain"]
+    assert cracked["x"] == pytest.approx(critical_load * (1 + CRITICAL_MARGIN), rel=1.5 * CRITICAL_MARGIN)
+    assert result.reason == "broken" and result.summary["load"] == cracked["x"]
