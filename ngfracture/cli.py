@@ -246,7 +246,8 @@ def _run_run(args):
           f"{result.reason}: {result.message}", file=closing)
     if s.get("notes"):     # departures from the plain path (docs/command_line.md): say that there are some
         last = s["notes"][-1]
-        print(f"{len(s['notes'])} notes in summary.json (\"notes\"), the last of step {last['step']}: "
+        print(f"{len(s['notes'])} note{'s' if len(s['notes']) > 1 else ''} in summary.json (\"notes\"), "
+              f"the last of step {last['step']}: "
               f"{last['note']}", file=closing)
     if s.get("pictures", {}).get("final_error"):
         print(f"final.png was not drawn: {s['pictures']['final_error']}", file=sys.stderr)

@@ -220,7 +220,7 @@ def test_a_run_with_notes_says_so_in_its_closing_lines(tmp_path, capsys):
     assert main(["run", "sphere3d", "--set", "maxh=0.4", "--set", "fine=0.15", "--steps", "8", "--quiet",
                  "--pictures", "none", "--out", str(out)]) == 0
     notes = json.loads((out / "summary.json").read_text())["notes"]
-    assert notes and "stay overstrained" in notes[-1]["note"]
+    assert notes and "overstrained (up to" in notes[-1]["note"] and "where no splitting rule cuts" in notes[-1]["note"]
     line = f'{len(notes)} notes in summary.json ("notes"), the last of step {notes[-1]["step"]}: {notes[-1]["note"]}'
     assert line in capsys.readouterr().out.splitlines()
 

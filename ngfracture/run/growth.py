@@ -21,7 +21,8 @@ from ..mechanics.resultants import load_vector, unsupported_pieces, work_of_forc
 from .records import Relaxation, StepFailed, merged_notes
 from .refinement import refine_equilibrium
 
-__all__ = ["NO_EQUILIBRIUM", "CRITICAL_MARGIN", "CRITICAL_ITERATIONS", "max_overstrain", "critical_event", "critical_load", "relax"]
+__all__ = ["NO_EQUILIBRIUM", "CRITICAL_MARGIN", "CRITICAL_ITERATIONS", "max_overstrain", "critical_event", "critical_load",
+           "left_out", "relax"]
 
 #: failures of a solve at fixed load that, under a scene's dead loads, mean there is no
 #: equilibrium: the crack runs on (force control)
@@ -43,7 +44,7 @@ def max_overstrain(stepper, mesh, u, strength, arrays, timings, skip=None):
     stepper : LoadStep
     mesh : ngsolve.Mesh
     u : ngsolve.GridFunction or numpy.ndarray
-        The displacement, or its vertex values (nv, 2).
+        The displacement, or its vertex values (nv, dim).
     strength : numpy.ndarray or None
     arrays : MeshArrays
         The mesh as arrays.
@@ -102,10 +103,16 @@ def critical_event(stepper, state, dx, method, timings, substeps=1, keep=True):
     while True:
         m_state = max_overstrain(stepper, state.mesh, U, state.strength, state.arrays, timings, skip) if state.step else 0.0
         if x_try != (state.x if m_state >= 1.0 else state.x + dx):
-            # the state's kept tangent serves the first increment solve only (as in the fallback)
-            first, x_try = x_try is None, state.x if m_state >= 1.0 else state.x + dx
-            prob, eq, start = stepper.increment(state, x_try, method, timings, substeps, keep and first)
+            x_try = state.x if m_state >= 1.0 else state.x + dx
+            prob, eq, start = stepper.increment(state, x_try, method, timings, substeps, keep)
             iterations += eq.iterations
+            if x_try == state.x:
+                # the state is overstrained: where only by vertices no rule cuts, its own pass
+                # says so, without a search below its load
+                own = stepper.crack_pass(prob, x_try, state.strength, eq.tangent, timings)
+                if own.n_split == 0 and np.setdiff1d(own.refused_vertices, skip).size:
+                    skip, notes = np.union1d(skip, own.refused_vertices), merged_notes(notes, [left_out(own, x_try)])
+                    continue
         x, pc, ec, more = critical_load(stepper, state, x_try, prob, eq, method, timings, skip)
         iterations += more
         if pc is prob:            # x_try overstrains nothing (but vertices no rule cuts): a quiet
@@ -113,18 +120,37 @@ def critical_event(stepper, state, dx, method, timings, substeps=1, keep=True):
         crack = stepper.crack_pass(pc, x, state.strength, ec.tangent, timings)
         if crack.n_split:
             return x, pc, ec, crack, start, iterations, merged_notes(ec.notes, notes)
-        refused = np.setdiff1d(crack.refused_vertices, skip)
-        if refused.size == 0:
+        if np.setdiff1d(crack.refused_vertices, skip).size == 0:
             break
         # the critical vertex splits by no rule (a clamped corner, a pocket): the event is
         # the next vertex's, at its own critical load
-        skip, notes = np.union1d(skip, refused), merged_notes(notes, [crack.refusal_note()])
-    note = (f"the vertex critical at x = {x:.6g} splits by no rule: the step took its whole increment "
+        skip, notes = np.union1d(skip, crack.refused_vertices), merged_notes(notes, [left_out(crack, x)])
+    note = (f"the pass at the critical load x = {x:.6g} split nothing: the step took its whole increment "
             f"(growth at fixed load)")
     if x_try != state.x + dx:
         prob, eq, _ = stepper.increment(state, state.x + dx, method, timings, substeps, keep=False)
         iterations += eq.iterations
     return state.x + dx, prob, eq, None, start, iterations, merged_notes(eq.notes, notes + [note])
+
+
+def left_out(crack, x):
+    """The note of vertices a critical load's search leaves out: no splitting rule cuts them.
+
+    Parameters
+    ----------
+    crack : CrackPass
+        The pass that refused them.
+    x : float
+        Its load.
+
+    Returns
+    -------
+    str
+    """
+    rules = ", ".join(f"{name}: {count}" for name, count in crack.refused.items())
+    n = sum(crack.refused.values())
+    return (f"{n} {'vertex' if n == 1 else 'vertices'} overstrained at x = {x:.6g} (up to {crack.overstrain:.4g}) "
+            f"split by no rule ({rules}): left out of the search for the critical load")
 
 
 def critical_load(stepper, state, x_try, prob, eq, method, timings, skip=None):
