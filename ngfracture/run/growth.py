@@ -22,7 +22,7 @@ from .records import Relaxation, StepFailed, merged_notes
 from .refinement import refine_equilibrium
 
 __all__ = ["NO_EQUILIBRIUM", "CRITICAL_MARGIN", "CRITICAL_ITERATIONS", "max_overstrain", "critical_event", "critical_load",
-           "left_out", "relax"]
+           "relax"]
 
 #: failures of a solve at fixed load that, under a scene's dead loads, mean there is no
 #: equilibrium: the crack runs on (force control)
@@ -111,7 +111,7 @@ def critical_event(stepper, state, dx, method, timings, substeps=1, keep=True):
                 # says so, without a search below its load
                 own = stepper.crack_pass(prob, x_try, state.strength, eq.tangent, timings)
                 if own.n_split == 0 and np.setdiff1d(own.refused_vertices, skip).size:
-                    skip, notes = np.union1d(skip, own.refused_vertices), merged_notes(notes, [left_out(own, x_try)])
+                    skip, notes = np.union1d(skip, own.refused_vertices), merged_notes(notes, [own.left_out_note(x_try)])
                     continue
         x, pc, ec, more = critical_load(stepper, state, x_try, prob, eq, method, timings, skip)
         iterations += more
@@ -124,33 +124,13 @@ def critical_event(stepper, state, dx, method, timings, substeps=1, keep=True):
             break
         # the critical vertex splits by no rule (a clamped corner, a pocket): the event is
         # the next vertex's, at its own critical load
-        skip, notes = np.union1d(skip, crack.refused_vertices), merged_notes(notes, [left_out(crack, x)])
+        skip, notes = np.union1d(skip, crack.refused_vertices), merged_notes(notes, [crack.left_out_note(x)])
     note = (f"the pass at the critical load x = {x:.6g} split nothing: the step took its whole increment "
             f"(growth at fixed load)")
     if x_try != state.x + dx:
         prob, eq, _ = stepper.increment(state, state.x + dx, method, timings, substeps, keep=False)
         iterations += eq.iterations
     return state.x + dx, prob, eq, None, start, iterations, merged_notes(eq.notes, notes + [note])
-
-
-def left_out(crack, x):
-    """The note of vertices a critical load's search leaves out: no splitting rule cuts them.
-
-    Parameters
-    ----------
-    crack : CrackPass
-        The pass that refused them.
-    x : float
-        Its load.
-
-    Returns
-    -------
-    str
-    """
-    rules = ", ".join(f"{name}: {count}" for name, count in crack.refused.items())
-    n = sum(crack.refused.values())
-    return (f"{n} {'vertex' if n == 1 else 'vertices'} overstrained at x = {x:.6g} (up to {crack.overstrain:.4g}) "
-            f"split by no rule ({rules}): left out of the search for the critical load")
 
 
 def critical_load(stepper, state, x_try, prob, eq, method, timings, skip=None):

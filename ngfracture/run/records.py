@@ -124,10 +124,29 @@ class CrackPass:
         """
         if not self.refused:
             return None
-        rules = ", ".join(f"{name}: {count}" for name, count in self.refused.items())
-        n = sum(self.refused.values())
+        n, rules = self._refused_in_words()
         return (f"{n} {'vertex stays' if n == 1 else 'vertices stay'} overstrained (up to {self.overstrain:.4g}) "
                 f"where no splitting rule cuts them ({rules}): cracks stop there on the rules, not on the criterion")
+
+    def left_out_note(self, x):
+        """The note of the refused vertices that a critical load's search leaves out.
+
+        Parameters
+        ----------
+        x : float
+            The load this pass judged.
+
+        Returns
+        -------
+        str
+        """
+        n, rules = self._refused_in_words()
+        return (f"{n} {'vertex' if n == 1 else 'vertices'} overstrained at x = {x:.6g} (up to {self.overstrain:.4g}) "
+                f"split by no rule ({rules}): left out of the search for the critical load")
+
+    def _refused_in_words(self):
+        """(how many vertices were refused, "rule: count, ..."), for the notes."""
+        return sum(self.refused.values()), ", ".join(f"{name}: {count}" for name, count in self.refused.items())
 
 
 @dataclass
